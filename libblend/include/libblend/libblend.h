@@ -1,0 +1,9 @@
+/* libblend — the umbrella header: include this one. */
+#ifndef LIBBLEND_H
+#define LIBBLEND_H
+
+#include "common.h"
+#include "operators.h"
+#include "primitives.h"
+
+#endif

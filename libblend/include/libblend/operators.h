@@ -1,0 +1,176 @@
+/*
+ * libblend — operators.h: scalar blend operators with analytic gradients.
+ *
+ * Naming and invariants (hg_sdf style, stated once for every family):
+ *  - One entry point per family: lb_<family>(op, k, x, <per-argument
+ *    parameters>, value, grad, err). `op` selects union, intersection or
+ *    difference; the difference subtracts x[1..k-1] from x[0].
+ *  - x[0..k-1] are the values of the blended fields at one point. Per-argument
+ *    parameter arrays have length k: r (blending range, > 0), p (curvature
+ *    exponent, > 1 so the result is C1), m (subsequent-blend parameter, > 0;
+ *    m = 1 everywhere reproduces the older operator exactly). m may be NULL,
+ *    meaning m_i = 1.
+ *  - `value` receives the blend; `grad` (may be NULL) receives the k partial
+ *    derivatives d value / d x_i. The spatial gradient is the chain rule
+ *    sum_i grad[i] * grad f_i(X).
+ *  - Root-solved operators use one safeguarded solver (Newton inside a bracket,
+ *    bisection fallback): the result never leaves the bracket stated in
+ *    shared/spec/operators.md, and gradients come from the implicit function
+ *    theorem, so they are exact to rounding.
+ *  - For every finite input and valid parameters the value and the gradient
+ *    are finite. Non-finite inputs give LB_ERR_NOT_FINITE; invalid parameters
+ *    give LB_ERR_INVALID_ARGUMENT naming the parameter and its allowed range.
+ *  - Conventions: `zero` families (displacement, conic, scale, bounded,
+ *    R-functions) have f < 0 inside and f = 0 on the surface; `soft` families
+ *    (soft_hyper, soft_conic, scale_ba/bs, sum, Ricci, Perlin) have f > 0.5
+ *    inside and f = 0.5 on the surface.
+ */
+#ifndef LIBBLEND_OPERATORS_H
+#define LIBBLEND_OPERATORS_H
+
+#include "common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Largest number of arguments one operator call takes. */
+#define LB_MAX_ARITY 256
+/* Largest curvature exponent p accepted. */
+#define LB_MAX_EXPONENT 1000.0
+
+typedef enum lb_setop {
+    LB_UNION = 0,
+    LB_INTERSECTION = 1,
+    LB_DIFFERENCE = 2 /* x[0] minus x[1..k-1] */
+} lb_setop;
+
+/* ---- Displacement family BT_k (zero convention) [hsu2006 3.1-3.4] --------
+ * Union: h with sum_i [(r_i - x_i + m_i h)/r_i]+^p_i = 1; equals
+ * min_i x_i/m_i away from the blending region; the zero set does not depend
+ * on m. m = 1 is Rockwood's displacement union. Intersection is
+ * -union(-x), difference -union(-x_0, x_1, ..., x_{k-1}).
+ * Fast paths: all p_i = 2 is solved in closed form per active set; integer
+ * p_i use products instead of pow().
+ * Parameters: 1 <= k <= LB_MAX_ARITY; r_i > 0; 1 < p_i <= LB_MAX_EXPONENT;
+ * m_i > 0 (m may be NULL). */
+LB_API lb_status lb_displacement(lb_setop op, size_t k, const double *x, const double *r,
+                                 const double *p, const double *m, double *value, double *grad,
+                                 lb_error *err);
+
+/* ---- Binary conic BT_2 (zero convention) [hsu2006 3.2.1, Eq. 4] ----------
+ * Closed form. x, r, m have 2 entries (m may be NULL); p is the conic's shape
+ * parameter, -inf < p < r1 r2 (p = 0 is the quarter ellipse, identical to
+ * lb_displacement with p_1 = p_2 = 2). */
+LB_API lb_status lb_conic(lb_setop op, const double x[2], const double r[2], double p,
+                          const double m[2], double *value, double grad[2], lb_error *err);
+
+/* ---- Scale method (Hsu-Lee) [hsu-bounded 2.4.2; hsu-nonuniform 2.3] -------
+ * lb_scale_ba: soft-domain Min-like B_A(y) (r_i > 0); equals min(y) when
+ * min(y) <= 0. lb_scale_bs: Max-like B_S(y) (0 < r_i <= 1); equals max(y)
+ * when max(y) <= 0; all r_i = 1 is Ricci's (sum y_i^p)^(1/p).
+ * lb_scale: zero-convention set operations B_U, B_I, B_D built from them
+ * (shared/spec/operators.md section 5). Parameters: r_i > 0 (and r_i <= 1
+ * wherever B_S is used: lb_scale_bs always; lb_scale for every op, since the
+ * sign of its shifted arguments decides between B_A and B_S per point);
+ * 1 < p_i <= LB_MAX_EXPONENT. */
+LB_API lb_status lb_scale_ba(size_t k, const double *y, const double *r, const double *p,
+                             double *value, double *grad, lb_error *err);
+LB_API lb_status lb_scale_bs(size_t k, const double *y, const double *r, const double *p,
+                             double *value, double *grad, lb_error *err);
+LB_API lb_status lb_scale(lb_setop op, size_t k, const double *x, const double *r,
+                          const double *p, double *value, double *grad, lb_error *err);
+
+/* ---- Bounded primitives [hsu-bounded 3] ------------------------------------
+ * Scale-method set operations whose ranges are position functions built from
+ * a bounding solid per argument: c[i] is the value of the bounding solid of
+ * argument i at the point (same kind of ray-linear function as x[i]).
+ * union: R_i = (x_i + 1)/(c_i + 1) - 1; intersection: R_i = 1 - (x_i + 1)/(c_i + 1);
+ * difference: R_0 as for intersection, the others as for union. Where
+ * c_i <= -1, or R_i would fall below omega (a bounding solid that does not
+ * contain its primitive there), R_i = omega = LB_BOUNDED_OMEGA. Outside its
+ * bounding solid an argument does not blend: the union's blending region of
+ * f_i is exactly {f_i >= 0, f_ci <= 0}. grad_x and grad_c (each may be NULL)
+ * receive d value / d x_i and d value / d c_i. Parameters: 1 < p_i <= LB_MAX_EXPONENT. */
+#define LB_BOUNDED_OMEGA 1e-3
+LB_API lb_status lb_bounded(lb_setop op, size_t k, const double *x, const double *c,
+                            const double *p, double *value, double *grad_x, double *grad_c,
+                            lb_error *err);
+
+/* ---- Bulge elimination [hsu2006 5; hsu-bounded 2.5] ------------------------
+ * Binary blends whose ranges (and, for the displacement family, m) depend on
+ * the angle theta between the argument gradients g1, g2:
+ *   R_i = r_i (1 - cos theta + omega)                 (LB_BULGE_RANGE)
+ *   M_i as in shared/spec/operators.md section 4      (LB_BULGE_SLOPE; not for
+ *                                                      the scale family)
+ * Gradients: dx[2] = d value / d x_i, dg1[3], dg2[3] = d value / d g1, g2
+ * (each may be NULL); the spatial gradient is dx[0] g1 + dx[1] g2
+ * + H1 dg1 + H2 dg2 with H_i the Hessians of the arguments. Where a gradient
+ * is zero, cos theta is taken as 0. For intersection and difference the
+ * angle is measured between the gradients of the arguments as they enter the
+ * dual union (the subtracted argument's gradient is negated). */
+typedef enum lb_bulge_family {
+    LB_BULGE_DISPLACEMENT = 0, /* lb_displacement with k = 2 */
+    LB_BULGE_CONIC = 1,        /* lb_conic */
+    LB_BULGE_SCALE = 2         /* lb_scale with k = 2 */
+} lb_bulge_family;
+
+enum { LB_BULGE_RANGE = 1u, LB_BULGE_SLOPE = 2u };
+
+typedef struct lb_bulge_params {
+    double r[2];     /* base ranges r_i > 0 (<= 1 for the scale family) */
+    double p[2];     /* curvature exponents (displacement, scale) */
+    double conic_p;  /* conic shape parameter (conic family), < R_1 R_2 everywhere */
+    double m[2];     /* base m_i > 0 (displacement, conic) */
+    double omega;    /* >= 0, range floor; 0.001 in the papers */
+    unsigned flags;  /* LB_BULGE_RANGE | LB_BULGE_SLOPE */
+} lb_bulge_params;
+
+LB_API lb_status lb_bulge(lb_bulge_family family, lb_setop op, const lb_bulge_params *params,
+                          const double x[2], const double g1[3], const double g2[3],
+                          double *value, double dx[2], double dg1[3], double dg2[3],
+                          lb_error *err);
+
+/* ---- Non-uniform scaling for soft objects [hsu-nonuniform 3-4] -------------
+ * s_i(h) = 0.5^(1 - m_i) h^m_i. lb_soft_hyper: super-ellipsoidal k-ary union
+ * B_Sk (Max-like, 0 < r_i <= 1), intersection B_Ak (Min-like, r_i > 0) and
+ * difference B_Ak(x_0, 1 - x_1, ...) (r_0 > 0, the others as intersection).
+ * The 0.5 surface does not depend on m. Away from the blending region the
+ * result is Max/Min of 0.5 (x_i / 0.5)^(1/m_i).
+ * lb_soft_conic: the binary variants with the conic of lb_conic as base curve
+ * (p < r1 r2), solved numerically. */
+LB_API lb_status lb_soft_hyper(lb_setop op, size_t k, const double *x, const double *r,
+                               const double *p, const double *m, double *value, double *grad,
+                               lb_error *err);
+LB_API lb_status lb_soft_conic(lb_setop op, const double x[2], const double r[2], double p,
+                               const double m[2], double *value, double grad[2], lb_error *err);
+
+/* ---- Classic operators (baselines) ----------------------------------------
+ * zero: LB_MIN (union), LB_MAX (intersection), R-functions (binary, k = 2):
+ * union f1 + f2 - sqrt(f1^2 + f2^2), intersection f1 + f2 + sqrt(f1^2 + f2^2).
+ * soft: LB_SOFT_SUM (Wyvill sum), LB_RICCI_UNION (sum x_i^n)^(1/n) with
+ * param = n >= 1 on x_i >= 0 (negative x_i count as 0), Perlin union
+ * 1 - prod(1 - x_i), intersection prod x_i, difference x_0 prod_{i>0}(1 - x_i).
+ * At ties, min/max differentiate with respect to the first extreme argument;
+ * the R-functions' gradient at (0, 0) is taken as (1/2, 1/2) times the limit
+ * along the diagonal, i.e. (1 - 1/sqrt 2) for union. */
+typedef enum lb_classic_kind {
+    LB_MIN = 0,
+    LB_MAX = 1,
+    LB_RFUNC_UNION = 2,
+    LB_RFUNC_INTERSECTION = 3,
+    LB_SOFT_SUM = 4,
+    LB_RICCI_UNION = 5,
+    LB_PERLIN_UNION = 6,
+    LB_PERLIN_INTERSECTION = 7,
+    LB_PERLIN_DIFFERENCE = 8
+} lb_classic_kind;
+
+LB_API lb_status lb_classic(lb_classic_kind kind, size_t k, const double *x, double param,
+                            double *value, double *grad, lb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

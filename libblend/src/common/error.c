@@ -1,0 +1,101 @@
+/* Error records and parameter validation shared by every public entry point. */
+#include "internal.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+
+int lb_version(void) {
+    return LB_VERSION_MAJOR * 10000 + LB_VERSION_MINOR * 100 + LB_VERSION_PATCH;
+}
+
+const char *lb_status_string(lb_status status) {
+    switch (status) {
+    case LB_OK: return "ok";
+    case LB_ERR_INVALID_ARGUMENT: return "invalid argument";
+    case LB_ERR_NOT_FINITE: return "non-finite input";
+    case LB_ERR_NO_MEMORY: return "out of memory or over a size limit";
+    case LB_ERR_INTERNAL: return "internal error";
+    }
+    return "unknown status";
+}
+
+lb_status lb__fail(lb_error *err, lb_status status, const char *fmt, ...) {
+    if (err) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(err->message, sizeof err->message, fmt, ap);
+        va_end(ap);
+        err->status = status;
+    }
+    return status;
+}
+
+lb_status lb__check_k(const char *fn, size_t k, size_t kmin, size_t kmax, lb_error *err) {
+    if (k < kmin || k > kmax) {
+        if (kmin == kmax)
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: k = %zu arguments; this operator takes exactly %zu", fn, k, kmin);
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: k = %zu arguments; allowed: %zu <= k <= %zu", fn, k, kmin, kmax);
+    }
+    return LB_OK;
+}
+
+lb_status lb__check_finite(const char *fn, const char *name, size_t n, const double *v,
+                           lb_error *err) {
+    if (!v) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: %s is NULL", fn, name);
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(v[i]))
+            return lb__fail(err, LB_ERR_NOT_FINITE, "%s: %s[%zu] = %g is not finite", fn, name, i,
+                            v[i]);
+    return LB_OK;
+}
+
+lb_status lb__check_range(const char *fn, const char *name, size_t n, const double *v, double lo,
+                          int lo_closed, double hi, int hi_closed, const char *what,
+                          lb_error *err) {
+    if (!v) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: %s is NULL", fn, name);
+    for (size_t i = 0; i < n; ++i) {
+        const double a = v[i];
+        const int ok = isfinite(a) && (lo_closed ? a >= lo : a > lo) && (hi_closed ? a <= hi : a < hi);
+        if (!ok) {
+            if (n == 1)
+                return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: %s = %g is out of range; allowed: %s",
+                                fn, name, a, what);
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: %s[%zu] = %g is out of range; allowed: %s", fn, name, i, a, what);
+        }
+    }
+    return LB_OK;
+}
+
+lb_status lb__check_setop(const char *fn, lb_setop op, lb_error *err) {
+    if (op != LB_UNION && op != LB_INTERSECTION && op != LB_DIFFERENCE)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: op = %d is not a set operation; allowed: LB_UNION (0), "
+                        "LB_INTERSECTION (1), LB_DIFFERENCE (2)",
+                        fn, (int)op);
+    return LB_OK;
+}
+
+lb_status lb__check_out(const char *fn, const void *value, lb_error *err) {
+    if (!value) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: value (output) is NULL", fn);
+    return LB_OK;
+}
+
+int lb__exponent_mode(size_t k, const double *p) {
+    int all_two = 1, all_int = 1;
+    for (size_t i = 0; i < k; ++i) {
+        if (p[i] != 2.0) all_two = 0;
+        if (p[i] != floor(p[i]) || p[i] > 64.0) all_int = 0;
+    }
+    return all_two ? LB__P_TWO : all_int ? LB__P_INTEGER : LB__P_GENERAL;
+}
+
+void lb__dual_args(lb_setop op, size_t k, const double *x, double *xt, double *sign) {
+    for (size_t i = 0; i < k; ++i) {
+        const double s = (op == LB_UNION) ? 1.0 : (op == LB_INTERSECTION || i == 0) ? -1.0 : 1.0;
+        sign[i] = s;
+        xt[i] = s * x[i];
+    }
+}

@@ -1,0 +1,114 @@
+/* Internal declarations shared by libblend's source files. Not installed.
+ * Kernels named lb__* skip validation: the public wrappers validate first. */
+#ifndef LIBBLEND_INTERNAL_H
+#define LIBBLEND_INTERNAL_H
+
+#include "libblend/operators.h"
+#include "libblend/primitives.h"
+
+#include <math.h>
+#include <stddef.h>
+
+#if defined(__GNUC__)
+#define LB_INTERNAL __attribute__((visibility("hidden")))
+#define LB_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define LB_INTERNAL
+#define LB_PRINTF(a, b)
+#endif
+/* Tells GCC that a kernel reads only the first k (parameter n) elements of
+ * array parameter ptr, so stack scratch arrays of LB_MAX_ARITY that are
+ * filled up to k are not reported as maybe-uninitialised. */
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 10
+#define LB_READS(ptr, n) __attribute__((access(read_only, ptr, n)))
+#else
+#define LB_READS(ptr, n)
+#endif
+
+/* ---- errors and validation (common/error.c) ---- */
+LB_INTERNAL lb_status lb__fail(lb_error *err, lb_status status, const char *fmt, ...)
+    LB_PRINTF(3, 4);
+LB_INTERNAL lb_status lb__check_k(const char *fn, size_t k, size_t kmin, size_t kmax, lb_error *err);
+LB_INTERNAL lb_status lb__check_finite(const char *fn, const char *name, size_t n, const double *v,
+                                       lb_error *err);
+/* Each v[i] in the range; bounds are open (strict) unless *_closed is set.
+ * Use -INFINITY / INFINITY for no bound. `what` is the human text of the
+ * range, e.g. "r > 0". NULL v is an error naming the parameter. */
+LB_INTERNAL lb_status lb__check_range(const char *fn, const char *name, size_t n, const double *v,
+                                      double lo, int lo_closed, double hi, int hi_closed,
+                                      const char *what, lb_error *err);
+LB_INTERNAL lb_status lb__check_setop(const char *fn, lb_setop op, lb_error *err);
+LB_INTERNAL lb_status lb__check_out(const char *fn, const void *value, lb_error *err);
+/* r in (0, rmax] (rmax = INFINITY: r > 0), 1 < p <= LB_MAX_EXPONENT, m > 0 or NULL. */
+LB_INTERNAL lb_status lb__check_blend_params(const char *fn, size_t k, const double *r,
+                                             const double *p, const double *m, double rmax,
+                                             lb_error *err);
+/* x finite, r > 0, m > 0 or NULL, p < r0 r1 (conic shape). */
+LB_INTERNAL lb_status lb__check_conic(const char *fn, const double x[2], const double r[2],
+                                      double p, const double m[2], const void *value,
+                                      lb_error *err);
+
+/* ---- exponent helpers ---- */
+/* t^n for small non-negative integer n by repeated squaring. */
+static inline double lb__ipow(double t, unsigned n) {
+    double r = 1.0;
+    while (n) {
+        if (n & 1u) r *= t;
+        t *= t;
+        n >>= 1u;
+    }
+    return r;
+}
+
+/* How the exponents of one operator call can be evaluated. */
+enum { LB__P_GENERAL = 0, LB__P_INTEGER = 1, LB__P_TWO = 2 };
+LB_INTERNAL int lb__exponent_mode(size_t k, const double *p);
+
+/* t^(p-1) for t >= 0, using products when mode says the exponents are integers. */
+static inline double lb__pow_m1(double t, double p, int mode) {
+    if (mode != LB__P_GENERAL) return lb__ipow(t, (unsigned)p - 1u);
+    return pow(t, p - 1.0);
+}
+
+/* The conic base curve of hsu2006 Eq. 4 and its partial derivatives. */
+static inline double lb__conic_H(double r1, double r2, double p, double u1, double u2, double *H1,
+                                 double *H2) {
+    *H1 = 2.0 * (r2 * r2 * (u1 - r1) + p * u2);
+    *H2 = 2.0 * (r1 * r1 * (u2 - r2) + p * u1);
+    return r2 * r2 * u1 * u1 + r1 * r1 * u2 * u2 + r1 * r1 * r2 * r2 - 2.0 * r2 * r2 * r1 * u1 -
+           2.0 * r1 * r1 * r2 * u2 + 2.0 * p * u1 * u2;
+}
+
+/* ---- kernels (unchecked). Gradient outputs may be NULL. ---- */
+
+/* BT_k union (displacement). m must be non-NULL. dx, dr, dm: d/dx_i, d/dr_i, d/dm_i. */
+LB_INTERNAL LB_READS(2, 1) LB_READS(3, 1) LB_READS(5, 1) double lb__bt_union(size_t k, const double *x, const double *r, const double *p,
+                                const double *m, int mode, double *dx, double *dr, double *dm);
+/* Same, by the generic safeguarded Newton solver only (no closed form): the
+ * reference the p = 2 closed form is tested against. */
+LB_INTERNAL double lb__bt_union_newton(size_t k, const double *x, const double *r,
+                                       const double *p, const double *m, int mode, double *dx,
+                                       double *dr, double *dm);
+
+/* Binary conic union, closed form (and root-solved, for tests). */
+LB_INTERNAL double lb__conic_union(const double x[2], const double r[2], double p,
+                                   const double m[2], double dx[2], double dr[2], double dm[2]);
+LB_INTERNAL double lb__conic_union_solved(const double x[2], const double r[2], double p,
+                                          const double m[2], double dx[2]);
+
+/* Scale method: B_A (Min-like) and B_S (Max-like, r <= 1) on soft-domain y.
+ * dy, dr: derivatives with respect to y_i and r_i. */
+LB_INTERNAL LB_READS(2, 1) double lb__scale_ba(size_t k, const double *y, const double *r, const double *p,
+                                int mode, double *dy, double *dr);
+LB_INTERNAL LB_READS(2, 1) double lb__scale_bs(size_t k, const double *y, const double *r, const double *p,
+                                int mode, double *dy, double *dr);
+/* Zero-convention B_U / B_I / B_D from them. */
+LB_INTERNAL LB_READS(3, 2) LB_READS(4, 2) double lb__scale_setop(lb_setop op, size_t k, const double *x, const double *r,
+                                   const double *p, int mode, double *dx, double *dr);
+
+/* Zero-convention duality: intersection(x) = -union(-x), difference(x) =
+ * -union(-x_0, x_1, ...). Writes x'_i = sign_i x_i; the result is
+ * (op == LB_UNION ? 1 : -1) * union(x'), and d/dx_i = sign_i * (that sign) * du/dx'_i. */
+LB_INTERNAL void lb__dual_args(lb_setop op, size_t k, const double *x, double *xt, double *sign);
+
+#endif

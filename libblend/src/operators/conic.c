@@ -1,0 +1,152 @@
+/* Binary conic BT_2 [hsu2006 3.2.1, Eq. 4], zero convention.
+ *
+ * H(u1,u2) = r2^2 u1^2 + r1^2 u2^2 + r1^2 r2^2 - 2 r2^2 r1 u1 - 2 r1^2 r2 u2
+ *            + 2 p u1 u2,  p < r1 r2,
+ * with u_i = x_i - m_i h. Outside region II the union is h1 = min(x1/m1, x2/m2).
+ * Inside, the root of H(u(h)) = 0 between the chord value h2 and h1. We
+ * solve in the shifted variable s = h - h1 (u_i = v_i - m_i s with
+ * v_i = x_i - m_i h1 >= 0, one of them 0), which keeps the quadratic's
+ * coefficients of the size of r even when |x| is huge, and take the root
+ * with the cancellation-free formula q = -(b + sign(b) sqrt(D))/2.
+ * Gradients by the implicit function theorem with E = m1 H_u1 + m2 H_u2:
+ * dh/dx_i = H_ui / E, dh/dm_i = -h H_ui / E, dh/dr_i = H_ri / E. */
+#include "../common/internal.h"
+#include "../solver/root.h"
+
+typedef struct {
+    double v1, v2, r1, r2, p, m1, m2;
+} conic_ctx;
+
+
+/* Region II test; fills the shifted context and h1. Returns 0 outside. */
+static int conic_setup(const double x[2], const double r[2], double p, const double m[2],
+                       conic_ctx *c, double *h1, size_t *argmin) {
+    const double a = x[0] / m[0], b = x[1] / m[1];
+    *argmin = b < a;
+    *h1 = b < a ? b : a;
+    c->r1 = r[0];
+    c->r2 = r[1];
+    c->p = p;
+    c->m1 = m[0];
+    c->m2 = m[1];
+    c->v1 = *argmin == 0 ? 0.0 : x[0] - m[0] * *h1;
+    c->v2 = *argmin == 1 ? 0.0 : x[1] - m[1] * *h1;
+    /* region II <=> the other argument is within its range at h1 */
+    return *argmin == 0 ? c->v2 < r[1] : c->v1 < r[0];
+}
+
+static double conic_grads(const conic_ctx *c, double h1, double s, double dx[2], double dr[2],
+                          double dm[2]) {
+    const double u1 = c->v1 - c->m1 * s, u2 = c->v2 - c->m2 * s;
+    double H1, H2;
+    lb__conic_H(c->r1, c->r2, c->p, u1, u2, &H1, &H2);
+    const double E = c->m1 * H1 + c->m2 * H2;
+    const double h = h1 + s;
+    if (dx) {
+        dx[0] = H1 / E;
+        dx[1] = H2 / E;
+    }
+    if (dm) {
+        dm[0] = -h * H1 / E;
+        dm[1] = -h * H2 / E;
+    }
+    if (dr) {
+        const double r1 = c->r1, r2 = c->r2;
+        dr[0] = 2.0 * (r1 * u2 * u2 + r1 * r2 * r2 - r2 * r2 * u1 - 2.0 * r1 * r2 * u2) / E;
+        dr[1] = 2.0 * (r2 * u1 * u1 + r1 * r1 * r2 - 2.0 * r1 * r2 * u1 - r1 * r1 * u2) / E;
+    }
+    return h;
+}
+
+static double outside_grads(size_t j, const double m[2], double h1, double dx[2], double dr[2],
+                            double dm[2]) {
+    for (size_t i = 0; i < 2; ++i) {
+        if (dx) dx[i] = i == j ? 1.0 / m[i] : 0.0;
+        if (dr) dr[i] = 0.0;
+        if (dm) dm[i] = i == j ? -h1 / m[i] : 0.0;
+    }
+    return h1;
+}
+
+double lb__conic_union(const double x[2], const double r[2], double p, const double m[2],
+                       double dx[2], double dr[2], double dm[2]) {
+    conic_ctx c;
+    double h1;
+    size_t j;
+    if (!conic_setup(x, r, p, m, &c, &h1, &j)) return outside_grads(j, m, h1, dx, dr, dm);
+    const double r1 = c.r1, r2 = c.r2, m1 = c.m1, m2 = c.m2, v1 = c.v1, v2 = c.v2;
+    const double a = r2 * r2 * m1 * m1 + r1 * r1 * m2 * m2 + 2.0 * p * m1 * m2;
+    const double b = 2.0 * ((r1 - v1) * r2 * r2 * m1 + (r2 - v2) * r1 * r1 * m2 -
+                            p * (v1 * m2 + v2 * m1));
+    const double chord = r1 * v2 + r2 * v1 - r1 * r2;
+    const double cc = chord * chord + 2.0 * (p - r1 * r2) * v1 * v2;
+    const double s2 = chord / (r1 * m2 + r2 * m1); /* chord value, <= 0 */
+    double D = b * b - 4.0 * a * cc;
+    if (D < 0.0) D = 0.0;
+    const double q = -0.5 * (b + (b >= 0.0 ? sqrt(D) : -sqrt(D)));
+    /* candidates q/a and cc/q; take the one inside [s2, 0] */
+    double best = 0.0, best_dist = INFINITY;
+    const double cand[2] = {a != 0.0 ? q / a : NAN, q != 0.0 ? cc / q : NAN};
+    for (int i = 0; i < 2; ++i) {
+        if (!isfinite(cand[i])) continue;
+        const double d = cand[i] > 0.0 ? cand[i] : cand[i] < s2 ? s2 - cand[i] : 0.0;
+        if (d < best_dist) {
+            best_dist = d;
+            best = cand[i];
+        }
+    }
+    double s = best;
+    if (s > 0.0) s = 0.0;
+    if (s < s2) s = s2;
+    return conic_grads(&c, h1, s, dx, dr, dm);
+}
+
+static void conic_T(double s, const void *vctx, double *T, double *dT) {
+    const conic_ctx *c = vctx;
+    const double u1 = c->v1 - c->m1 * s, u2 = c->v2 - c->m2 * s;
+    double H1, H2;
+    *T = lb__conic_H(c->r1, c->r2, c->p, u1, u2, &H1, &H2);
+    *dT = -(c->m1 * H1 + c->m2 * H2);
+}
+
+double lb__conic_union_solved(const double x[2], const double r[2], double p, const double m[2],
+                              double dx[2]) {
+    conic_ctx c;
+    double h1;
+    size_t j;
+    if (!conic_setup(x, r, p, m, &c, &h1, &j)) return outside_grads(j, m, h1, dx, NULL, NULL);
+    const double s2 = (c.r1 * c.v2 + c.r2 * c.v1 - c.r1 * c.r2) / (c.r1 * c.m2 + c.r2 * c.m1);
+    const double s = lb__root_solve(conic_T, &c, s2, 0.0, 0.0);
+    return conic_grads(&c, h1, s, dx, NULL, NULL);
+}
+
+lb_status lb__check_conic(const char *fn, const double x[2], const double r[2], double p,
+                          const double m[2], const void *value, lb_error *err) {
+    lb_status s;
+    if ((s = lb__check_out(fn, value, err)) || (s = lb__check_finite(fn, "x", 2, x, err)) ||
+        (s = lb__check_range(fn, "r", 2, r, 0.0, 0, INFINITY, 0, "r > 0", err)) ||
+        (m && (s = lb__check_range(fn, "m", 2, m, 0.0, 0, INFINITY, 0, "m > 0", err))))
+        return s;
+    if (!isfinite(p) || !(p < r[0] * r[1]))
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: p = %g is out of range; allowed: p < r[0]*r[1] = %g (conic shape)", fn,
+                        p, r[0] * r[1]);
+    return LB_OK;
+}
+
+lb_status lb_conic(lb_setop op, const double x[2], const double r[2], double p, const double m[2],
+                   double *value, double grad[2], lb_error *err) {
+    static const char fn[] = "lb_conic";
+    lb_status s;
+    if ((s = lb__check_setop(fn, op, err)) || (s = lb__check_conic(fn, x, r, p, m, value, err)))
+        return s;
+    static const double ones[2] = {1.0, 1.0};
+    double xt[2], sg[2];
+    lb__dual_args(op, 2, x, xt, sg);
+    const double h = lb__conic_union(xt, r, p, m ? m : ones, grad, NULL, NULL);
+    const double out = op == LB_UNION ? 1.0 : -1.0;
+    *value = out * h;
+    if (grad)
+        for (size_t i = 0; i < 2; ++i) grad[i] *= out * sg[i];
+    return LB_OK;
+}

@@ -1,0 +1,170 @@
+/* Shared helpers for libblend's tests: a seeded RNG, parameter samplers,
+ * long-double bisection for independent references, and a central-difference
+ * gradient check whose tolerance is estimated from the data (Richardson:
+ * two step sizes) so it stays meaningful from r = 1e-3 to |x| = 1e6.
+ * Every test counts how many cases were checked tightly and asserts a floor,
+ * so a check cannot quietly degrade into checking nothing. */
+#ifndef LIBBLEND_TESTLIB_H
+#define LIBBLEND_TESTLIB_H
+
+#include <float.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include <libblend/libblend.h>
+
+typedef struct {
+    uint64_t s;
+} rng_t;
+
+static inline uint64_t rng_u64(rng_t *r) {
+    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+static inline double rng_unit(rng_t *r) { return (double)(rng_u64(r) >> 11) * 0x1.0p-53; }
+static inline double rng_range(rng_t *r, double a, double b) { return a + (b - a) * rng_unit(r); }
+static inline double rng_log(rng_t *r, double a, double b) {
+    return exp(rng_range(r, log(a), log(b)));
+}
+static inline size_t rng_int(rng_t *r, size_t a, size_t b) { /* inclusive */
+    return a + (size_t)(rng_u64(r) % (uint64_t)(b - a + 1));
+}
+/* p in [1.05, 64]: a third general, a third integer, a third exactly 2 */
+static inline double rng_p(rng_t *r) {
+    const double u = rng_unit(r);
+    if (u < 1.0 / 3.0) return rng_log(r, 1.05, 64.0);
+    if (u < 2.0 / 3.0) return (double)rng_int(r, 2, 64);
+    return 2.0;
+}
+
+/* Failure accounting: print the first few failures, count all. */
+typedef struct {
+    const char *name;
+    long checked, failed, tight;
+} tally_t;
+
+static inline void tally_fail(tally_t *t, const char *fmt, ...) {
+    t->failed++;
+    if (t->failed <= 8) {
+        va_list ap;
+        va_start(ap, fmt);
+        fprintf(stderr, "  [%s] ", t->name);
+        vfprintf(stderr, fmt, ap);
+        fputc('\n', stderr);
+        va_end(ap);
+    }
+}
+static inline void tally_check(tally_t *t, int ok, const char *fmt, ...) {
+    t->checked++;
+    if (ok) return;
+    t->failed++;
+    if (t->failed <= 8) {
+        va_list ap;
+        va_start(ap, fmt);
+        fprintf(stderr, "  [%s] ", t->name);
+        vfprintf(stderr, fmt, ap);
+        fputc('\n', stderr);
+        va_end(ap);
+    }
+}
+static inline void tally_end(const tally_t *t, long min_checked) {
+    fprintf(stderr, "  %-44s checked %8ld  failed %ld\n", t->name, t->checked, t->failed);
+    assert_true(t->checked >= min_checked);
+    assert_int_equal(t->failed, 0);
+}
+
+/* A scalar function of n arguments (for gradient checks). */
+typedef double (*fn_t)(const double *x, const void *ctx);
+
+/* Base relative tolerance of the central-difference check. Numerical
+ * derivatives are only trustworthy on moderate scales, so the tests run this
+ * check on moderate parameters and check gradients over the full ranges
+ * (r from 1e-3 to 1e3, p up to 64, |x| up to 1e6) against the implicit
+ * function theorem evaluated in long double at a long-double root. */
+#ifndef GRAD_RTOL
+#define GRAD_RTOL 1e-2
+#endif
+
+/* Central-difference check of g = grad f at x. step[i] is the perturbation
+ * scale of argument i (a length over which f is smooth). For each argument
+ * the step is swept over four decades below step[i]; the step whose two
+ * estimates fd(h), fd(h/2) agree best is used, and their difference (the
+ * Richardson error estimate) sets the tolerance. A wrong analytic gradient
+ * fails wherever the function is smooth enough to be differentiated
+ * numerically; *tight reports whether every component was checked to 1e-3
+ * relative (so callers can assert that most cases were).. */
+static inline int grad_ok(fn_t f, const void *ctx, size_t n, const double *x, const double *g,
+                          const double *step, int *tight, double *worst) {
+    double xp[64];
+    int ok = 1, all_tight = 1;
+    double w = 0.0, gmax = 0.0;
+    memcpy(xp, x, n * sizeof *x);
+    for (size_t i = 0; i < n; ++i) gmax = fmax(gmax, fabs(g[i]));
+    const double floor_ = 1e-6 * gmax + 1e-300;
+    /* rounding noise of f: its own size plus the size of what was summed or
+     * cancelled to get it (x_j g_j terms), and the root solvers' 1e-14 */
+    double fsize = fabs(f(x, ctx));
+    for (size_t j = 0; j < n; ++j) fsize += fabs(x[j] * g[j]);
+    for (size_t i = 0; i < n; ++i) {
+        double best_fd = NAN, best_est = INFINITY, best_h = 0.0;
+        double h = fmax(step[i], 0x1.0p-40 * fabs(x[i]));
+        for (int j = 0; j < 4; ++j, h *= 0.1) {
+            double fd[2];
+            for (int s = 0; s < 2; ++s) {
+                volatile double hp = x[i] + h / (1 + s), hm = x[i] - h / (1 + s);
+                xp[i] = hp;
+                const double a = f(xp, ctx);
+                xp[i] = hm;
+                const double b = f(xp, ctx);
+                xp[i] = x[i];
+                fd[s] = hp > hm ? (a - b) / (hp - hm) : NAN;
+            }
+            const double est = fabs(fd[0] - fd[1]);
+            if (est < best_est) {
+                best_est = est;
+                best_fd = fd[1];
+                best_h = h;
+            }
+        }
+        const double scale = fabs(g[i]) + floor_;
+        const double noise = 64.0 * DBL_EPSILON * (fsize + fabs(x[i]) * gmax) / best_h;
+        const double tol = GRAD_RTOL * scale + 4.0 * best_est + noise;
+        const double err = fabs(g[i] - best_fd);
+        if (!(4.0 * best_est + noise <= 1e-3 * scale)) all_tight = 0;
+        if (!(err <= tol)) ok = 0;
+        if (err / scale > w) w = err / scale;
+    }
+    if (tight) *tight = all_tight;
+    if (worst) *worst = w;
+    return ok;
+}
+
+/* Long-double bisection of an increasing function on [lo, hi] to the last bit. */
+typedef long double (*ldfn_t)(long double h, const void *ctx);
+static inline long double ld_bisect(ldfn_t T, const void *ctx, long double lo, long double hi) {
+    for (int it = 0; it < 400; ++it) {
+        const long double mid = 0.5L * (lo + hi);
+        if (mid <= lo || mid >= hi) break;
+        if (T(mid, ctx) < 0.0L)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return 0.5L * (lo + hi);
+}
+
+static inline int all_finite(size_t n, const double *v) {
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+#endif
