@@ -6,7 +6,8 @@
  * bracket and at least halve the step before last, and bisects otherwise
  * (rtsafe). Every evaluation narrows the bracket, so the result never leaves
  * [lo, hi].
- * Stopping: with tol = LB_ROOT_RTOL * (|h| + width of the original bracket),
+ * Stopping: with tol = LB_ROOT_RTOL * |h| + LB_ROOT_WTOL * (width of the
+ * original bracket),
  * it stops when the bracket is narrower than tol, when T is exactly 0, or
  * when a Newton step is below tol AND a probe one tol beyond the new point
  * shows the sign change (so a step that is small only because convergence
@@ -20,7 +21,8 @@
 
 #include <math.h>
 
-#define LB_ROOT_RTOL 1e-14
+#define LB_ROOT_RTOL 1e-15
+#define LB_ROOT_WTOL 1e-16
 #define LB_ROOT_MAX_ITER 200
 
 /* Evaluate T and dT/dh at h. */
@@ -42,7 +44,7 @@ static inline double lb__root_solve(lb__root_fn fn, const void *ctx, double lo, 
             lo = h;
         else
             hi = h;
-        const double tol = LB_ROOT_RTOL * (fabs(h) + width0);
+        const double tol = LB_ROOT_RTOL * fabs(h) + LB_ROOT_WTOL * width0;
         if (hi - lo <= tol) return h;
         double next = h - T / dT;
         if (!(dT > 0.0) || !(next > lo && next < hi) || fabs(2.0 * (h - next)) > fabs(dx_old)) {
