@@ -89,6 +89,7 @@ static void test_ba_bs(void **state) {
         const double vr = (double)ref_scale(&c);
         tally_check(&ref, fabs(v - vr) <= 1e-12 * fabs(vr) + 1e-300 && isfinite(v),
                     "case %d (%s): %.17g vs %.17g", n, which ? "B_S" : "B_A", v, vr);
+
         double s = 0.0;
         for (size_t i = 0; i < c.k; ++i) s += c.y[i] * gr[i];
         tally_check(&eul, fabs(s - v) <= 1e-10 * fabs(v), "case %d: %g vs %g", n, s, v);

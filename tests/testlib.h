@@ -108,7 +108,7 @@ static inline int grad_ok(fn_t f, const void *ctx, size_t n, const double *x, co
     double w = 0.0, gmax = 0.0;
     memcpy(xp, x, n * sizeof *x);
     for (size_t i = 0; i < n; ++i) gmax = fmax(gmax, fabs(g[i]));
-    const double floor_ = 1e-6 * gmax + 1e-300;
+    const double floor_ = 1e-5 * gmax + 1e-300; /* components this small compare absolutely */
     /* rounding noise of f: its own size plus the size of what was summed or
      * cancelled to get it (x_j g_j terms), and the root solvers' 1e-14 */
     double fsize = fabs(f(x, ctx));

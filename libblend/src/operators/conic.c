@@ -101,12 +101,14 @@ double lb__conic_union(const double x[2], const double r[2], double p, const dou
     return conic_grads(&c, h1, s, dx, dr, dm);
 }
 
-static void conic_T(double s, const void *vctx, double *T, double *dT) {
+static void conic_T(double s, const void *vctx, double *T, double *dT, double *d2T) {
+    (void)d2T;
     const conic_ctx *c = vctx;
     const double u1 = c->v1 - c->m1 * s, u2 = c->v2 - c->m2 * s;
     double H1, H2;
-    *T = lb__conic_H(c->r1, c->r2, c->p, u1, u2, &H1, &H2);
-    *dT = -(c->m1 * H1 + c->m2 * H2);
+    const double n = 1.0 / (c->r1 * c->r1 * c->r2 * c->r2); /* H is of size r1^2 r2^2 */
+    *T = n * lb__conic_H(c->r1, c->r2, c->p, u1, u2, &H1, &H2);
+    *dT = -n * (c->m1 * H1 + c->m2 * H2);
 }
 
 double lb__conic_union_solved(const double x[2], const double r[2], double p, const double m[2],

@@ -17,51 +17,83 @@
 
 typedef struct {
     size_t k;
-    const double *x, *r, *p, *m;
+    const double *x, *r, *p, *m, *ir, *im; /* ir = 1/r, im = 1/m */
     int mode;
+    double *w;     /* w_i at the last evaluation (for the gradient) */
+    double h_last; /* where w was computed */
 } bt_ctx;
 
-static void bt_T(double h, const void *vctx, double *T, double *dT) {
-    const bt_ctx *c = vctx;
-    double sum = -1.0, dsum = 0.0;
+static void bt_T(double h, const void *vctx, double *T, double *dT, double *d2T) {
+    bt_ctx *c = (bt_ctx *)vctx; /* owned by lb__bt_union_newton; w is scratch */
+    double sum = -1.0, dsum = 0.0, d2sum = 0.0;
     for (size_t i = 0; i < c->k; ++i) {
-        const double t = (c->r[i] - (c->x[i] - c->m[i] * h)) / c->r[i];
+        const double t = (c->r[i] - (c->x[i] - c->m[i] * h)) * c->ir[i];
+        double wi = 0.0;
         if (t > 0.0) {
             const double tp1 = lb__pow_m1(t, c->p[i], c->mode);
+            const double mr = c->m[i] * c->ir[i];
             sum += tp1 * t;
-            dsum += c->p[i] * c->m[i] / c->r[i] * tp1;
+            wi = c->p[i] * c->ir[i] * tp1;
+            dsum += c->m[i] * wi;
+            d2sum += (c->p[i] - 1.0) * mr * c->m[i] * wi / t;
         }
+        c->w[i] = wi;
     }
+    c->h_last = h;
     *T = sum;
     *dT = dsum;
+    *d2T = d2sum;
 }
 
-static void bt_bracket(size_t k, const double *x, const double *r, const double *m, double *lo,
-                       double *hi, size_t *argmin) {
-    double a = INFINITY, b = INFINITY;
+/* Reciprocals, the bracket [min (x-r)/m, min x/m] and its argmin. */
+static void bt_setup(size_t k, const double *x, const double *r, const double *m, double *ir,
+                     double *im, double *b, double *lo, double *hi, size_t *argmin) {
+    double a = INFINITY, c = INFINITY;
     size_t j = 0;
     for (size_t i = 0; i < k; ++i) {
-        const double lo_i = (x[i] - r[i]) / m[i], hi_i = x[i] / m[i];
-        if (lo_i < a) a = lo_i;
-        if (hi_i < b) {
-            b = hi_i;
+        ir[i] = 1.0 / r[i];
+        im[i] = 1.0 / m[i];
+        b[i] = (x[i] - r[i]) * im[i];
+        const double hi_i = x[i] * im[i];
+        if (b[i] < a) a = b[i];
+        if (hi_i < c) {
+            c = hi_i;
             j = i;
         }
     }
     *lo = a;
-    *hi = b;
+    *hi = c;
     *argmin = j;
 }
 
-/* Derivatives at the root h (shared by every path). */
+/* Non-blending region: no argument but the argmin j is within its range at
+ * h = x_j/m_j (every other breakpoint b_i >= hi). Then BT = x_j/m_j exactly. */
+static int bt_alone(size_t k, const double *x, const double *m, const double *b, double hi,
+                    size_t j, double *dx, double *dr, double *dm) {
+    for (size_t i = 0; i < k; ++i)
+        if (i != j && b[i] < hi) return 0;
+    for (size_t i = 0; i < k; ++i) {
+        if (dx) dx[i] = i == j ? 1.0 / m[j] : 0.0;
+        if (dr) dr[i] = 0.0;
+        if (dm) dm[i] = i == j ? -x[j] / (m[j] * m[j]) : 0.0;
+    }
+    return 1;
+}
+
+/* Derivatives at the root h from w_i (or recomputed when w is NULL). */
 static void bt_grads(size_t k, const double *x, const double *r, const double *p, const double *m,
-                     int mode, double h, size_t argmin, double *dx, double *dr, double *dm) {
+                     const double *ir, int mode, double h, size_t argmin, const double *wl,
+                     double *dx, double *dr, double *dm) {
     if (!dx && !dr && !dm) return;
     double w[LB_MAX_ARITY];
     double D = 0.0;
     for (size_t i = 0; i < k; ++i) {
-        const double t = (r[i] - (x[i] - m[i] * h)) / r[i];
-        w[i] = t > 0.0 ? p[i] / r[i] * lb__pow_m1(t, p[i], mode) : 0.0;
+        if (wl) {
+            w[i] = wl[i];
+        } else {
+            const double t = (r[i] - (x[i] - m[i] * h)) * ir[i];
+            w[i] = t > 0.0 ? p[i] * ir[i] * lb__pow_m1(t, p[i], mode) : 0.0;
+        }
         D += m[i] * w[i];
     }
     if (!(D > 0.0)) { /* rounding left no active term: the Min branch */
@@ -69,22 +101,21 @@ static void bt_grads(size_t k, const double *x, const double *r, const double *p
         w[argmin] = 1.0;
         D = m[argmin];
     }
+    const double iD = 1.0 / D;
     for (size_t i = 0; i < k; ++i) {
-        const double wi = w[i] / D;
+        const double wi = w[i] * iD;
         if (dx) dx[i] = wi;
-        if (dr) dr[i] = -wi * (x[i] - m[i] * h) / r[i];
+        if (dr) dr[i] = -wi * (x[i] - m[i] * h) * ir[i];
         if (dm) dm[i] = -wi * h;
     }
 }
 
-/* Closed form for all p_i = 2. */
-static double bt_two(size_t k, const double *x, const double *r, const double *m, double lo,
+/* Closed form for all p_i = 2, given the breakpoints b_i = (x_i - r_i)/m_i. */
+static double bt_two(size_t k, const double *b, const double *m, const double *ir, double lo,
                      double hi) {
-    double b[LB_MAX_ARITY];
     size_t idx[LB_MAX_ARITY];
     if (k == 0) return hi;
     for (size_t i = 0; i < k; ++i) {
-        b[i] = (x[i] - r[i]) / m[i];
         size_t j = i;
         while (j > 0 && b[idx[j - 1]] > b[i]) {
             idx[j] = idx[j - 1];
@@ -95,30 +126,21 @@ static double bt_two(size_t k, const double *x, const double *r, const double *m
     /* Sums over the active terms of c^2, c^2 d, c^2 d^2 with c = m/r and
      * d = pivot - b_i >= 0, so T(pivot + s) = A s^2 + 2 B s + C - 1. */
     double A = 0.0, B = 0.0, C = 0.0, piv = b[idx[0]];
-    double h = hi;
-    int solved = 0;
-    for (size_t j = 0; j < k && !solved; ++j) {
+    for (size_t j = 0; j < k; ++j) {
         const size_t i = idx[j];
         if (j > 0) {
             const double d = b[i] - piv;
             const double Cn = C + d * (2.0 * B + A * d);
-            if (Cn >= 1.0) { /* root between piv and b_i, with the current set */
-                const double e = 1.0 - C;  /* >= 0 */
-                h = piv + e / (B + sqrt(B * B + A * e));
-                solved = 1;
-                break;
-            }
+            if (Cn >= 1.0) break; /* root between piv and b_i, with the current set */
             B += A * d;
             C = Cn;
             piv = b[i];
         }
-        const double c = m[i] / r[i];
+        const double c = m[i] * ir[i];
         A += c * c;
     }
-    if (!solved) {
-        const double e = 1.0 - C;
-        h = piv + e / (B + sqrt(B * B + A * e));
-    }
+    const double e = 1.0 - C; /* >= 0 */
+    double h = piv + e / (B + sqrt(B * B + A * e));
     if (h < lo) h = lo;
     if (h > hi) h = hi;
     return h;
@@ -126,23 +148,27 @@ static double bt_two(size_t k, const double *x, const double *r, const double *m
 
 double lb__bt_union_newton(size_t k, const double *x, const double *r, const double *p,
                            const double *m, int mode, double *dx, double *dr, double *dm) {
+    double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY], w[LB_MAX_ARITY];
     double lo, hi;
     size_t j;
-    bt_bracket(k, x, r, m, &lo, &hi, &j);
-    const bt_ctx ctx = {k, x, r, p, m, mode == LB__P_TWO ? LB__P_INTEGER : mode};
+    bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
+    if (bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
+    bt_ctx ctx = {k, x, r, p, m, ir, im, mode == LB__P_TWO ? LB__P_INTEGER : mode, w, NAN};
     const double h = lb__root_solve(bt_T, &ctx, lo, hi, hi);
-    bt_grads(k, x, r, p, m, ctx.mode, h, j, dx, dr, dm);
+    bt_grads(k, x, r, p, m, ir, ctx.mode, h, j, h == ctx.h_last ? w : NULL, dx, dr, dm);
     return h;
 }
 
 double lb__bt_union(size_t k, const double *x, const double *r, const double *p, const double *m,
                     int mode, double *dx, double *dr, double *dm) {
     if (mode != LB__P_TWO) return lb__bt_union_newton(k, x, r, p, m, mode, dx, dr, dm);
+    double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY];
     double lo, hi;
     size_t j;
-    bt_bracket(k, x, r, m, &lo, &hi, &j);
-    const double h = bt_two(k, x, r, m, lo, hi);
-    bt_grads(k, x, r, p, m, LB__P_INTEGER, h, j, dx, dr, dm);
+    bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
+    if (bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
+    const double h = bt_two(k, b, m, ir, lo, hi);
+    bt_grads(k, x, r, p, m, ir, LB__P_INTEGER, h, j, NULL, dx, dr, dm);
     return h;
 }
 

@@ -21,7 +21,8 @@ typedef struct {
     int mode, union_like;
 } soft_ctx;
 
-static void soft_T(double lam, const void *vctx, double *T, double *dT) {
+static void soft_T(double lam, const void *vctx, double *T, double *dT, double *d2T) {
+    (void)d2T;
     const soft_ctx *c = vctx;
     double sum = 0.0, dsum = 0.0;
     for (size_t i = 0; i < c->k; ++i) {
@@ -67,22 +68,31 @@ static double soft_hyper_kernel(int union_like, size_t k, const double *x, const
         }
     }
     const soft_ctx ctx = {n, a, ra, pa, ma, lb__exponent_mode(n, pa), union_like};
-    double T, dT, lam = lam_nb;
-    soft_T(lam_nb, &ctx, &T, &dT);
-    if (T != 0.0) { /* some other term is active: blend */
-        double other = union_like ? -INFINITY : INFINITY;
-        for (size_t i = 0; i < n; ++i) {
-            double l;
-            if (union_like)
-                l = ra[i] < 1.0 ? log(a[i] / (1.0 - ra[i])) / ma[i]
-                                : (log(a[i]) + log((double)n) / pa[i]) / ma[i];
-            else
-                l = log(a[i] / (1.0 + ra[i])) / ma[i];
-            if (union_like ? l > other : l < other) other = l;
-        }
-        lam = union_like ? lb__root_solve(soft_T, &ctx, lam_nb, other, lam_nb)
-                         : lb__root_solve(soft_T, &ctx, other, lam_nb, lam_nb);
+    /* non-blending: no other term active at lam_nb; then h = a_j^(1/m_j) exactly */
+    int alone = 1;
+    for (size_t i = 0; i < n && alone; ++i) {
+        if (i == j) continue;
+        const double z = a[i] * exp(-ma[i] * lam_nb);
+        const double t = union_like ? (ra[i] - 1.0 + z) / ra[i] : (1.0 + ra[i] - z) / ra[i];
+        if (t > 0.0) alone = 0;
     }
+    if (alone) {
+        const double h = pow(a[j], 1.0 / ma[j]);
+        if (dx) dx[map[j]] = h / (ma[j] * x[map[j]]);
+        return h;
+    }
+    double other = union_like ? -INFINITY : INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        double l;
+        if (union_like)
+            l = ra[i] < 1.0 ? log(a[i] / (1.0 - ra[i])) / ma[i]
+                            : (log(a[i]) + log((double)n) / pa[i]) / ma[i];
+        else
+            l = log(a[i] / (1.0 + ra[i])) / ma[i];
+        if (union_like ? l > other : l < other) other = l;
+    }
+    const double lam = union_like ? lb__root_solve(soft_T, &ctx, lam_nb, other, lam_nb)
+                                  : lb__root_solve(soft_T, &ctx, other, lam_nb, lam_nb);
     const double h = exp(lam);
     if (dx) {
         double q[LB_MAX_ARITY], E = 0.0;
@@ -116,7 +126,8 @@ static void sconic_u(const sconic_ctx *c, double lam, double u[2], double du[2])
     }
 }
 
-static void sconic_T(double lam, const void *vctx, double *T, double *dT) {
+static void sconic_T(double lam, const void *vctx, double *T, double *dT, double *d2T) {
+    (void)d2T;
     const sconic_ctx *c = vctx;
     double u[2], du[2], H1, H2;
     sconic_u(c, lam, u, du);
@@ -127,8 +138,9 @@ static void sconic_T(double lam, const void *vctx, double *T, double *dT) {
         return;
     }
     const double H = lb__conic_H(c->r[0], c->r[1], c->p, u[0], u[1], &H1, &H2);
-    *T = -sgn * H;
-    *dT = -sgn * (H1 * du[0] + H2 * du[1]);
+    const double n = 1.0 / (c->r[0] * c->r[0] * c->r[1] * c->r[1]); /* H is of size r1^2 r2^2 */
+    *T = -sgn * n * H;
+    *dT = -sgn * n * (H1 * du[0] + H2 * du[1]);
 }
 
 static double soft_conic_kernel(int union_like, const double x[2], const double r[2], double p,

@@ -2,17 +2,19 @@
  *
  * Contract: T is continuous and non-decreasing on [lo, hi] with
  * T(lo) <= 0 <= T(hi). The solver starts at `start` (clamped into the
- * bracket), takes Newton steps while they stay strictly inside the current
+ * bracket), takes Newton (or Halley) steps while they stay strictly inside the current
  * bracket and at least halve the step before last, and bisects otherwise
  * (rtsafe). Every evaluation narrows the bracket, so the result never leaves
  * [lo, hi].
- * Stopping: with tol = LB_ROOT_RTOL * |h| + LB_ROOT_WTOL * (width of the
+ * Stopping: when |T| <= LB_ROOT_TNOISE (T is zero to its own rounding) and
+ * |T|/T' <= 10 LB_ROOT_RTOL |h| (so h is that close to the root), or with tol = LB_ROOT_RTOL * |h| + LB_ROOT_WTOL * (width of the
  * original bracket),
  * it stops when the bracket is narrower than tol, when T is exactly 0, or
  * when a Newton step is below tol AND a probe one tol beyond the new point
  * shows the sign change (so a step that is small only because convergence
  * has turned slow near a kink is never mistaken for convergence). After
- * LB_ROOT_MAX_ITER evaluations it returns the best point found.
+ * LB_ROOT_MAX_ITER evaluations it returns the best point found. Except in
+ * rare safeguard exits the returned point is the last one passed to fn.
  *
  * It is a static inline function so each operator gets a copy specialised
  * to its own T (the compiler inlines the callback). */
@@ -21,12 +23,16 @@
 
 #include <math.h>
 
-#define LB_ROOT_RTOL 1e-15
+#define LB_ROOT_RTOL 2e-15
 #define LB_ROOT_WTOL 1e-16
 #define LB_ROOT_MAX_ITER 200
 
-/* Evaluate T and dT/dh at h. */
-typedef void (*lb__root_fn)(double h, const void *ctx, double *T, double *dT);
+/* Evaluate T, dT/dh and (optionally, else 0) d2T/dh2 at h: with the second
+ * derivative the step is Halley's (cubic convergence), otherwise Newton's. T must be scaled so that its rounding error is
+ * a few LB_ROOT_TNOISE: |T| <= LB_ROOT_TNOISE counts as T = 0 (the root is
+ * then resolved as far as T itself is). */
+typedef void (*lb__root_fn)(double h, const void *ctx, double *T, double *dT, double *d2T);
+#define LB_ROOT_TNOISE 1e-14
 
 static inline double lb__root_solve(lb__root_fn fn, const void *ctx, double lo, double hi,
                                     double start) {
@@ -37,16 +43,19 @@ static inline double lb__root_solve(lb__root_fn fn, const void *ctx, double lo, 
     if (!(h <= hi)) h = hi;
     double dx_old = width0, dx = width0;
     for (int it = 0; it < LB_ROOT_MAX_ITER; ++it) {
-        double T, dT;
-        fn(h, ctx, &T, &dT);
-        if (T == 0.0) return h;
+        double T, dT, d2T = 0.0;
+        fn(h, ctx, &T, &dT, &d2T);
+        const double tol = LB_ROOT_RTOL * fabs(h) + LB_ROOT_WTOL * width0;
+        /* T at its rounding floor, and the root within 10 LB_ROOT_RTOL |h| of h */
+        if (T == 0.0 || (fabs(T) <= LB_ROOT_TNOISE && fabs(T) <= 10.0 * LB_ROOT_RTOL * fabs(h) * dT))
+            return h;
         if (T < 0.0)
             lo = h;
         else
             hi = h;
-        const double tol = LB_ROOT_RTOL * fabs(h) + LB_ROOT_WTOL * width0;
         if (hi - lo <= tol) return h;
-        double next = h - T / dT;
+        const double den = 2.0 * dT * dT - T * d2T;
+        double next = d2T != 0.0 && den > 0.0 ? h - 2.0 * T * dT / den : h - T / dT;
         if (!(dT > 0.0) || !(next > lo && next < hi) || fabs(2.0 * (h - next)) > fabs(dx_old)) {
             dx_old = dx;
             dx = 0.5 * (hi - lo);
@@ -58,9 +67,11 @@ static inline double lb__root_solve(lb__root_fn fn, const void *ctx, double lo, 
                 /* confirm: the root must lie within tol of next, on the far side */
                 const double probe = T > 0.0 ? next - tol : next + tol;
                 if (!(probe > lo && probe < hi)) return next;
-                double Tp, dTp;
-                fn(probe, ctx, &Tp, &dTp);
-                if (T > 0.0 ? Tp <= 0.0 : Tp >= 0.0) return next;
+                double Tp, dTp, d2Tp = 0.0;
+                fn(probe, ctx, &Tp, &dTp, &d2Tp);
+                /* the root lies between probe and next: return the probe, the
+                 * last point evaluated, so callers may reuse what fn computed */
+                if (T > 0.0 ? Tp <= 0.0 : Tp >= 0.0) return probe;
                 if (Tp < 0.0)
                     lo = probe;
                 else

@@ -1,0 +1,182 @@
+/* bench_operators: evaluations per second, single thread, for each operator
+ * family at k = 2 and k = 6, general p and the fast paths, next to the
+ * paper's own method (regula falsi on the bracket with pow(), written
+ * plainly) and a plain min() as baselines timed in the same run. Figures are
+ * ratios against those baselines: the machine is shared and noisy, so each
+ * timing is the best of several interleaved repetitions of process CPU time.
+ *
+ * Usage: bench_operators [--quick]   (--quick: fewer repetitions, for smoke runs) */
+#define _POSIX_C_SOURCE 200809L
+#include <libblend/libblend.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#include "../libblend/src/common/internal.h"
+
+#define NV 4096 /* argument vectors per pass */
+
+static double cpu_now(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static uint64_t rs = 12345;
+static double urand(void) {
+    rs = rs * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(rs >> 11) * 0x1.0p-53;
+}
+
+typedef struct {
+    size_t k;
+    double x[NV][8], r[8], p[8], m[8];
+} workload;
+
+/* arguments near one level so the blend is active in most evaluations */
+static void make(workload *w, size_t k, double p) {
+    w->k = k;
+    for (size_t i = 0; i < k; ++i) {
+        w->r[i] = 0.5 + 0.5 * urand();
+        w->p[i] = p;
+        w->m[i] = 0.7 + 0.6 * urand();
+    }
+    for (int n = 0; n < NV; ++n) {
+        const double h0 = 4.0 * urand() - 2.0;
+        for (size_t i = 0; i < k; ++i) w->x[n][i] = w->m[i] * h0 + (1.3 * urand() - 0.2) * w->r[i];
+    }
+}
+
+/* the paper's method: regula falsi on [min (x-r)/m, min x/m], pow() in T */
+static double rf_T(const workload *w, const double *x, double h) {
+    double s = -1.0;
+    for (size_t i = 0; i < w->k; ++i) s += pow(fmax(0.0, (w->r[i] - x[i] + w->m[i] * h) / w->r[i]), w->p[i]);
+    return s;
+}
+static double regula_falsi(const workload *w, const double *x) {
+    double a = INFINITY, b = INFINITY;
+    for (size_t i = 0; i < w->k; ++i) {
+        a = fmin(a, (x[i] - w->r[i]) / w->m[i]);
+        b = fmin(b, x[i] / w->m[i]);
+    }
+    double fa = rf_T(w, x, a), fb = rf_T(w, x, b), c = b, prev = a;
+    for (int it = 0; it < 1000; ++it) {
+        if (fb == fa) break;
+        c = (a * fb - b * fa) / (fb - fa);
+        const double fc = rf_T(w, x, c);
+        if (fc == 0.0 || fabs(c - prev) <= 1e-12 * (1.0 + fabs(c))) break;
+        prev = c;
+        if (fc < 0) { a = c; fa = fc; } else { b = c; fb = fc; }
+    }
+    return c;
+}
+
+__attribute__((noinline)) static double plain_min(double a, double b) { return a < b ? a : b; }
+
+typedef enum { F_RF, F_BT, F_CONIC, F_MIN_CALL, F_MIN_INLINE, F_SCALE, F_SOFT, F_BULGE } fam;
+
+static volatile double sink;
+
+static double run_once(fam f, const workload *w) {
+    double acc = 0.0, g[8];
+    const double t0 = cpu_now();
+    for (int n = 0; n < NV; ++n) {
+        const double *x = w->x[n];
+        double v = 0.0;
+        switch (f) {
+        case F_RF: v = regula_falsi(w, x); break;
+        case F_BT: lb_displacement(LB_UNION, w->k, x, w->r, w->p, w->m, &v, g, NULL); break;
+        case F_CONIC: lb_conic(LB_UNION, x, w->r, 0.0, w->m, &v, g, NULL); break;
+        case F_MIN_CALL: v = plain_min(x[0], x[1]); break;
+        case F_MIN_INLINE: v = x[0] < x[1] ? x[0] : x[1]; break;
+        case F_SCALE: lb_scale(LB_UNION, w->k, x, w->r, w->p, &v, g, NULL); break;
+        case F_SOFT: {
+            double y[8], r1[8];
+            for (size_t i = 0; i < w->k; ++i) {
+                y[i] = 0.5 - 0.2 * x[i];
+                r1[i] = fmin(w->r[i], 1.0);
+            }
+            lb_soft_hyper(LB_UNION, w->k, y, r1, w->p, w->m, &v, g, NULL);
+            break;
+        }
+        case F_BULGE: {
+            static const double g1[3] = {1, 0.2, 0}, g2[3] = {0.3, 1, 0};
+            lb_bulge_params bp = {{w->r[0], w->r[1]}, {w->p[0], w->p[1]}, 0.0, {w->m[0], w->m[1]}, 1e-3,
+                                  LB_BULGE_RANGE | LB_BULGE_SLOPE};
+            double dx[2], d1[3], d2[3];
+            lb_bulge(LB_BULGE_DISPLACEMENT, LB_UNION, &bp, x, g1, g2, &v, dx, d1, d2, NULL);
+            break;
+        }
+        }
+        acc += v;
+    }
+    sink = acc;
+    return cpu_now() - t0;
+}
+
+/* evaluations per second: best of `reps` passes (each pass NV evaluations,
+ * repeated until it takes >= 2 ms) */
+static double rate(fam f, const workload *w, int reps) {
+    int inner = 1;
+    while (1) {
+        double t = 0;
+        for (int i = 0; i < inner; ++i) t += run_once(f, w);
+        if (t >= 2e-3 || inner > 1 << 20) break;
+        inner *= 2;
+    }
+    double best = INFINITY;
+    for (int r = 0; r < reps; ++r) {
+        double t = 0;
+        for (int i = 0; i < inner; ++i) t += run_once(f, w);
+        if (t < best) best = t;
+    }
+    return (double)NV * inner / best;
+}
+
+int main(int argc, char **argv) {
+    const int reps = argc > 1 && strcmp(argv[1], "--quick") == 0 ? 2 : 9;
+    printf("libblend %d operator benchmark: evaluations/s, single thread, value + gradient\n", lb_version());
+    printf("(best of %d; baseline RF = regula falsi with pow(), the papers' method)\n\n", reps);
+    printf("%-34s %4s %14s %14s %9s\n", "operator", "k", "evals/s", "baseline/s", "ratio");
+    struct {
+        const char *name;
+        fam f;
+        double p;
+        size_t k;
+        fam base;
+    } rows[] = {
+        {"BT_k displacement, p = 2.5", F_BT, 2.5, 2, F_RF},
+        {"BT_k displacement, p = 2.5", F_BT, 2.5, 6, F_RF},
+        {"BT_k displacement, p = 3 (int)", F_BT, 3.0, 2, F_RF},
+        {"BT_k displacement, p = 3 (int)", F_BT, 3.0, 6, F_RF},
+        {"BT_k displacement, p = 2 (closed)", F_BT, 2.0, 2, F_RF},
+        {"BT_k displacement, p = 2 (closed)", F_BT, 2.0, 6, F_RF},
+        {"conic BT_2 vs min() call", F_CONIC, 2.0, 2, F_MIN_CALL},
+        {"conic BT_2 vs inline min", F_CONIC, 2.0, 2, F_MIN_INLINE},
+        {"scale union B_U, p = 2.5", F_SCALE, 2.5, 2, F_RF},
+        {"scale union B_U, p = 2.5", F_SCALE, 2.5, 6, F_RF},
+        {"scale union B_U, p = 2", F_SCALE, 2.0, 6, F_RF},
+        {"soft union B_Sk, p = 2.5", F_SOFT, 2.5, 2, F_RF},
+        {"soft union B_Sk, p = 2.5", F_SOFT, 2.5, 6, F_RF},
+        {"bulge BT_2 (range + slope), p = 2", F_BULGE, 2.0, 2, F_RF},
+    };
+    double ratio_k6_general = 0, ratio_k6_two = 0, conic_vs_min = 0;
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; ++i) {
+        static workload w;
+        rs = 1000 + i;
+        make(&w, rows[i].k, rows[i].p);
+        const double a = rate(rows[i].f, &w, reps), b = rate(rows[i].base, &w, reps);
+        const double ratio = a / b;
+        printf("%-34s %4zu %14.4g %14.4g %8.2fx\n", rows[i].name, rows[i].k, a, b, ratio);
+        if (i == 1) ratio_k6_general = ratio;
+        if (i == 5) ratio_k6_two = ratio;
+        if (i == 6) conic_vs_min = b / a;
+    }
+    printf("\nbars: BT_6 general p vs RF %.1fx (>= 5), BT_6 p = 2 vs RF %.1fx (>= 20), "
+           "conic cost %.1fx a min() call (<= 5)\n",
+           ratio_k6_general, ratio_k6_two, conic_vs_min);
+    return 0;
+}
