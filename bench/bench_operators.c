@@ -2,8 +2,9 @@
  * family at k = 2 and k = 6, general p and the fast paths, next to the
  * paper's own method (regula falsi on the bracket with pow(), written
  * plainly) and a plain min() as baselines timed in the same run. Figures are
- * ratios against those baselines: the machine is shared and noisy, so each
- * timing is the best of several interleaved repetitions of process CPU time.
+ * ratios against those baselines: the machine is shared and noisy, so the
+ * candidate and its baseline are timed alternately (process CPU time) and the
+ * median of the per-round ratios is reported.
  *
  * Usage: bench_operators [--quick]   (--quick: fewer repetitions, for smoke runs) */
 #define _POSIX_C_SOURCE 200809L
@@ -11,6 +12,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -117,29 +119,53 @@ static double run_once(fam f, const workload *w) {
     return cpu_now() - t0;
 }
 
-/* evaluations per second: best of `reps` passes (each pass NV evaluations,
- * repeated until it takes >= 2 ms) */
-static double rate(fam f, const workload *w, int reps) {
+/* inner repetitions so one timed pass of f takes >= 5 ms */
+static int calibrate(fam f, const workload *w) {
     int inner = 1;
-    while (1) {
+    while (inner < (1 << 20)) {
         double t = 0;
         for (int i = 0; i < inner; ++i) t += run_once(f, w);
-        if (t >= 2e-3 || inner > 1 << 20) break;
+        if (t >= 5e-3) break;
         inner *= 2;
     }
-    double best = INFINITY;
+    return inner;
+}
+
+static double timed(fam f, const workload *w, int inner) {
+    double t = 0;
+    for (int i = 0; i < inner; ++i) t += run_once(f, w);
+    return t / ((double)NV * inner); /* seconds per evaluation */
+}
+
+static int cmp_d(const void *a, const void *b) {
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Candidate and baseline timed alternately, `reps` rounds; the ratio is the
+ * median of the per-round ratios (robust to another process taking the core
+ * for a while), the rates are the best rounds. */
+static void compare(fam f, fam base, const workload *w, int reps, double *rate_f,
+                    double *rate_b, double *ratio) {
+    const int ia = calibrate(f, w), ib = calibrate(base, w);
+    double rs[64], best_a = INFINITY, best_b = INFINITY;
     for (int r = 0; r < reps; ++r) {
-        double t = 0;
-        for (int i = 0; i < inner; ++i) t += run_once(f, w);
-        if (t < best) best = t;
+        const double ta = timed(f, w, ia), tb = timed(base, w, ib);
+        rs[r] = tb / ta;
+        if (ta < best_a) best_a = ta;
+        if (tb < best_b) best_b = tb;
     }
-    return (double)NV * inner / best;
+    qsort(rs, (size_t)reps, sizeof rs[0], cmp_d);
+    *rate_f = 1.0 / best_a;
+    *rate_b = 1.0 / best_b;
+    *ratio = rs[reps / 2];
 }
 
 int main(int argc, char **argv) {
-    const int reps = argc > 1 && strcmp(argv[1], "--quick") == 0 ? 2 : 9;
+    const int reps = argc > 1 && strcmp(argv[1], "--quick") == 0 ? 3 : 15;
     printf("libblend %d operator benchmark: evaluations/s, single thread, value + gradient\n", lb_version());
-    printf("(best of %d; baseline RF = regula falsi with pow(), the papers' method)\n\n", reps);
+    printf("(ratio = median over %d alternating rounds; rates = best round;\n"
+           " baseline RF = regula falsi with pow(), the papers' method)\n\n", reps);
     printf("%-34s %4s %14s %14s %9s\n", "operator", "k", "evals/s", "baseline/s", "ratio");
     struct {
         const char *name;
@@ -168,8 +194,8 @@ int main(int argc, char **argv) {
         static workload w;
         rs = 1000 + i;
         make(&w, rows[i].k, rows[i].p);
-        const double a = rate(rows[i].f, &w, reps), b = rate(rows[i].base, &w, reps);
-        const double ratio = a / b;
+        double a, b, ratio;
+        compare(rows[i].f, rows[i].base, &w, reps, &a, &b, &ratio);
         printf("%-34s %4zu %14.4g %14.4g %8.2fx\n", rows[i].name, rows[i].k, a, b, ratio);
         if (i == 1) ratio_k6_general = ratio;
         if (i == 5) ratio_k6_two = ratio;

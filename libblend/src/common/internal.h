@@ -48,6 +48,23 @@ LB_INTERNAL lb_status lb__check_conic(const char *fn, const double x[2], const d
                                       double p, const double m[2], const void *value,
                                       lb_error *err);
 
+/* Cheap validity pre-check for the hot path (no messages): every x_i finite,
+ * 0 < r_i <= rmax, 1 < p_i <= LB_MAX_EXPONENT (p may be NULL when the family
+ * has none), m_i > 0 finite or m NULL. Callers run the detailed checks only
+ * when this fails, to produce the message. */
+static inline int lb__fast_ok(size_t k, const double *x, const double *r, const double *p,
+                              const double *m, double rmax) {
+    if (!x || !r || k == 0 || k > LB_MAX_ARITY) return 0;
+    int ok = 1;
+    for (size_t i = 0; i < k; ++i) {
+        ok &= (x[i] - x[i] == 0.0); /* finite */
+        ok &= (r[i] > 0.0) & (r[i] <= rmax) & (r[i] < INFINITY);
+        if (p) ok &= (p[i] > 1.0) & (p[i] <= LB_MAX_EXPONENT);
+        if (m) ok &= (m[i] > 0.0) & (m[i] < INFINITY);
+    }
+    return ok;
+}
+
 /* ---- exponent helpers ---- */
 /* t^n for small non-negative integer n by repeated squaring. */
 static inline double lb__ipow(double t, unsigned n) {

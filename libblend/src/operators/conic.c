@@ -101,8 +101,10 @@ double lb__conic_union(const double x[2], const double r[2], double p, const dou
     return conic_grads(&c, h1, s, dx, dr, dm);
 }
 
-static void conic_T(double s, const void *vctx, double *T, double *dT, double *d2T) {
+static void conic_T(double s, const void *vctx, double *T, double *dT, double *d2T,
+                    double *smooth) {
     (void)d2T;
+    (void)smooth;
     const conic_ctx *c = vctx;
     const double u1 = c->v1 - c->m1 * s, u2 = c->v2 - c->m2 * s;
     double H1, H2;

@@ -21,8 +21,10 @@ typedef struct {
     int mode, union_like;
 } soft_ctx;
 
-static void soft_T(double lam, const void *vctx, double *T, double *dT, double *d2T) {
+static void soft_T(double lam, const void *vctx, double *T, double *dT, double *d2T,
+                    double *smooth) {
     (void)d2T;
+    (void)smooth;
     const soft_ctx *c = vctx;
     double sum = 0.0, dsum = 0.0;
     for (size_t i = 0; i < c->k; ++i) {
@@ -126,8 +128,10 @@ static void sconic_u(const sconic_ctx *c, double lam, double u[2], double du[2])
     }
 }
 
-static void sconic_T(double lam, const void *vctx, double *T, double *dT, double *d2T) {
+static void sconic_T(double lam, const void *vctx, double *T, double *dT, double *d2T,
+                    double *smooth) {
     (void)d2T;
+    (void)smooth;
     const sconic_ctx *c = vctx;
     double u[2], du[2], H1, H2;
     sconic_u(c, lam, u, du);
