@@ -65,6 +65,26 @@ static inline int lb__fast_ok(size_t k, const double *x, const double *r, const 
     return ok;
 }
 
+/* How the exponents of one operator call can be evaluated. */
+enum { LB__P_GENERAL = 0, LB__P_INTEGER = 1, LB__P_TWO = 2 };
+
+/* lb__fast_ok for blend parameters that also returns the exponent mode
+ * (one pass): the mode, or -1 when a check fails. */
+static inline int lb__fast_mode(size_t k, const double *x, const double *r, const double *p,
+                                const double *m, double rmax) {
+    if (!x || !r || !p || k == 0 || k > LB_MAX_ARITY) return -1;
+    int ok = 1, two = 1, integer = 1;
+    for (size_t i = 0; i < k; ++i) {
+        ok &= (x[i] - x[i] == 0.0);
+        ok &= (r[i] > 0.0) & (r[i] <= rmax) & (r[i] < INFINITY);
+        ok &= (p[i] > 1.0) & (p[i] <= LB_MAX_EXPONENT);
+        if (m) ok &= (m[i] > 0.0) & (m[i] < INFINITY);
+        two &= p[i] == 2.0;
+        integer &= (p[i] <= 64.0) & ((double)(long)p[i] == p[i]);
+    }
+    return !ok ? -1 : two ? LB__P_TWO : integer ? LB__P_INTEGER : LB__P_GENERAL;
+}
+
 /* ---- exponent helpers ---- */
 /* t^n for small non-negative integer n by repeated squaring. */
 static inline double lb__ipow(double t, unsigned n) {
@@ -77,8 +97,6 @@ static inline double lb__ipow(double t, unsigned n) {
     return r;
 }
 
-/* How the exponents of one operator call can be evaluated. */
-enum { LB__P_GENERAL = 0, LB__P_INTEGER = 1, LB__P_TWO = 2 };
 LB_INTERNAL int lb__exponent_mode(size_t k, const double *p);
 
 /* t^(p-1) for t >= 0, using products when mode says the exponents are integers. */

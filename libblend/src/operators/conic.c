@@ -141,10 +141,18 @@ lb_status lb__check_conic(const char *fn, const double x[2], const double r[2], 
 lb_status lb_conic(lb_setop op, const double x[2], const double r[2], double p, const double m[2],
                    double *value, double grad[2], lb_error *err) {
     static const char fn[] = "lb_conic";
-    lb_status s;
-    if ((s = lb__check_setop(fn, op, err)) || (s = lb__check_conic(fn, x, r, p, m, value, err)))
-        return s;
+    if (!((unsigned)op <= LB_DIFFERENCE && value && lb__fast_ok(2, x, r, NULL, m, INFINITY) &&
+          p < r[0] * r[1] && p > -INFINITY)) {
+        lb_status s;
+        if ((s = lb__check_setop(fn, op, err)) || (s = lb__check_conic(fn, x, r, p, m, value, err)))
+            return s;
+        return lb__fail(err, LB_ERR_INTERNAL, "%s: parameter check disagreement", fn);
+    }
     static const double ones[2] = {1.0, 1.0};
+    if (op == LB_UNION) {
+        *value = lb__conic_union(x, r, p, m ? m : ones, grad, NULL, NULL);
+        return LB_OK;
+    }
     double xt[2], sg[2];
     lb__dual_args(op, 2, x, xt, sg);
     const double h = lb__conic_union(xt, r, p, m ? m : ones, grad, NULL, NULL);

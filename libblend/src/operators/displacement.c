@@ -58,8 +58,9 @@ static void bt_setup(size_t k, const double *x, const double *r, const double *m
     double a = INFINITY, c = INFINITY;
     size_t j = 0;
     for (size_t i = 0; i < k; ++i) {
-        ir[i] = 1.0 / r[i];
-        im[i] = 1.0 / m[i];
+        const double inv = 1.0 / (r[i] * m[i]); /* one division for both reciprocals */
+        ir[i] = m[i] * inv;
+        im[i] = r[i] * inv;
         b[i] = (x[i] - r[i]) * im[i];
         const double hi_i = x[i] * im[i];
         if (b[i] < a) a = b[i];
@@ -211,7 +212,8 @@ lb_status lb__check_blend_params(const char *fn, size_t k, const double *r, cons
 lb_status lb_displacement(lb_setop op, size_t k, const double *x, const double *r, const double *p,
                           const double *m, double *value, double *grad, lb_error *err) {
     static const char fn[] = "lb_displacement";
-    if (!((unsigned)op <= LB_DIFFERENCE && value && p && lb__fast_ok(k, x, r, p, m, INFINITY))) {
+    const int mode = lb__fast_mode(k, x, r, p, m, INFINITY);
+    if (!((unsigned)op <= LB_DIFFERENCE && value && mode >= 0)) {
         lb_status s;
         if ((s = lb__check_setop(fn, op, err)) || (s = lb__check_k(fn, k, 1, LB_MAX_ARITY, err)) ||
             (s = lb__check_out(fn, value, err)) || (s = lb__check_finite(fn, "x", k, x, err)) ||
@@ -224,7 +226,6 @@ lb_status lb_displacement(lb_setop op, size_t k, const double *x, const double *
         for (size_t i = 0; i < k; ++i) ones[i] = 1.0;
         m = ones;
     }
-    const int mode = lb__exponent_mode(k, p);
     if (op == LB_UNION) {
         *value = lb__bt_union(k, x, r, p, m, mode, grad, NULL, NULL);
         return LB_OK;
