@@ -55,7 +55,8 @@ static void make(workload *w, size_t k, double p) {
 /* the paper's method: regula falsi on [min (x-r)/m, min x/m], pow() in T */
 static double rf_T(const workload *w, const double *x, double h) {
     double s = -1.0;
-    for (size_t i = 0; i < w->k; ++i) s += pow(fmax(0.0, (w->r[i] - x[i] + w->m[i] * h) / w->r[i]), w->p[i]);
+    for (size_t i = 0; i < w->k; ++i)
+        s += pow(fmax(0.0, (w->r[i] - x[i] + w->m[i] * h) / w->r[i]), w->p[i]);
     return s;
 }
 static double regula_falsi(const workload *w, const double *x) {
@@ -71,12 +72,20 @@ static double regula_falsi(const workload *w, const double *x) {
         const double fc = rf_T(w, x, c);
         if (fc == 0.0 || fabs(c - prev) <= 1e-12 * (1.0 + fabs(c))) break;
         prev = c;
-        if (fc < 0) { a = c; fa = fc; } else { b = c; fb = fc; }
+        if (fc < 0) {
+            a = c;
+            fa = fc;
+        } else {
+            b = c;
+            fb = fc;
+        }
     }
     return c;
 }
 
-__attribute__((noinline)) static double plain_min(double a, double b) { return a < b ? a : b; }
+__attribute__((noinline)) static double plain_min(double a, double b) {
+    return a < b ? a : b;
+}
 
 typedef enum { F_RF, F_BT, F_CONIC, F_MIN_CALL, F_MIN_INLINE, F_SCALE, F_SOFT, F_BULGE } fam;
 
@@ -89,12 +98,24 @@ static double run_once(fam f, const workload *w) {
         const double *x = w->x[n];
         double v = 0.0;
         switch (f) {
-        case F_RF: v = regula_falsi(w, x); break;
-        case F_BT: lb_displacement(LB_UNION, w->k, x, w->r, w->p, w->m, &v, g, NULL); break;
-        case F_CONIC: lb_conic(LB_UNION, x, w->r, 0.0, w->m, &v, g, NULL); break;
-        case F_MIN_CALL: v = plain_min(x[0], x[1]); break;
-        case F_MIN_INLINE: v = x[0] < x[1] ? x[0] : x[1]; break;
-        case F_SCALE: lb_scale(LB_UNION, w->k, x, w->r, w->p, &v, g, NULL); break;
+        case F_RF:
+            v = regula_falsi(w, x);
+            break;
+        case F_BT:
+            lb_displacement(LB_UNION, w->k, x, w->r, w->p, w->m, &v, g, NULL);
+            break;
+        case F_CONIC:
+            lb_conic(LB_UNION, x, w->r, 0.0, w->m, &v, g, NULL);
+            break;
+        case F_MIN_CALL:
+            v = plain_min(x[0], x[1]);
+            break;
+        case F_MIN_INLINE:
+            v = x[0] < x[1] ? x[0] : x[1];
+            break;
+        case F_SCALE:
+            lb_scale(LB_UNION, w->k, x, w->r, w->p, &v, g, NULL);
+            break;
         case F_SOFT: {
             double y[8], r1[8];
             for (size_t i = 0; i < w->k; ++i) {
@@ -106,7 +127,11 @@ static double run_once(fam f, const workload *w) {
         }
         case F_BULGE: {
             static const double g1[3] = {1, 0.2, 0}, g2[3] = {0.3, 1, 0};
-            lb_bulge_params bp = {{w->r[0], w->r[1]}, {w->p[0], w->p[1]}, 0.0, {w->m[0], w->m[1]}, 1e-3,
+            lb_bulge_params bp = {{w->r[0], w->r[1]},
+                                  {w->p[0], w->p[1]},
+                                  0.0,
+                                  {w->m[0], w->m[1]},
+                                  1e-3,
                                   LB_BULGE_RANGE | LB_BULGE_SLOPE};
             double dx[2], d1[3], d2[3];
             lb_bulge(LB_BULGE_DISPLACEMENT, LB_UNION, &bp, x, g1, g2, &v, dx, d1, d2, NULL);
@@ -145,8 +170,8 @@ static int cmp_d(const void *a, const void *b) {
 /* Candidate and baseline timed alternately, `reps` rounds; the ratio is the
  * median of the per-round ratios (robust to another process taking the core
  * for a while), the rates are the best rounds. */
-static void compare(fam f, fam base, const workload *w, int reps, double *rate_f,
-                    double *rate_b, double *ratio) {
+static void compare(fam f, fam base, const workload *w, int reps, double *rate_f, double *rate_b,
+                    double *ratio) {
     const int ia = calibrate(f, w), ib = calibrate(base, w);
     double rs[64], best_a = INFINITY, best_b = INFINITY;
     for (int r = 0; r < reps; ++r) {
@@ -163,9 +188,11 @@ static void compare(fam f, fam base, const workload *w, int reps, double *rate_f
 
 int main(int argc, char **argv) {
     const int reps = argc > 1 && strcmp(argv[1], "--quick") == 0 ? 3 : 15;
-    printf("libblend %d operator benchmark: evaluations/s, single thread, value + gradient\n", lb_version());
+    printf("libblend %d operator benchmark: evaluations/s, single thread, value + gradient\n",
+           lb_version());
     printf("(ratio = median over %d alternating rounds; rates = best round;\n"
-           " baseline RF = regula falsi with pow(), the papers' method)\n\n", reps);
+           " baseline RF = regula falsi with pow(), the papers' method)\n\n",
+           reps);
     printf("%-34s %4s %14s %14s %9s\n", "operator", "k", "evals/s", "baseline/s", "ratio");
     struct {
         const char *name;

@@ -22,9 +22,15 @@ static double eval_fn(const double *a, const void *vctx) {
 static double base(const bg_case *c, const double x[2], const double R[2], const double M[2]) {
     double v = NAN;
     switch (c->fam) {
-    case LB_BULGE_DISPLACEMENT: lb_displacement(c->op, 2, x, R, c->bp.p, M, &v, NULL, NULL); break;
-    case LB_BULGE_CONIC: lb_conic(c->op, x, R, c->bp.conic_p, M, &v, NULL, NULL); break;
-    case LB_BULGE_SCALE: lb_scale(c->op, 2, x, R, c->bp.p, &v, NULL, NULL); break;
+    case LB_BULGE_DISPLACEMENT:
+        lb_displacement(c->op, 2, x, R, c->bp.p, M, &v, NULL, NULL);
+        break;
+    case LB_BULGE_CONIC:
+        lb_conic(c->op, x, R, c->bp.conic_p, M, &v, NULL, NULL);
+        break;
+    case LB_BULGE_SCALE:
+        lb_scale(c->op, 2, x, R, c->bp.p, &v, NULL, NULL);
+        break;
     }
     return v;
 }
@@ -41,7 +47,8 @@ static void test_bulge(void **state) {
         c.op = (lb_setop)((n / 3) % 3);
         c.bp.flags = (unsigned)rng_int(&g, 0, c.fam == LB_BULGE_SCALE ? 1 : 3);
         c.bp.omega = rng_range(&g, 1e-3, 0.1);
-        const double rmax = c.fam == LB_BULGE_SCALE && c.op != LB_UNION ? 1.0 / (2.0 + c.bp.omega) : 2.0;
+        const double rmax =
+            c.fam == LB_BULGE_SCALE && c.op != LB_UNION ? 1.0 / (2.0 + c.bp.omega) : 2.0;
         for (int i = 0; i < 2; ++i) {
             c.bp.r[i] = rng_range(&g, 0.05, rmax);
             c.bp.p[i] = fmin(rng_p(&g), 8.0);
@@ -56,8 +63,10 @@ static void test_bulge(void **state) {
         if (rng_unit(&g) < 0.1) /* parallel gradients: cos theta = +-1 */
             for (int i = 0; i < 3; ++i) a[5 + i] = a[2 + i] * (rng_unit(&g) < 0.5 ? 2.0 : -0.5);
         double v, dx[2], dg1[3], dg2[3];
-        assert_int_equal(lb_bulge(c.fam, c.op, &c.bp, a, a + 2, a + 5, &v, dx, dg1, dg2, NULL), LB_OK);
-        tally_check(&fin, isfinite(v) && all_finite(2, dx) && all_finite(3, dg1) && all_finite(3, dg2),
+        assert_int_equal(lb_bulge(c.fam, c.op, &c.bp, a, a + 2, a + 5, &v, dx, dg1, dg2, NULL),
+                         LB_OK);
+        tally_check(&fin,
+                    isfinite(v) && all_finite(2, dx) && all_finite(3, dg1) && all_finite(3, dg2),
                     "case %d", n);
         /* the spec's formulas, written out here */
         const double *g1 = a + 2, *g2 = a + 5;
@@ -70,21 +79,25 @@ static void test_bulge(void **state) {
             R[i] = (c.bp.flags & LB_BULGE_RANGE) ? c.bp.r[i] * (1 - cs + c.bp.omega) : c.bp.r[i];
         if (c.bp.flags & LB_BULGE_SLOPE) {
             const double G = n1 / n2, cp = fmax(cs, 0.0), m1 = c.bp.m[0], m2 = c.bp.m[1];
-            if (m1 > m2 * G) M[1] = m2 + (m1 / G - m2) * cp;
-            else M[0] = m1 + (m2 * G - m1) * cp;
+            if (m1 > m2 * G)
+                M[1] = m2 + (m1 / G - m2) * cp;
+            else
+                M[0] = m1 + (m2 * G - m1) * cp;
             if (cs >= 1.0 - 1e-12) /* M1/M2 = G at cos theta = 1 */
                 tally_check(&val, fabs(M[0] / M[1] - G) <= 1e-9 * G, "case %d: M ratio", n);
         }
         const double vb = base(&c, a, R, M);
-        tally_check(&val, fabs(v - vb) <= 1e-12 * (1 + fabs(v)), "case %d fam %d op %d flags %u: %.17g vs %.17g",
-                    n, (int)c.fam, (int)c.op, c.bp.flags, v, vb);
+        tally_check(&val, fabs(v - vb) <= 1e-12 * (1 + fabs(v)),
+                    "case %d fam %d op %d flags %u: %.17g vs %.17g", n, (int)c.fam, (int)c.op,
+                    c.bp.flags, v, vb);
         double gall[8] = {dx[0], dx[1], dg1[0], dg1[1], dg1[2], dg2[0], dg2[1], dg2[2]};
         double step[8];
         for (int i = 0; i < 8; ++i) step[i] = 1e-3 * (i < 2 ? fmin(c.bp.r[0], c.bp.r[1]) : 0.1);
         int tight = 0;
         double worst = 0;
         tally_check(&gd, grad_ok(eval_fn, &c, 8, a, gall, step, &tight, &worst),
-                    "case %d fam %d op %d flags %u: worst %g", n, (int)c.fam, (int)c.op, c.bp.flags, worst);
+                    "case %d fam %d op %d flags %u: worst %g", n, (int)c.fam, (int)c.op, c.bp.flags,
+                    worst);
         gd.tight += tight;
     }
     tally_end(&val, N_CASES);

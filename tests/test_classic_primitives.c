@@ -32,24 +32,49 @@ static void test_classic(void **state) {
         assert_int_equal(lb_classic(c.kind, c.k, x, c.param, &v, gr, NULL), LB_OK);
         long double e = 0; /* expected, written from the spec */
         switch (c.kind) {
-        case LB_MIN: e = INFINITY; for (size_t i = 0; i < c.k; ++i) e = fminl(e, x[i]); break;
-        case LB_MAX: e = -INFINITY; for (size_t i = 0; i < c.k; ++i) e = fmaxl(e, x[i]); break;
-        case LB_RFUNC_UNION: e = x[0] + x[1] - sqrtl((long double)x[0] * x[0] + (long double)x[1] * x[1]); break;
-        case LB_RFUNC_INTERSECTION: e = x[0] + x[1] + sqrtl((long double)x[0] * x[0] + (long double)x[1] * x[1]); break;
-        case LB_SOFT_SUM: for (size_t i = 0; i < c.k; ++i) e += x[i]; break;
-        case LB_RICCI_UNION: for (size_t i = 0; i < c.k; ++i) e += powl(x[i], c.param); e = powl(e, 1.0L / c.param); break;
-        case LB_PERLIN_UNION: e = 1; for (size_t i = 0; i < c.k; ++i) e *= 1 - x[i]; e = 1 - e; break;
-        case LB_PERLIN_INTERSECTION: e = 1; for (size_t i = 0; i < c.k; ++i) e *= x[i]; break;
-        case LB_PERLIN_DIFFERENCE: e = x[0]; for (size_t i = 1; i < c.k; ++i) e *= 1 - x[i]; break;
+        case LB_MIN:
+            e = INFINITY;
+            for (size_t i = 0; i < c.k; ++i) e = fminl(e, x[i]);
+            break;
+        case LB_MAX:
+            e = -INFINITY;
+            for (size_t i = 0; i < c.k; ++i) e = fmaxl(e, x[i]);
+            break;
+        case LB_RFUNC_UNION:
+            e = x[0] + x[1] - sqrtl((long double)x[0] * x[0] + (long double)x[1] * x[1]);
+            break;
+        case LB_RFUNC_INTERSECTION:
+            e = x[0] + x[1] + sqrtl((long double)x[0] * x[0] + (long double)x[1] * x[1]);
+            break;
+        case LB_SOFT_SUM:
+            for (size_t i = 0; i < c.k; ++i) e += x[i];
+            break;
+        case LB_RICCI_UNION:
+            for (size_t i = 0; i < c.k; ++i) e += powl(x[i], c.param);
+            e = powl(e, 1.0L / c.param);
+            break;
+        case LB_PERLIN_UNION:
+            e = 1;
+            for (size_t i = 0; i < c.k; ++i) e *= 1 - x[i];
+            e = 1 - e;
+            break;
+        case LB_PERLIN_INTERSECTION:
+            e = 1;
+            for (size_t i = 0; i < c.k; ++i) e *= x[i];
+            break;
+        case LB_PERLIN_DIFFERENCE:
+            e = x[0];
+            for (size_t i = 1; i < c.k; ++i) e *= 1 - x[i];
+            break;
         }
-        tally_check(&val, fabsl(v - e) <= 1e-14L * (1 + fabsl(e)), "case %d kind %d: %.17g vs %.17Lg", n,
-                    (int)c.kind, v, e);
+        tally_check(&val, fabsl(v - e) <= 1e-14L * (1 + fabsl(e)),
+                    "case %d kind %d: %.17g vs %.17Lg", n, (int)c.kind, v, e);
         double step[8];
         for (size_t i = 0; i < c.k; ++i) step[i] = 1e-4;
         int tight = 0;
         double worst = 0;
-        tally_check(&gd, grad_ok(cl_eval, &c, c.k, x, gr, step, &tight, &worst), "case %d kind %d: %g",
-                    n, (int)c.kind, worst);
+        tally_check(&gd, grad_ok(cl_eval, &c, c.k, x, gr, step, &tight, &worst),
+                    "case %d kind %d: %g", n, (int)c.kind, worst);
         gd.tight += tight;
     }
     tally_end(&val, N_CASES);
@@ -68,16 +93,31 @@ static void make_prim(rng_t *g, lb_primitive *P, int kind) {
     d[0] += 1.5;
     lb_status s = LB_OK;
     switch (kind) {
-    case LB_PRIM_ELLIPSOID: s = lb_primitive_ellipsoid(P, c, a, NULL); break;
-    case LB_PRIM_LP: s = lb_primitive_lp(P, c, a, rng_range(g, 1.0, 8.0), NULL); break;
-    case LB_PRIM_SUPERQUADRIC:
-        s = lb_primitive_superquadric(P, c, a, rng_range(g, 0.2, 2.0), rng_range(g, 0.2, 2.0), NULL);
+    case LB_PRIM_ELLIPSOID:
+        s = lb_primitive_ellipsoid(P, c, a, NULL);
         break;
-    case LB_PRIM_SLAB: s = lb_primitive_slab(P, c, d, a[0], NULL); break;
-    case LB_PRIM_HALFSPACE: s = lb_primitive_halfspace(P, c, d, a[0], NULL); break;
-    case LB_PRIM_CYLINDER: s = lb_primitive_cylinder(P, c, d, a[0], NULL); break;
-    case LB_PRIM_CAPSULE: s = lb_primitive_capsule(P, c, q, a[0], NULL); break;
-    case LB_PRIM_TORUS: s = lb_primitive_torus(P, c, d, a[0] + 1.0, a[1] * 0.4, NULL); break;
+    case LB_PRIM_LP:
+        s = lb_primitive_lp(P, c, a, rng_range(g, 1.0, 8.0), NULL);
+        break;
+    case LB_PRIM_SUPERQUADRIC:
+        s = lb_primitive_superquadric(P, c, a, rng_range(g, 0.2, 2.0), rng_range(g, 0.2, 2.0),
+                                      NULL);
+        break;
+    case LB_PRIM_SLAB:
+        s = lb_primitive_slab(P, c, d, a[0], NULL);
+        break;
+    case LB_PRIM_HALFSPACE:
+        s = lb_primitive_halfspace(P, c, d, a[0], NULL);
+        break;
+    case LB_PRIM_CYLINDER:
+        s = lb_primitive_cylinder(P, c, d, a[0], NULL);
+        break;
+    case LB_PRIM_CAPSULE:
+        s = lb_primitive_capsule(P, c, q, a[0], NULL);
+        break;
+    case LB_PRIM_TORUS:
+        s = lb_primitive_torus(P, c, d, a[0] + 1.0, a[1] * 0.4, NULL);
+        break;
     }
     assert_int_equal(s, LB_OK);
 }
@@ -131,8 +171,8 @@ static void test_primitives(void **state) {
         const double step[3] = {1e-5, 1e-5, 1e-5};
         int tight = 0;
         double worst = 0;
-        tally_check(&gd, grad_ok(prim_eval, &S, 3, X, gr, step, &tight, &worst), "case %d kind %d kernel %d: %g",
-                    n, kind, n % 3, worst);
+        tally_check(&gd, grad_ok(prim_eval, &S, 3, X, gr, step, &tight, &worst),
+                    "case %d kind %d kernel %d: %g", n, kind, n % 3, worst);
         gd.tight += tight;
     }
     double wy = 0.0; /* Wyvill at a = 0.5 is exactly 0.5 */

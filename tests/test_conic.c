@@ -88,14 +88,14 @@ static void test_values(void **state) {
                     c.p);
         const double hs = lb__conic_union_solved(c.x, c.r, c.p, c.m, NULL);
         tally_check(&sol, fabs(h - hs) <= 1e-12 * sc, "case %d: %.17g vs %.17g", n, h, hs);
-        tally_check(&sum, fabs(c.m[0] * gr[0] + c.m[1] * gr[1] - 1.0) <= 1e-9, "case %d: %g %g",
-                    n, gr[0], gr[1]);
+        tally_check(&sum, fabs(c.m[0] * gr[0] + c.m[1] * gr[1] - 1.0) <= 1e-9, "case %d: %g %g", n,
+                    gr[0], gr[1]);
         const double p2[2] = {2.0, 2.0};
         double he, h0;
         lb_displacement(LB_UNION, 2, c.x, c.r, p2, c.m, &he, NULL, NULL);
         lb_conic(LB_UNION, c.x, c.r, 0.0, c.m, &h0, NULL, NULL);
-        tally_check(&ell, fabs(he - h0) <= 1e-12 * scale_of(&c, he), "case %d: %.17g vs %.17g",
-                    n, he, h0);
+        tally_check(&ell, fabs(he - h0) <= 1e-12 * scale_of(&c, he), "case %d: %.17g vs %.17g", n,
+                    he, h0);
     }
     tally_end(&ref, N_CASES);
     tally_end(&sol, N_CASES);
@@ -118,8 +118,7 @@ static void test_invariants(void **state) {
         lb_conic(LB_UNION, c.x, c.r, c.p, c.m, &h, NULL, NULL);
         const int region2 = c.m[1] * c.x[0] - c.m[0] * (c.x[1] - c.r[1]) > 0 &&
                             c.m[1] * (c.x[0] - c.r[0]) - c.m[0] * c.x[1] < 0;
-        if (!region2)
-            tally_check(&nb, h == fmin(c.x[0] / c.m[0], c.x[1] / c.m[1]), "case %d", n);
+        if (!region2) tally_check(&nb, h == fmin(c.x[0] / c.m[0], c.x[1] / c.m[1]), "case %d", n);
         cc_case c2 = c;
         c2.m[0] = rng_log(&g, 1e-3, 1e3);
         c2.m[1] = rng_log(&g, 1e-3, 1e3);

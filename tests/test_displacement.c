@@ -96,7 +96,9 @@ static void sample_scaled(rng_t *g, bt_case *c, int wide) {
     }
 }
 
-static void sample(rng_t *g, bt_case *c) { sample_scaled(g, c, 1); }
+static void sample(rng_t *g, bt_case *c) {
+    sample_scaled(g, c, 1);
+}
 
 typedef struct {
     const bt_case *c;
@@ -128,8 +130,8 @@ static void test_values_against_reference(void **state) {
         tally_check(&fin, isfinite(h) && all_finite(c.k, gr), "case %d: h = %g", n, h);
         const double ref = ref_union(&c);
         const double sc = scale_at(&c, ref);
-        tally_check(&val, fabs(h - ref) <= 1e-12 * sc, "case %d k=%zu: h = %.17g ref = %.17g (scale %g)",
-                    n, c.k, h, ref, sc);
+        tally_check(&val, fabs(h - ref) <= 1e-12 * sc,
+                    "case %d k=%zu: h = %.17g ref = %.17g (scale %g)", n, c.k, h, ref, sc);
         /* gradient at the reference root; where the root sits within rounding
          * of an activation boundary the two sides' gradients differ, so the
          * comparison uses the tolerance the value itself has */
@@ -145,7 +147,8 @@ static void test_values_against_reference(void **state) {
         }
         int gok = 1;
         for (size_t i = 0; i < c.k; ++i) {
-            const long double tol = (1e-9L + 2.0L * (ce[i] + emax)) * fabsl(gref[i]) + 1e-12L / c.m[i];
+            const long double tol =
+                (1e-9L + 2.0L * (ce[i] + emax)) * fabsl(gref[i]) + 1e-12L / c.m[i];
             if (!(fabsl(gr[i] - gref[i]) <= tol || (ce[i] + emax) > 0.1)) gok = 0;
         }
         tally_check(&gl, gok, "case %d", n);
@@ -173,8 +176,8 @@ static void test_values_against_reference(void **state) {
         const double a = lb__bt_union(c.k, c2.x, c2.r, c2.p, c2.m, LB__P_TWO, NULL, NULL, NULL);
         const double b =
             lb__bt_union_newton(c.k, c2.x, c2.r, c2.p, c2.m, LB__P_INTEGER, NULL, NULL, NULL);
-        tally_check(&cf, fabs(a - b) <= 1e-12 * scale_at(&c2, b), "case %d: closed %.17g newton %.17g",
-                    n, a, b);
+        tally_check(&cf, fabs(a - b) <= 1e-12 * scale_at(&c2, b),
+                    "case %d: closed %.17g newton %.17g", n, a, b);
     }
     tally_end(&val, N_CASES);
     tally_end(&fin, N_CASES);
@@ -266,9 +269,8 @@ static void test_zero_set_independent_of_m(void **state) {
                 tally_check(&sg, HT > 0 ? ref < 0 : ref > 0, "case %d: HT = %Lg, ref = %g", n, HT,
                             ref);
             if (fabs(ref) > 1e-12 * sc)
-                tally_check(&sg, HT > 0 ? h < 0 : h > 0, "case %d: HT = %Lg, BT = %g, ref %g", n, HT,
-                            h, ref);
-
+                tally_check(&sg, HT > 0 ? h < 0 : h > 0, "case %d: HT = %Lg, BT = %g, ref %g", n,
+                            HT, h, ref);
         }
     }
     tally_end(&sg, N_CASES);

@@ -12,7 +12,9 @@ typedef struct {
     int union_like;
 } nu_case;
 
-static long double s_of(long double h, double m) { return powl(0.5L, 1.0L - m) * powl(h, m); }
+static long double s_of(long double h, double m) {
+    return powl(0.5L, 1.0L - m) * powl(h, m);
+}
 
 static long double T_ld(long double h, const void *vctx) {
     const nu_case *c = vctx;
@@ -72,8 +74,10 @@ typedef struct {
 static double eval_fn(const double *x, const void *vctx) {
     const eval_ctx *e = vctx;
     double v = NAN;
-    if (e->conic) lb_soft_conic(e->op, x, e->c->r, e->cp, e->c->m, &v, NULL, NULL);
-    else lb_soft_hyper(e->op, e->c->k, x, e->c->r, e->c->p, e->c->m, &v, NULL, NULL);
+    if (e->conic)
+        lb_soft_conic(e->op, x, e->c->r, e->cp, e->c->m, &v, NULL, NULL);
+    else
+        lb_soft_hyper(e->op, e->c->k, x, e->c->r, e->c->p, e->c->m, &v, NULL, NULL);
     return v;
 }
 
@@ -90,9 +94,9 @@ static void test_hyper(void **state) {
         const int ul = n & 1;
         sample(&g, &c, rng_int(&g, 1, 6), ul, 1);
         double v, gr[8];
-        assert_int_equal(lb_soft_hyper(ul ? LB_UNION : LB_INTERSECTION, c.k, c.x, c.r, c.p, c.m, &v,
-                                       gr, NULL),
-                         LB_OK);
+        assert_int_equal(
+            lb_soft_hyper(ul ? LB_UNION : LB_INTERSECTION, c.k, c.x, c.r, c.p, c.m, &v, gr, NULL),
+            LB_OK);
         const double vr = ref_hyper(&c);
         tally_check(&ref, fabs(v - vr) <= 1e-12 * fabs(vr) && all_finite(c.k, gr),
                     "case %d (%s): %.17g vs %.17g", n, ul ? "union" : "inter", v, vr);
@@ -106,7 +110,8 @@ static void test_hyper(void **state) {
         nu_case c2 = c;
         for (size_t i = 0; i < c.k; ++i) c2.m[i] = rng_log(&g, 1e-2, 1e2);
         double v2;
-        lb_soft_hyper(ul ? LB_UNION : LB_INTERSECTION, c.k, c2.x, c2.r, c2.p, c2.m, &v2, NULL, NULL);
+        lb_soft_hyper(ul ? LB_UNION : LB_INTERSECTION, c.k, c2.x, c2.r, c2.p, c2.m, &v2, NULL,
+                      NULL);
         if (fabs(v - 0.5) > 1e-12 && fabs(v2 - 0.5) > 1e-12)
             tally_check(&iso, (v > 0.5) == (v2 > 0.5), "case %d: %g vs %g", n, v, v2);
         /* difference */
@@ -185,7 +190,8 @@ static void test_conic(void **state) {
         const double cpm = rng_range(&g, -3.0, 0.9) * cm.r[0] * cm.r[1];
         double v, gr[2];
         assert_int_equal(lb_soft_conic(op3, cm.x, cm.r, cpm, cm.m, &v, gr, NULL), LB_OK);
-        const double step[2] = {1e-3 * fmin(cm.r[0], 1.0) * cm.x[0], 1e-3 * fmin(cm.r[1], 1.0) * cm.x[1]};
+        const double step[2] = {1e-3 * fmin(cm.r[0], 1.0) * cm.x[0],
+                                1e-3 * fmin(cm.r[1], 1.0) * cm.x[1]};
         const eval_ctx ec = {&cm, op3, 1, cpm};
         int tight = 0;
         double worst = 0;

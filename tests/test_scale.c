@@ -19,8 +19,8 @@ static long double T_ld(long double h, const void *vctx) {
     long double s = -1.0L;
     for (size_t i = 0; i < c->k; ++i) {
         const long double yh = (long double)c->y[i] / h;
-        const long double t = c->max_like ? (yh - 1.0L + c->r[i]) / c->r[i]
-                                          : (1.0L + c->r[i] - yh) / c->r[i];
+        const long double t =
+            c->max_like ? (yh - 1.0L + c->r[i]) / c->r[i] : (1.0L + c->r[i] - yh) / c->r[i];
         if (t > 0.0L) s += powl(t, (long double)c->p[i]);
     }
     return c->max_like ? -s : s; /* increasing in h for the bisection */
@@ -64,8 +64,10 @@ typedef struct {
 static double eval_fn(const double *y, const void *vctx) {
     const eval_ctx *e = vctx;
     double v = NAN;
-    if (e->which == 0) lb_scale_ba(e->c->k, y, e->c->r, e->c->p, &v, NULL, NULL);
-    else lb_scale_bs(e->c->k, y, e->c->r, e->c->p, &v, NULL, NULL);
+    if (e->which == 0)
+        lb_scale_ba(e->c->k, y, e->c->r, e->c->p, &v, NULL, NULL);
+    else
+        lb_scale_bs(e->c->k, y, e->c->r, e->c->p, &v, NULL, NULL);
     return v;
 }
 
@@ -96,8 +98,10 @@ static void test_ba_bs(void **state) {
         const double cs = rng_log(&g, 1e-2, 1e2);
         double ys[16], vs;
         for (size_t i = 0; i < c.k; ++i) ys[i] = cs * c.y[i];
-        if (which) lb_scale_bs(c.k, ys, c.r, c.p, &vs, NULL, NULL);
-        else lb_scale_ba(c.k, ys, c.r, c.p, &vs, NULL, NULL);
+        if (which)
+            lb_scale_bs(c.k, ys, c.r, c.p, &vs, NULL, NULL);
+        else
+            lb_scale_ba(c.k, ys, c.r, c.p, &vs, NULL, NULL);
         tally_check(&hom, fabs(vs - cs * v) <= 1e-12 * fabs(cs * v), "case %d", n);
         if (!which) {
             size_t j = 0;
@@ -162,8 +166,10 @@ typedef struct {
 static double z_eval(const double *args, const void *vctx) {
     const z_case *z = vctx;
     double v = NAN;
-    if (!z->bounded) lb_scale(z->op, z->k, args, z->r, z->p, &v, NULL, NULL);
-    else lb_bounded(z->op, z->k, args, args + z->k, z->p, &v, NULL, NULL, NULL);
+    if (!z->bounded)
+        lb_scale(z->op, z->k, args, z->r, z->p, &v, NULL, NULL);
+    else
+        lb_bounded(z->op, z->k, args, args + z->k, z->p, &v, NULL, NULL, NULL);
     return v;
 }
 
@@ -221,8 +227,8 @@ static void test_setops_and_bounded(void **state) {
         if (!z.bounded) {
             assert_int_equal(lb_scale(z.op, z.k, z.x, z.r, z.p, &v, gx, NULL), LB_OK);
             const double vr = (double)ref_zero(z.op, z.k, z.x, z.r, z.p);
-            tally_check(&ref, fabs(v - vr) <= 1e-12 * (1.0 + fabs(vr)), "case %d op %d: %.17g vs %.17g",
-                        n, (int)z.op, v, vr);
+            tally_check(&ref, fabs(v - vr) <= 1e-12 * (1.0 + fabs(vr)),
+                        "case %d op %d: %.17g vs %.17g", n, (int)z.op, v, vr);
         } else {
             assert_int_equal(lb_bounded(z.op, z.k, z.x, z.c, z.p, &v, gx, gc, NULL), LB_OK);
             double R[16];
@@ -237,8 +243,8 @@ static void test_setops_and_bounded(void **state) {
                 R[i] = Ri;
             }
             const double vr = (double)ref_zero(z.op, z.k, z.x, R, z.p);
-            tally_check(&bref, fabs(v - vr) <= 1e-12 * (1.0 + fabs(vr)), "case %d op %d: %.17g vs %.17g",
-                        n, (int)z.op, v, vr);
+            tally_check(&bref, fabs(v - vr) <= 1e-12 * (1.0 + fabs(vr)),
+                        "case %d op %d: %.17g vs %.17g", n, (int)z.op, v, vr);
             /* union: where every bounding solid is outside (c_i >= 0, c_i >= min x),
              * nothing blends */
             if (z.op == LB_UNION) {

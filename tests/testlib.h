@@ -29,8 +29,12 @@ static inline uint64_t rng_u64(rng_t *r) {
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     return z ^ (z >> 31);
 }
-static inline double rng_unit(rng_t *r) { return (double)(rng_u64(r) >> 11) * 0x1.0p-53; }
-static inline double rng_range(rng_t *r, double a, double b) { return a + (b - a) * rng_unit(r); }
+static inline double rng_unit(rng_t *r) {
+    return (double)(rng_u64(r) >> 11) * 0x1.0p-53;
+}
+static inline double rng_range(rng_t *r, double a, double b) {
+    return a + (b - a) * rng_unit(r);
+}
 static inline double rng_log(rng_t *r, double a, double b) {
     return exp(rng_range(r, log(a), log(b)));
 }

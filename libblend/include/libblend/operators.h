@@ -70,16 +70,19 @@ LB_API lb_status lb_conic(lb_setop op, const double x[2], const double r[2], dou
  * min(y) <= 0. lb_scale_bs: Max-like B_S(y) (0 < r_i <= 1); equals max(y)
  * when max(y) <= 0; all r_i = 1 is Ricci's (sum y_i^p)^(1/p).
  * lb_scale: zero-convention set operations B_U, B_I, B_D built from them
- * (shared/spec/operators.md section 5). Parameters: r_i > 0 (and r_i <= 1
- * wherever B_S is used: lb_scale_bs always; lb_scale for every op, since the
- * sign of its shifted arguments decides between B_A and B_S per point);
- * 1 < p_i <= LB_MAX_EXPONENT. */
+ * (shared/spec/operators.md section 5). Parameters: 1 < p_i <= LB_MAX_EXPONENT;
+ * lb_scale_ba: r_i > 0; lb_scale_bs: 0 < r_i <= 1; lb_scale: 0 < r_i <= 1 for
+ * intersection and difference (they use B_S), any r_i > 0 for the union
+ * (where a union argument is <= -1, outside the ray-linear range f >= -1, its
+ * dual branch B_S uses min(r_i, 1)).
+ * The scale method shares the displacement kernel (B_A and B_S are BT_k in
+ * 1/h), so it has the same p = 2 closed form and integer-p fast paths. */
 LB_API lb_status lb_scale_ba(size_t k, const double *y, const double *r, const double *p,
                              double *value, double *grad, lb_error *err);
 LB_API lb_status lb_scale_bs(size_t k, const double *y, const double *r, const double *p,
                              double *value, double *grad, lb_error *err);
-LB_API lb_status lb_scale(lb_setop op, size_t k, const double *x, const double *r,
-                          const double *p, double *value, double *grad, lb_error *err);
+LB_API lb_status lb_scale(lb_setop op, size_t k, const double *x, const double *r, const double *p,
+                          double *value, double *grad, lb_error *err);
 
 /* ---- Bounded primitives [hsu-bounded 3] ------------------------------------
  * Scale-method set operations whose ranges are position functions built from
@@ -118,18 +121,17 @@ typedef enum lb_bulge_family {
 enum { LB_BULGE_RANGE = 1u, LB_BULGE_SLOPE = 2u };
 
 typedef struct lb_bulge_params {
-    double r[2];     /* base ranges r_i > 0 (<= 1 for the scale family) */
-    double p[2];     /* curvature exponents (displacement, scale) */
-    double conic_p;  /* conic shape parameter (conic family), < R_1 R_2 everywhere */
-    double m[2];     /* base m_i > 0 (displacement, conic) */
-    double omega;    /* >= 0, range floor; 0.001 in the papers */
-    unsigned flags;  /* LB_BULGE_RANGE | LB_BULGE_SLOPE */
+    double r[2];    /* base ranges r_i > 0 (<= 1 for the scale family) */
+    double p[2];    /* curvature exponents (displacement, scale) */
+    double conic_p; /* conic shape parameter (conic family), < R_1 R_2 everywhere */
+    double m[2];    /* base m_i > 0 (displacement, conic) */
+    double omega;   /* >= 0, range floor; 0.001 in the papers */
+    unsigned flags; /* LB_BULGE_RANGE | LB_BULGE_SLOPE */
 } lb_bulge_params;
 
 LB_API lb_status lb_bulge(lb_bulge_family family, lb_setop op, const lb_bulge_params *params,
-                          const double x[2], const double g1[3], const double g2[3],
-                          double *value, double dx[2], double dg1[3], double dg2[3],
-                          lb_error *err);
+                          const double x[2], const double g1[3], const double g2[3], double *value,
+                          double dx[2], double dg1[3], double dg2[3], lb_error *err);
 
 /* ---- Non-uniform scaling for soft objects [hsu-nonuniform 3-4] -------------
  * s_i(h) = 0.5^(1 - m_i) h^m_i. lb_soft_hyper: super-ellipsoidal k-ary union

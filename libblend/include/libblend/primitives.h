@@ -29,14 +29,16 @@ extern "C" {
 #endif
 
 typedef enum lb_primitive_kind {
-    LB_PRIM_ELLIPSOID = 0,    /* rho = |diag(1/a) (X - c)|; a sphere when a is uniform */
-    LB_PRIM_LP = 1,           /* rho = (sum |x_i/a_i|^n)^(1/n), n >= 1 */
-    LB_PRIM_SUPERQUADRIC = 2, /* Barr: ((|x/a1|^(2/e2) + |y/a2|^(2/e2))^(e2/e1) + |z/a3|^(2/e1))^(e1/2) */
-    LB_PRIM_SLAB = 3,         /* rho = |n.(X - c)| / w: the space between two parallel planes */
-    LB_PRIM_HALFSPACE = 4,    /* rho = [n.(X - c)]+ / w: inside is n.(X - c) < w; only C0 at n.(X-c) = 0 */
-    LB_PRIM_CYLINDER = 5,     /* rho = dist(X, axis through c along n) / R (infinite) */
-    LB_PRIM_CAPSULE = 6,      /* rho = dist(X, segment c..q) / R */
-    LB_PRIM_TORUS = 7         /* rho = dist(X, circle of radius R about axis n at c) / r */
+    LB_PRIM_ELLIPSOID = 0, /* rho = |diag(1/a) (X - c)|; a sphere when a is uniform */
+    LB_PRIM_LP = 1,        /* rho = (sum |x_i/a_i|^n)^(1/n), n >= 1 */
+    LB_PRIM_SUPERQUADRIC =
+        2,            /* Barr: ((|x/a1|^(2/e2) + |y/a2|^(2/e2))^(e2/e1) + |z/a3|^(2/e1))^(e1/2) */
+    LB_PRIM_SLAB = 3, /* rho = |n.(X - c)| / w: the space between two parallel planes */
+    LB_PRIM_HALFSPACE =
+        4, /* rho = [n.(X - c)]+ / w: inside is n.(X - c) < w; only C0 at n.(X-c) = 0 */
+    LB_PRIM_CYLINDER = 5, /* rho = dist(X, axis through c along n) / R (infinite) */
+    LB_PRIM_CAPSULE = 6,  /* rho = dist(X, segment c..q) / R */
+    LB_PRIM_TORUS = 7     /* rho = dist(X, circle of radius R about axis n at c) / r */
 } lb_primitive_kind;
 
 typedef enum lb_kernel {

@@ -10,11 +10,16 @@ int lb_version(void) {
 
 const char *lb_status_string(lb_status status) {
     switch (status) {
-    case LB_OK: return "ok";
-    case LB_ERR_INVALID_ARGUMENT: return "invalid argument";
-    case LB_ERR_NOT_FINITE: return "non-finite input";
-    case LB_ERR_NO_MEMORY: return "out of memory or over a size limit";
-    case LB_ERR_INTERNAL: return "internal error";
+    case LB_OK:
+        return "ok";
+    case LB_ERR_INVALID_ARGUMENT:
+        return "invalid argument";
+    case LB_ERR_NOT_FINITE:
+        return "non-finite input";
+    case LB_ERR_NO_MEMORY:
+        return "out of memory or over a size limit";
+    case LB_ERR_INTERNAL:
+        return "internal error";
     }
     return "unknown status";
 }
@@ -57,11 +62,12 @@ lb_status lb__check_range(const char *fn, const char *name, size_t n, const doub
     if (!v) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: %s is NULL", fn, name);
     for (size_t i = 0; i < n; ++i) {
         const double a = v[i];
-        const int ok = isfinite(a) && (lo_closed ? a >= lo : a > lo) && (hi_closed ? a <= hi : a < hi);
+        const int ok =
+            isfinite(a) && (lo_closed ? a >= lo : a > lo) && (hi_closed ? a <= hi : a < hi);
         if (!ok) {
             if (n == 1)
-                return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: %s = %g is out of range; allowed: %s",
-                                fn, name, a, what);
+                return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                                "%s: %s = %g is out of range; allowed: %s", fn, name, a, what);
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "%s: %s[%zu] = %g is out of range; allowed: %s", fn, name, i, a, what);
         }

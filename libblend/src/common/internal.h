@@ -28,7 +28,8 @@
 /* ---- errors and validation (common/error.c) ---- */
 LB_INTERNAL lb_status lb__fail(lb_error *err, lb_status status, const char *fmt, ...)
     LB_PRINTF(3, 4);
-LB_INTERNAL lb_status lb__check_k(const char *fn, size_t k, size_t kmin, size_t kmax, lb_error *err);
+LB_INTERNAL lb_status lb__check_k(const char *fn, size_t k, size_t kmin, size_t kmax,
+                                  lb_error *err);
 LB_INTERNAL lb_status lb__check_finite(const char *fn, const char *name, size_t n, const double *v,
                                        lb_error *err);
 /* Each v[i] in the range; bounds are open (strict) unless *_closed is set.
@@ -117,13 +118,15 @@ static inline double lb__conic_H(double r1, double r2, double p, double u1, doub
 /* ---- kernels (unchecked). Gradient outputs may be NULL. ---- */
 
 /* BT_k union (displacement). m must be non-NULL. dx, dr, dm: d/dx_i, d/dr_i, d/dm_i. */
-LB_INTERNAL LB_READS(2, 1) LB_READS(3, 1) LB_READS(5, 1) double lb__bt_union(size_t k, const double *x, const double *r, const double *p,
-                                const double *m, int mode, double *dx, double *dr, double *dm);
+LB_INTERNAL LB_READS(2, 1) LB_READS(3, 1)
+    LB_READS(5, 1) double lb__bt_union(size_t k, const double *x, const double *r, const double *p,
+                                       const double *m, int mode, double *dx, double *dr,
+                                       double *dm);
 /* Same, by the generic safeguarded Newton solver only (no closed form): the
  * reference the p = 2 closed form is tested against. */
-LB_INTERNAL double lb__bt_union_newton(size_t k, const double *x, const double *r,
-                                       const double *p, const double *m, int mode, double *dx,
-                                       double *dr, double *dm);
+LB_INTERNAL double lb__bt_union_newton(size_t k, const double *x, const double *r, const double *p,
+                                       const double *m, int mode, double *dx, double *dr,
+                                       double *dm);
 
 /* Binary conic union, closed form (and root-solved, for tests). */
 LB_INTERNAL double lb__conic_union(const double x[2], const double r[2], double p,
@@ -133,13 +136,14 @@ LB_INTERNAL double lb__conic_union_solved(const double x[2], const double r[2], 
 
 /* Scale method: B_A (Min-like) and B_S (Max-like, r <= 1) on soft-domain y.
  * dy, dr: derivatives with respect to y_i and r_i. */
-LB_INTERNAL LB_READS(2, 1) double lb__scale_ba(size_t k, const double *y, const double *r, const double *p,
-                                int mode, double *dy, double *dr);
-LB_INTERNAL LB_READS(2, 1) double lb__scale_bs(size_t k, const double *y, const double *r, const double *p,
-                                int mode, double *dy, double *dr);
+LB_INTERNAL LB_READS(2, 1) double lb__scale_ba(size_t k, const double *y, const double *r,
+                                               const double *p, int mode, double *dy, double *dr);
+LB_INTERNAL LB_READS(2, 1) double lb__scale_bs(size_t k, const double *y, const double *r,
+                                               const double *p, int mode, double *dy, double *dr);
 /* Zero-convention B_U / B_I / B_D from them. */
-LB_INTERNAL LB_READS(3, 2) LB_READS(4, 2) double lb__scale_setop(lb_setop op, size_t k, const double *x, const double *r,
-                                   const double *p, int mode, double *dx, double *dr);
+LB_INTERNAL LB_READS(3, 2)
+    LB_READS(4, 2) double lb__scale_setop(lb_setop op, size_t k, const double *x, const double *r,
+                                          const double *p, int mode, double *dx, double *dr);
 
 /* Zero-convention duality: intersection(x) = -union(-x), difference(x) =
  * -union(-x_0, x_1, ...). Writes x'_i = sign_i x_i; the result is

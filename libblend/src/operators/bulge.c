@@ -26,7 +26,8 @@ static lb_status bulge_check(lb_bulge_family family, lb_setop op, const lb_bulge
                         "LB_BULGE_SCALE (2)",
                         fn, (int)family);
     if ((s = lb__check_setop(fn, op, err)) || (s = lb__check_out(fn, value, err)) ||
-        (s = lb__check_finite(fn, "x", 2, x, err)) || (s = lb__check_finite(fn, "g1", 3, g1, err)) ||
+        (s = lb__check_finite(fn, "x", 2, x, err)) ||
+        (s = lb__check_finite(fn, "g1", 3, g1, err)) ||
         (s = lb__check_finite(fn, "g2", 3, g2, err)))
         return s;
     if (bp->flags & ~(unsigned)(LB_BULGE_RANGE | LB_BULGE_SLOPE))

@@ -17,7 +17,6 @@ typedef struct {
     double v1, v2, r1, r2, p, m1, m2;
 } conic_ctx;
 
-
 /* Region II test; fills the shifted context and h1. Returns 0 outside. */
 static int conic_setup(const double x[2], const double r[2], double p, const double m[2],
                        conic_ctx *c, double *h1, size_t *argmin) {
@@ -76,8 +75,8 @@ double lb__conic_union(const double x[2], const double r[2], double p, const dou
     if (!conic_setup(x, r, p, m, &c, &h1, &j)) return outside_grads(j, m, h1, dx, dr, dm);
     const double r1 = c.r1, r2 = c.r2, m1 = c.m1, m2 = c.m2, v1 = c.v1, v2 = c.v2;
     const double a = r2 * r2 * m1 * m1 + r1 * r1 * m2 * m2 + 2.0 * p * m1 * m2;
-    const double b = 2.0 * ((r1 - v1) * r2 * r2 * m1 + (r2 - v2) * r1 * r1 * m2 -
-                            p * (v1 * m2 + v2 * m1));
+    const double b =
+        2.0 * ((r1 - v1) * r2 * r2 * m1 + (r2 - v2) * r1 * r1 * m2 - p * (v1 * m2 + v2 * m1));
     const double chord = r1 * v2 + r2 * v1 - r1 * r2;
     const double cc = chord * chord + 2.0 * (p - r1 * r2) * v1 * v2;
     const double s2 = chord / (r1 * m2 + r2 * m1); /* chord value, <= 0 */

@@ -23,7 +23,8 @@ typedef struct {
     double h_last; /* where w was computed */
 } bt_ctx;
 
-static LB__ALWAYS_INLINE void bt_T(double h, const void *vctx, double *T, double *dT, double *d2T, double *smooth) {
+static LB__ALWAYS_INLINE void bt_T(double h, const void *vctx, double *T, double *dT, double *d2T,
+                                   double *smooth) {
     bt_ctx *c = (bt_ctx *)vctx; /* owned by lb__bt_union_newton; w is scratch */
     double sum = -1.0, dsum = 0.0, d2sum = 0.0, rad = INFINITY;
     for (size_t i = 0; i < c->k; ++i) {

@@ -22,14 +22,15 @@ typedef struct {
 } soft_ctx;
 
 static void soft_T(double lam, const void *vctx, double *T, double *dT, double *d2T,
-                    double *smooth) {
+                   double *smooth) {
     (void)d2T;
     (void)smooth;
     const soft_ctx *c = vctx;
     double sum = 0.0, dsum = 0.0;
     for (size_t i = 0; i < c->k; ++i) {
         const double z = c->a[i] * exp(-c->m[i] * lam);
-        const double t = c->union_like ? (c->r[i] - 1.0 + z) / c->r[i] : (1.0 + c->r[i] - z) / c->r[i];
+        const double t =
+            c->union_like ? (c->r[i] - 1.0 + z) / c->r[i] : (1.0 + c->r[i] - z) / c->r[i];
         if (t > 0.0) {
             const double tp1 = lb__pow_m1(t, c->p[i], c->mode);
             sum += tp1 * t;
@@ -129,7 +130,7 @@ static void sconic_u(const sconic_ctx *c, double lam, double u[2], double du[2])
 }
 
 static void sconic_T(double lam, const void *vctx, double *T, double *dT, double *d2T,
-                    double *smooth) {
+                     double *smooth) {
     (void)d2T;
     (void)smooth;
     const sconic_ctx *c = vctx;

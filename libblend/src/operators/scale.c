@@ -64,8 +64,7 @@ double lb__scale_bs(size_t k, const double *y, const double *r, const double *p,
             one[n] = 1.0;
             map[n++] = i;
         }
-    const double g =
-        lb__bt_union(n, one, ra, pa, ya, mode, NULL, dr ? drb : NULL, dy ? dm : NULL);
+    const double g = lb__bt_union(n, one, ra, pa, ya, mode, NULL, dr ? drb : NULL, dy ? dm : NULL);
     const double s = -1.0 / (g * g);
     for (size_t a = 0; a < n; ++a) {
         if (dy) dy[map[a]] = s * dm[a];

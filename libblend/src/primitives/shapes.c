@@ -7,8 +7,8 @@ static double dot3(const double *a, const double *b) {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-static lb_status start(const char *fn, lb_primitive *out, lb_primitive_kind kind,
-                       const double c[3], lb_error *err) {
+static lb_status start(const char *fn, lb_primitive *out, lb_primitive_kind kind, const double c[3],
+                       lb_error *err) {
     if (!out) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: out is NULL", fn);
     lb_status s = lb__check_finite(fn, "c", 3, c, err);
     if (s) return s;
@@ -190,11 +190,10 @@ double lb_primitive_rho(const lb_primitive *P, const double X[3], double g[3]) {
             const double k = f1 / S;
             const double Ab = A > 0.0 ? pow(A, be / al - 1.0) : 0.0;
             for (int i = 0; i < 2; ++i)
-                g[i] = u[i] > 0.0 ? k * Ab * pow(u[i], al - 1.0) * (d[i] < 0.0 ? -1.0 : 1.0) /
-                                        P->a[i]
-                                  : 0.0;
-            g[2] = u[2] > 0.0 ? k * pow(u[2], be - 1.0) * (d[2] < 0.0 ? -1.0 : 1.0) / P->a[2]
-                              : 0.0;
+                g[i] = u[i] > 0.0
+                           ? k * Ab * pow(u[i], al - 1.0) * (d[i] < 0.0 ? -1.0 : 1.0) / P->a[i]
+                           : 0.0;
+            g[2] = u[2] > 0.0 ? k * pow(u[2], be - 1.0) * (d[2] < 0.0 ? -1.0 : 1.0) / P->a[2] : 0.0;
         }
         return mx * f1;
     }
@@ -234,7 +233,8 @@ double lb_primitive_rho(const lb_primitive *P, const double X[3], double g[3]) {
         if (!(rl > 0.0)) { /* on the axis: every circle point is equally near */
             const double f = sqrt(P->s0 * P->s0 + t * t) / P->s1;
             if (g)
-                for (int i = 0; i < 3; ++i) g[i] = f > 0.0 ? t * P->n[i] / (f * P->s1 * P->s1) : 0.0;
+                for (int i = 0; i < 3; ++i)
+                    g[i] = f > 0.0 ? t * P->n[i] / (f * P->s1 * P->s1) : 0.0;
             return f;
         }
         return norm_over(v, P->s1, g);

@@ -7,10 +7,9 @@
  * (rtsafe). Every evaluation narrows the bracket, so the result never leaves
  * [lo, hi].
  * Stopping: when |T| <= LB_ROOT_TNOISE (T is zero to its own rounding) and
- * |T|/T' <= 10 LB_ROOT_RTOL |h| (so h is that close to the root), or with tol = LB_ROOT_RTOL * |h| + LB_ROOT_WTOL * (width of the
- * original bracket),
- * it stops when the bracket is narrower than tol, when T is exactly 0, or
- * when a Newton step is below tol AND a probe one tol beyond the new point
+ * |T|/T' <= 10 LB_ROOT_RTOL |h| (so h is that close to the root), or with tol = LB_ROOT_RTOL * |h|
+ * + LB_ROOT_WTOL * (width of the original bracket), it stops when the bracket is narrower than tol,
+ * when T is exactly 0, or when a Newton step is below tol AND a probe one tol beyond the new point
  * shows the sign change (so a step that is small only because convergence
  * has turned slow near a kink is never mistaken for convergence). After
  * LB_ROOT_MAX_ITER evaluations it returns the best point found. In the
@@ -34,8 +33,8 @@
 /* Evaluate T, dT/dh and (optionally, else 0) d2T/dh2 at h: with the second
  * derivative the step is Halley's (cubic convergence), otherwise Newton's.
  * *smooth (optionally, else 0) is a radius around h within which T is
- * analytic (no kink); only then is a step accepted without evaluating it. T must be scaled so that its rounding error is
- * a few LB_ROOT_TNOISE: |T| <= LB_ROOT_TNOISE counts as T = 0 (the root is
+ * analytic (no kink); only then is a step accepted without evaluating it. T must be scaled so that
+ * its rounding error is a few LB_ROOT_TNOISE: |T| <= LB_ROOT_TNOISE counts as T = 0 (the root is
  * then resolved as far as T itself is). */
 typedef void (*lb__root_fn)(double h, const void *ctx, double *T, double *dT, double *d2T,
                             double *smooth);
@@ -47,8 +46,8 @@ typedef void (*lb__root_fn)(double h, const void *ctx, double *T, double *dT, do
 #define LB__ALWAYS_INLINE inline
 #endif
 
-static LB__ALWAYS_INLINE double lb__root_solve(lb__root_fn fn, const void *ctx, double lo, double hi,
-                                    double start) {
+static LB__ALWAYS_INLINE double lb__root_solve(lb__root_fn fn, const void *ctx, double lo,
+                                               double hi, double start) {
     if (!(hi > lo)) return lo;
     const double width0 = hi - lo;
     double h = start;
@@ -61,7 +60,8 @@ static LB__ALWAYS_INLINE double lb__root_solve(lb__root_fn fn, const void *ctx, 
         fn(h, ctx, &T, &dT, &d2T, &smooth);
         const double tol = LB_ROOT_RTOL * fabs(h) + LB_ROOT_WTOL * width0;
         /* T at its rounding floor, and the root within 10 LB_ROOT_RTOL |h| of h */
-        if (T == 0.0 || (fabs(T) <= LB_ROOT_TNOISE && fabs(T) <= 10.0 * LB_ROOT_RTOL * fabs(h) * dT))
+        if (T == 0.0 ||
+            (fabs(T) <= LB_ROOT_TNOISE && fabs(T) <= 10.0 * LB_ROOT_RTOL * fabs(h) * dT))
             return h;
         if (T < 0.0)
             lo = h;
