@@ -119,37 +119,51 @@ static void bt_grads(size_t k, const double *x, const double *r, const double *p
     }
 }
 
-/* Closed form for all p_i = 2, given the breakpoints b_i = (x_i - r_i)/m_i. */
+/* Closed form for all p_i = 2, given the breakpoints b_i = (x_i - r_i)/m_i.
+ * T is convex and piecewise quadratic. Start at h = hi with S = the terms
+ * active there; with d_i = h - b_i >= 0 and c_i = m_i/r_i,
+ *   Q_S(h + s) = sum_S c_i^2 (s + d_i)^2 - 1 = A s^2 + 2 B s + C - 1
+ * equals T on [max_S b_i, h]. Its larger root (cancellation-free form, s <= 0)
+ * is the answer when every term of S is still active there; otherwise
+ * T > 0 at the largest breakpoint of S to the right of that root, so move h
+ * there and drop that term. Each pass drops a term: no sorting. */
 static double bt_two(size_t k, const double *b, const double *m, const double *ir, double lo,
                      double hi) {
-    size_t idx[LB_MAX_ARITY];
-    if (k == 0) return hi;
-    for (size_t i = 0; i < k; ++i) {
-        size_t j = i;
-        while (j > 0 && b[idx[j - 1]] > b[i]) {
-            idx[j] = idx[j - 1];
-            --j;
+    unsigned char act[LB_MAX_ARITY];
+    double h = hi;
+    for (size_t i = 0; i < k; ++i) act[i] = b[i] < hi;
+    for (size_t pass = 0; pass <= k; ++pass) {
+        double A = 0.0, B = 0.0, C = 0.0;
+        for (size_t i = 0; i < k; ++i) {
+            if (!act[i]) continue;
+            const double c = m[i] * ir[i], c2 = c * c, d = h - b[i];
+            A += c2;
+            B += c2 * d;
+            C += c2 * d * d;
         }
-        idx[j] = i;
-    }
-    /* Sums over the active terms of c^2, c^2 d, c^2 d^2 with c = m/r and
-     * d = pivot - b_i >= 0, so T(pivot + s) = A s^2 + 2 B s + C - 1. */
-    double A = 0.0, B = 0.0, C = 0.0, piv = b[idx[0]];
-    for (size_t j = 0; j < k; ++j) {
-        const size_t i = idx[j];
-        if (j > 0) {
-            const double d = b[i] - piv;
-            const double Cn = C + d * (2.0 * B + A * d);
-            if (Cn >= 1.0) break; /* root between piv and b_i, with the current set */
-            B += A * d;
-            C = Cn;
-            piv = b[i];
+        const double e = C - 1.0; /* T(h) >= 0 */
+        const double D = B * B - A * e;
+        double s = -INFINITY;
+        if (e <= 0.0)
+            s = 0.0;
+        else if (D >= 0.0)
+            s = -e / (B + sqrt(D));
+        const double hq = h + s;
+        /* the largest breakpoint of S right of hq: it is inactive at hq */
+        size_t drop = k;
+        double bd = -INFINITY;
+        for (size_t i = 0; i < k; ++i)
+            if (act[i] && b[i] > hq && b[i] > bd) {
+                bd = b[i];
+                drop = i;
+            }
+        if (drop == k) {
+            h = hq;
+            break;
         }
-        const double c = m[i] * ir[i];
-        A += c * c;
+        act[drop] = 0;
+        h = bd;
     }
-    const double e = 1.0 - C; /* >= 0 */
-    double h = piv + e / (B + sqrt(B * B + A * e));
     if (h < lo) h = lo;
     if (h > hi) h = hi;
     return h;
