@@ -151,6 +151,28 @@ static inline int grad_ok(fn_t f, const void *ctx, size_t n, const double *x, co
     return ok;
 }
 
+/* One gradient check counted in a tally: runs grad_ok, counts tightly checked
+ * cases in t->tight and reports a failure with the case's printf-style label
+ * and the worst relative error. */
+static inline void tally_grad(tally_t *t, fn_t f, const void *ctx, size_t n, const double *x,
+                              const double *g, const double *step, const char *fmt, ...) {
+    int tight = 0;
+    double worst = 0.0;
+    const int ok = grad_ok(f, ctx, n, x, g, step, &tight, &worst);
+    t->checked++;
+    t->tight += tight;
+    if (ok) return;
+    t->failed++;
+    if (t->failed <= 8) {
+        va_list ap;
+        va_start(ap, fmt);
+        fprintf(stderr, "  [%s] ", t->name);
+        vfprintf(stderr, fmt, ap);
+        fprintf(stderr, ": worst relative error %g\n", worst);
+        va_end(ap);
+    }
+}
+
 /* Long-double bisection of an increasing function on [lo, hi] to the last bit. */
 typedef long double (*ldfn_t)(long double h, const void *ctx);
 static inline long double ld_bisect(ldfn_t T, const void *ctx, long double lo, long double hi) {
