@@ -55,29 +55,21 @@ typedef struct {
     long checked, failed, tight;
 } tally_t;
 
-static inline void tally_fail(tally_t *t, const char *fmt, ...) {
+/* Count a failure; print the first 8 as "[name] <label><suffix>". */
+static inline void tally_vfail(tally_t *t, const char *suffix, const char *fmt, va_list ap) {
     t->failed++;
-    if (t->failed <= 8) {
-        va_list ap;
-        va_start(ap, fmt);
-        fprintf(stderr, "  [%s] ", t->name);
-        vfprintf(stderr, fmt, ap);
-        fputc('\n', stderr);
-        va_end(ap);
-    }
+    if (t->failed > 8) return;
+    fprintf(stderr, "  [%s] ", t->name);
+    vfprintf(stderr, fmt, ap);
+    fprintf(stderr, "%s\n", suffix);
 }
 static inline void tally_check(tally_t *t, int ok, const char *fmt, ...) {
     t->checked++;
     if (ok) return;
-    t->failed++;
-    if (t->failed <= 8) {
-        va_list ap;
-        va_start(ap, fmt);
-        fprintf(stderr, "  [%s] ", t->name);
-        vfprintf(stderr, fmt, ap);
-        fputc('\n', stderr);
-        va_end(ap);
-    }
+    va_list ap;
+    va_start(ap, fmt);
+    tally_vfail(t, "", fmt, ap);
+    va_end(ap);
 }
 static inline void tally_end(const tally_t *t, long min_checked) {
     fprintf(stderr, "  %-44s checked %8ld  failed %ld\n", t->name, t->checked, t->failed);
@@ -162,15 +154,12 @@ static inline void tally_grad(tally_t *t, fn_t f, const void *ctx, size_t n, con
     t->checked++;
     t->tight += tight;
     if (ok) return;
-    t->failed++;
-    if (t->failed <= 8) {
-        va_list ap;
-        va_start(ap, fmt);
-        fprintf(stderr, "  [%s] ", t->name);
-        vfprintf(stderr, fmt, ap);
-        fprintf(stderr, ": worst relative error %g\n", worst);
-        va_end(ap);
-    }
+    char suffix[64];
+    snprintf(suffix, sizeof suffix, ": worst relative error %g", worst);
+    va_list ap;
+    va_start(ap, fmt);
+    tally_vfail(t, suffix, fmt, ap);
+    va_end(ap);
 }
 
 /* Long-double bisection of an increasing function on [lo, hi] to the last bit. */
