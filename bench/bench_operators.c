@@ -87,7 +87,17 @@ __attribute__((noinline)) static double plain_min(double a, double b) {
     return a < b ? a : b;
 }
 
-typedef enum { F_RF, F_BT, F_CONIC, F_MIN_CALL, F_MIN_INLINE, F_SCALE, F_SOFT, F_BULGE } fam;
+typedef enum {
+    F_RF,
+    F_BT,
+    F_CONIC,
+    F_MIN_CALL,
+    F_MIN_INLINE,
+    F_MIN_API,
+    F_SCALE,
+    F_SOFT,
+    F_BULGE
+} fam;
 
 static volatile double sink;
 
@@ -112,6 +122,9 @@ static double run_once(fam f, const workload *w) {
             break;
         case F_MIN_INLINE:
             v = x[0] < x[1] ? x[0] : x[1];
+            break;
+        case F_MIN_API:
+            lb_classic(LB_MIN, 2, x, 0.0, &v, g, NULL);
             break;
         case F_SCALE:
             lb_scale(LB_UNION, w->k, x, w->r, w->p, &v, g, NULL);
@@ -209,6 +222,7 @@ int main(int argc, char **argv) {
         {"BT_k displacement, p = 2 (closed)", F_BT, 2.0, 6, F_RF},
         {"conic BT_2 vs min() call", F_CONIC, 2.0, 2, F_MIN_CALL},
         {"conic BT_2 vs inline min", F_CONIC, 2.0, 2, F_MIN_INLINE},
+        {"conic BT_2 vs lb_classic(LB_MIN)", F_CONIC, 2.0, 2, F_MIN_API},
         {"scale union B_U, p = 2.5", F_SCALE, 2.5, 2, F_RF},
         {"scale union B_U, p = 2.5", F_SCALE, 2.5, 6, F_RF},
         {"scale union B_U, p = 2", F_SCALE, 2.0, 6, F_RF},
@@ -216,7 +230,7 @@ int main(int argc, char **argv) {
         {"soft union B_Sk, p = 2.5", F_SOFT, 2.5, 6, F_RF},
         {"bulge BT_2 (range + slope), p = 2", F_BULGE, 2.0, 2, F_RF},
     };
-    double ratio_k6_general = 0, ratio_k6_two = 0, conic_vs_min = 0;
+    double ratio_k6_general = 0, ratio_k6_two = 0, conic_vs_min = 0, conic_vs_api = 0;
     for (size_t i = 0; i < sizeof rows / sizeof rows[0]; ++i) {
         static workload w;
         rs = 1000 + i;
@@ -227,9 +241,11 @@ int main(int argc, char **argv) {
         if (i == 1) ratio_k6_general = ratio;
         if (i == 5) ratio_k6_two = ratio;
         if (i == 6) conic_vs_min = b / a;
+        if (i == 8) conic_vs_api = b / a;
     }
     printf("\nbars: BT_6 general p vs RF %.1fx (>= 5), BT_6 p = 2 vs RF %.1fx (>= 20), "
-           "conic cost %.1fx a min() call (<= 5)\n",
-           ratio_k6_general, ratio_k6_two, conic_vs_min);
+           "conic cost %.1fx a min() call (<= 5)\n"
+           "      (conic cost %.1fx lb_classic(LB_MIN), min through the same API with gradient)\n",
+           ratio_k6_general, ratio_k6_two, conic_vs_min, conic_vs_api);
     return 0;
 }

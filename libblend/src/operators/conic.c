@@ -20,9 +20,9 @@ typedef struct {
 /* Region II test; fills the shifted context and h1. Returns 0 outside. */
 static int conic_setup(const double x[2], const double r[2], double p, const double m[2],
                        conic_ctx *c, double *h1, size_t *argmin) {
-    const double a = x[0] / m[0], b = x[1] / m[1];
-    *argmin = b < a;
-    *h1 = b < a ? b : a;
+    /* min(x0/m0, x1/m1) with one division: compare cross-multiplied */
+    *argmin = x[1] * m[0] < x[0] * m[1];
+    *h1 = x[*argmin] / m[*argmin];
     c->r1 = r[0];
     c->r2 = r[1];
     c->p = p;
@@ -39,20 +39,20 @@ static double conic_grads(const conic_ctx *c, double h1, double s, double dx[2],
     const double u1 = c->v1 - c->m1 * s, u2 = c->v2 - c->m2 * s;
     double H1, H2;
     lb__conic_H(c->r1, c->r2, c->p, u1, u2, &H1, &H2);
-    const double E = c->m1 * H1 + c->m2 * H2;
+    const double iE = 1.0 / (c->m1 * H1 + c->m2 * H2);
     const double h = h1 + s;
     if (dx) {
-        dx[0] = H1 / E;
-        dx[1] = H2 / E;
+        dx[0] = H1 * iE;
+        dx[1] = H2 * iE;
     }
     if (dm) {
-        dm[0] = -h * H1 / E;
-        dm[1] = -h * H2 / E;
+        dm[0] = -h * H1 * iE;
+        dm[1] = -h * H2 * iE;
     }
     if (dr) {
         const double r1 = c->r1, r2 = c->r2;
-        dr[0] = 2.0 * (r1 * u2 * u2 + r1 * r2 * r2 - r2 * r2 * u1 - 2.0 * r1 * r2 * u2) / E;
-        dr[1] = 2.0 * (r2 * u1 * u1 + r1 * r1 * r2 - 2.0 * r1 * r2 * u1 - r1 * r1 * u2) / E;
+        dr[0] = 2.0 * (r1 * u2 * u2 + r1 * r2 * r2 - r2 * r2 * u1 - 2.0 * r1 * r2 * u2) * iE;
+        dr[1] = 2.0 * (r2 * u1 * u1 + r1 * r1 * r2 - 2.0 * r1 * r2 * u1 - r1 * r1 * u2) * iE;
     }
     return h;
 }
@@ -79,24 +79,29 @@ double lb__conic_union(const double x[2], const double r[2], double p, const dou
         2.0 * ((r1 - v1) * r2 * r2 * m1 + (r2 - v2) * r1 * r1 * m2 - p * (v1 * m2 + v2 * m1));
     const double chord = r1 * v2 + r2 * v1 - r1 * r2;
     const double cc = chord * chord + 2.0 * (p - r1 * r2) * v1 * v2;
-    const double s2 = chord / (r1 * m2 + r2 * m1); /* chord value, <= 0 */
+    const double w = r1 * m2 + r2 * m1; /* the chord value is s2 = chord / w <= 0 */
     double D = b * b - 4.0 * a * cc;
     if (D < 0.0) D = 0.0;
     const double q = -0.5 * (b + (b >= 0.0 ? sqrt(D) : -sqrt(D)));
-    /* candidates q/a and cc/q; take the one inside [s2, 0] */
-    double best = 0.0, best_dist = INFINITY;
-    const double cand[2] = {a != 0.0 ? q / a : NAN, q != 0.0 ? cc / q : NAN};
-    for (int i = 0; i < 2; ++i) {
-        if (!isfinite(cand[i])) continue;
-        const double d = cand[i] > 0.0 ? cand[i] : cand[i] < s2 ? s2 - cand[i] : 0.0;
-        if (d < best_dist) {
-            best_dist = d;
-            best = cand[i];
+    /* roots cc/q and q/a; the one in [s2, 0] is almost always cc/q, so that
+     * one is tried first (the test s >= s2 is s w >= chord: no division) */
+    double s = q != 0.0 ? cc / q : NAN;
+    if (!(s <= 0.0 && s * w >= chord)) {
+        const double s2 = chord / w;
+        double best = s, best_dist = INFINITY;
+        const double cand[2] = {s, a != 0.0 ? q / a : NAN};
+        for (int i = 0; i < 2; ++i) {
+            if (!isfinite(cand[i])) continue;
+            const double d = cand[i] > 0.0 ? cand[i] : cand[i] < s2 ? s2 - cand[i] : 0.0;
+            if (d < best_dist) {
+                best_dist = d;
+                best = cand[i];
+            }
         }
+        s = isfinite(best) ? best : 0.0;
+        if (s > 0.0) s = 0.0;
+        if (s < s2) s = s2;
     }
-    double s = best;
-    if (s > 0.0) s = 0.0;
-    if (s < s2) s = s2;
     return conic_grads(&c, h1, s, dx, dr, dm);
 }
 
