@@ -60,7 +60,9 @@ static void sample(rng_t *g, nu_case *c, size_t k, int union_like, int wide) {
         c->r[i] = union_like ? rng_range(g, 1e-3, 1.0) : rng_log(g, 1e-3, wide ? 10.0 : 2.0);
         if (union_like && rng_unit(g) < 0.15) c->r[i] = 1.0;
         c->p[i] = wide ? rng_p(g) : fmin(rng_p(g), 16.0);
-        c->m[i] = rng_unit(g) < 0.2 ? 1.0 : rng_log(g, wide ? 1e-2 : 0.2, wide ? 1e2 : 5.0);
+        c->m[i] = rng_unit(g) < 0.2
+                      ? 1.0
+                      : rng_log(g, wide ? LB_SOFT_MIN_SLOPE : 0.2, wide ? LB_SOFT_MAX_SLOPE : 5.0);
         c->x[i] = rng_unit(g) < 0.7 ? rng_range(g, 0.2, 0.9) : rng_log(g, 1e-3, 1.0);
     }
 }
@@ -108,7 +110,8 @@ static void test_hyper(void **state) {
             tally_check(&nb, fabs(v - nbv) <= 1e-12 * nbv, "case %d: %.17g vs %.17g", n, v, nbv);
         /* the 0.5 set: sign of (B - 0.5) does not depend on m */
         nu_case c2 = c;
-        for (size_t i = 0; i < c.k; ++i) c2.m[i] = rng_log(&g, 1e-2, 1e2);
+        for (size_t i = 0; i < c.k; ++i)
+            c2.m[i] = rng_log(&g, LB_SOFT_MIN_SLOPE, LB_SOFT_MAX_SLOPE);
         double v2;
         lb_soft_hyper(ul ? LB_UNION : LB_INTERSECTION, c.k, c2.x, c2.r, c2.p, c2.m, &v2, NULL,
                       NULL);

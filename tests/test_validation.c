@@ -32,6 +32,8 @@ CALL(mzero, const double m[2] = {1, 0};
      return lb_displacement(LB_UNION, 2, X2, R2, P2, m, &out, NULL, err);)
 CALL(xnan, const double x[2] = {0, NAN};
      return lb_displacement(LB_UNION, 2, x, R2, P2, M2, &out, NULL, err);)
+CALL(xhuge, const double x[2] = {0, 1e101};
+     return lb_displacement(LB_UNION, 2, x, R2, P2, M2, &out, NULL, err);)
 CALL(xinf, const double x[2] = {INFINITY, 0};
      return lb_displacement(LB_UNION, 2, x, R2, P2, M2, &out, NULL, err);)
 CALL(rnan, const double r[2] = {NAN, 1};
@@ -60,6 +62,12 @@ CALL(softm, const double m[2] = {0.5, -2};
 CALL(softconicr, const double r[2] = {0.5, 2};
      return lb_soft_conic(LB_UNION, X2, r, 0.0, M2, &out, NULL, err);)
 CALL(softconicp, return lb_soft_conic(LB_INTERSECTION, X2, R2, 1.0, M2, &out, NULL, err);)
+CALL(softx, const double x[2] = {0.5, 1.5};
+     return lb_soft_hyper(LB_UNION, 2, x, R2, P2, M2, &out, NULL, err);)
+CALL(softmsmall, const double m[2] = {1, 1e-4};
+     return lb_soft_hyper(LB_INTERSECTION, 2, X2, R2, P2, m, &out, NULL, err);)
+CALL(rtiny, const double r[2] = {1e-10, 1};
+     return lb_displacement(LB_UNION, 2, X2, r, P2, M2, &out, NULL, err);)
 CALL(ricci, return lb_classic(LB_RICCI_UNION, 2, X2, 0.5, &out, NULL, err);)
 CALL(rfk, return lb_classic(LB_RFUNC_UNION, 3, X2, 0, &out, NULL, err);)
 CALL(classkind, return lb_classic((lb_classic_kind)42, 2, X2, 0, &out, NULL, err);)
@@ -104,12 +112,15 @@ static const row_t rows[] = {
     {"k = 0", k0, LB_ERR_INVALID_ARGUMENT, "k = 0 arguments; allowed: 1 <= k <= 256"},
     {"k too large", kbig, LB_ERR_INVALID_ARGUMENT, "k = 257"},
     {"negative r", rneg, LB_ERR_INVALID_ARGUMENT,
-     "lb_displacement: r[1] = -1 is out of range; allowed: r > 0"},
+     "lb_displacement: r[1] = -1 is out of range; allowed: 1e-09 <= r <= 1e+09"},
     {"zero r", rzero, LB_ERR_INVALID_ARGUMENT, "r[0] = 0 is out of range"},
     {"p = 1", pone, LB_ERR_INVALID_ARGUMENT, "p[1] = 1 is out of range; allowed: 1 < p <= 1000"},
     {"p too large", pbig, LB_ERR_INVALID_ARGUMENT, "p[1] = 2000"},
-    {"m = 0", mzero, LB_ERR_INVALID_ARGUMENT, "m[1] = 0 is out of range; allowed: m > 0"},
+    {"m = 0", mzero, LB_ERR_INVALID_ARGUMENT,
+     "m[1] = 0 is out of range; allowed: 1e-06 <= m <= 1e+06"},
     {"x NaN", xnan, LB_ERR_NOT_FINITE, "x[1] = nan is not finite"},
+    {"x beyond 1e100", xhuge, LB_ERR_NOT_FINITE,
+     "x[1] = 1e+101 is beyond the supported range; allowed: |x| <= 1e+100"},
     {"x inf", xinf, LB_ERR_NOT_FINITE, "x[0] = inf is not finite"},
     {"r NaN", rnan, LB_ERR_INVALID_ARGUMENT, "r[0] = nan"},
     {"bad op", badop, LB_ERR_INVALID_ARGUMENT, "op = 7 is not a set operation"},
@@ -120,17 +131,23 @@ static const row_t rows[] = {
     {"conic r", conicr, LB_ERR_INVALID_ARGUMENT, "lb_conic: r[0] = -1"},
     {"conic m", conicm, LB_ERR_INVALID_ARGUMENT, "lb_conic: m[0] = -1"},
     {"B_S r > 1", bsr, LB_ERR_INVALID_ARGUMENT,
-     "lb_scale_bs: r[1] = 1.5 is out of range; allowed: 0 < r <= 1"},
+     "lb_scale_bs: r[1] = 1.5 is out of range; allowed: 1e-09 <= r <= 1"},
     {"scale intersection r > 1", scaleir, LB_ERR_INVALID_ARGUMENT, "lb_scale: r[1] = 1.5"},
     {"scale p < 1", scalep, LB_ERR_INVALID_ARGUMENT, "lb_scale: p[0] = 0.5"},
     {"bounded p", boundp, LB_ERR_INVALID_ARGUMENT, "lb_bounded: p[0] = 1"},
     {"bounded c NaN", boundc, LB_ERR_NOT_FINITE, "lb_bounded: c[0] = nan"},
     {"soft union r > 1", softur, LB_ERR_INVALID_ARGUMENT,
-     "lb_soft_hyper: r[1] = 2 is out of range; allowed: 0 < r <= 1"},
+     "lb_soft_hyper: r[1] = 2 is out of range; allowed: 1e-09 <= r <= 1"},
     {"soft m < 0", softm, LB_ERR_INVALID_ARGUMENT, "lb_soft_hyper: m[1] = -2"},
     {"soft conic union r > 1", softconicr, LB_ERR_INVALID_ARGUMENT,
-     "lb_soft_conic: r = (0.5, 2) is out of range for a union"},
+     "lb_soft_conic: r[1] = 2 is out of range; allowed: 1e-09 <= r <= 1"},
     {"soft conic p", softconicp, LB_ERR_INVALID_ARGUMENT, "lb_soft_conic: p = 1"},
+    {"soft x > 1", softx, LB_ERR_INVALID_ARGUMENT,
+     "lb_soft_hyper: x[1] = 1.5 is out of range; allowed: 0 <= x <= 1 (a soft field value)"},
+    {"soft m too small", softmsmall, LB_ERR_INVALID_ARGUMENT,
+     "m[1] = 0.0001 is out of range; allowed: 0.05 <= m <= 20"},
+    {"r too small", rtiny, LB_ERR_INVALID_ARGUMENT,
+     "r[0] = 1e-10 is out of range; allowed: 1e-09 <= r <= 1e+09"},
     {"Ricci n < 1", ricci, LB_ERR_INVALID_ARGUMENT, "param (Ricci exponent n) = 0.5"},
     {"R-function k", rfk, LB_ERR_INVALID_ARGUMENT, "this operator takes exactly 2"},
     {"classic kind", classkind, LB_ERR_INVALID_ARGUMENT, "kind = 42"},
@@ -143,7 +160,8 @@ static const row_t rows[] = {
     {"bulge conic p", bulgeconicp, LB_ERR_INVALID_ARGUMENT,
      "params->conic_p = 0.1 is out of range"},
     {"bulge family", bulgefam, LB_ERR_INVALID_ARGUMENT, "family = 9"},
-    {"bulge g NaN", bulgeg, LB_ERR_NOT_FINITE, "g1[1] = nan"},
+    {"bulge g NaN", bulgeg, LB_ERR_INVALID_ARGUMENT,
+     "g1[1] = nan is out of range; allowed: finite, |g1 component| <= 1e30"},
     {"sphere radius", sphr, LB_ERR_INVALID_ARGUMENT,
      "lb_primitive_sphere: radius = -1 is out of range; allowed: finite and > 0"},
     {"ellipsoid axis", ellipa, LB_ERR_INVALID_ARGUMENT, "lb_primitive_ellipsoid: a[1] = 0"},

@@ -6,8 +6,10 @@
  *    parameters>, value, grad, err). `op` selects union, intersection or
  *    difference; the difference subtracts x[1..k-1] from x[0].
  *  - x[0..k-1] are the values of the blended fields at one point. Per-argument
- *    parameter arrays have length k: r (blending range, > 0), p (curvature
- *    exponent, > 1 so the result is C1), m (subsequent-blend parameter, > 0;
+ *    parameter arrays have length k: r (blending range, > 0; accepted in
+ *    [LB_MIN_RANGE, LB_MAX_RANGE]), p (curvature exponent, > 1 so the result
+ *    is C1; at most LB_MAX_EXPONENT), m (subsequent-blend parameter, > 0;
+ *    accepted in [LB_MIN_SLOPE, LB_MAX_SLOPE];
  *    m = 1 everywhere reproduces the older operator exactly). m may be NULL,
  *    meaning m_i = 1.
  *  - `value` receives the blend; `grad` (may be NULL) receives the k partial
@@ -17,8 +19,9 @@
  *    bisection fallback): the result never leaves the bracket stated in
  *    shared/spec/operators.md, and gradients come from the implicit function
  *    theorem, so they are exact to rounding.
- *  - For every finite input and valid parameters the value and the gradient
- *    are finite. Non-finite inputs give LB_ERR_NOT_FINITE; invalid parameters
+ *  - For every finite input (|x_i| <= LB_MAX_ABS_ARG) and valid parameters the
+ *    value and the gradient are finite. Non-finite or larger inputs give
+ *    LB_ERR_NOT_FINITE; invalid parameters
  *    give LB_ERR_INVALID_ARGUMENT naming the parameter and its allowed range.
  *  - Conventions: `zero` families (displacement, conic, scale, bounded,
  *    R-functions) have f < 0 inside and f = 0 on the surface; `soft` families
@@ -38,6 +41,22 @@ extern "C" {
 #define LB_MAX_ARITY 256
 /* Largest curvature exponent p accepted. */
 #define LB_MAX_EXPONENT 1000.0
+/* Largest |argument| accepted (field values, bounding values, gradients):
+ * far beyond any real field, and small enough that no intermediate product
+ * of the operators can overflow. Larger values give LB_ERR_NOT_FINITE. */
+#define LB_MAX_ABS_ARG 1e100
+/* Accepted blending ranges r and subsequent-blend parameters m (zero
+ * families): wide enough for any scene, bounded so that no intermediate
+ * quantity of an operator can overflow. The soft families take field values
+ * in [0, 1] and m in [LB_SOFT_MIN_SLOPE, LB_SOFT_MAX_SLOPE] (their value grows
+ * like x^(1/m); the papers use m from 0.3 to 1.5). */
+#define LB_MIN_RANGE 1e-9
+#define LB_MAX_RANGE 1e9
+#define LB_MIN_SLOPE 1e-6
+#define LB_MAX_SLOPE 1e6
+#define LB_SOFT_MIN_SLOPE 0.05
+#define LB_SOFT_MIN_FIELD 1e-300 /* soft values below this count as 0 */
+#define LB_SOFT_MAX_SLOPE 20.0
 
 typedef enum lb_setop {
     LB_UNION = 0,
@@ -107,11 +126,17 @@ LB_API lb_status lb_bounded(lb_setop op, size_t k, const double *x, const double
  *   M_i as in shared/spec/operators.md section 4      (LB_BULGE_SLOPE; not for
  *                                                      the scale family)
  * Gradients: dx[2] = d value / d x_i, dg1[3], dg2[3] = d value / d g1, g2
- * (each may be NULL); the spatial gradient is dx[0] g1 + dx[1] g2
+ * (each may be NULL); M_i is kept within [LB_MIN_SLOPE, LB_MAX_SLOPE] (it
+ * leaves that only for gradient magnitudes 1e6 apart). The spatial gradient is dx[0] g1 + dx[1] g2
  * + H1 dg1 + H2 dg2 with H_i the Hessians of the arguments. Where a gradient
- * is zero, cos theta is taken as 0. For intersection and difference the
+ * is zero, cos theta is taken as 0 and M_i = m_i. For intersection and difference the
  * angle is measured between the gradients of the arguments as they enter the
- * dual union (the subtracted argument's gradient is negated). */
+ * dual union (the subtracted argument's gradient is negated). A gradient
+ * shorter than LB_BULGE_MIN_GRAD counts as zero; components beyond
+ * LB_BULGE_MAX_GRAD are rejected (d cos(theta)/d g ~ 1/|g| and the slope ratio
+ * |g1|/|g2| must stay representable). */
+#define LB_BULGE_MIN_GRAD 1e-30
+#define LB_BULGE_MAX_GRAD 1e30 /* larger gradient components are rejected */
 typedef enum lb_bulge_family {
     LB_BULGE_DISPLACEMENT = 0, /* lb_displacement with k = 2 */
     LB_BULGE_CONIC = 1,        /* lb_conic */

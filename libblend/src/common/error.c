@@ -49,10 +49,15 @@ lb_status lb__check_k(const char *fn, size_t k, size_t kmin, size_t kmax, lb_err
 lb_status lb__check_finite(const char *fn, const char *name, size_t n, const double *v,
                            lb_error *err) {
     if (!v) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: %s is NULL", fn, name);
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i = 0; i < n; ++i) {
         if (!isfinite(v[i]))
             return lb__fail(err, LB_ERR_NOT_FINITE, "%s: %s[%zu] = %g is not finite", fn, name, i,
                             v[i]);
+        if (fabs(v[i]) > LB_MAX_ABS_ARG)
+            return lb__fail(err, LB_ERR_NOT_FINITE,
+                            "%s: %s[%zu] = %g is beyond the supported range; allowed: |%s| <= %g",
+                            fn, name, i, v[i], name, LB_MAX_ABS_ARG);
+    }
     return LB_OK;
 }
 
@@ -73,6 +78,18 @@ lb_status lb__check_range(const char *fn, const char *name, size_t n, const doub
         }
     }
     return LB_OK;
+}
+
+lb_status lb__check_r_m(const char *fn, const char *rname, const char *mname, size_t k,
+                        const double *r, const double *m, double rmax, double mmin, double mmax,
+                        lb_error *err) {
+    char what[64];
+    const double rhi = rmax < LB_MAX_RANGE ? rmax : LB_MAX_RANGE;
+    snprintf(what, sizeof what, "%g <= r <= %g", LB_MIN_RANGE, rhi);
+    lb_status s = lb__check_range(fn, rname, k, r, LB_MIN_RANGE, 1, rhi, 1, what, err);
+    if (s || !m) return s;
+    snprintf(what, sizeof what, "%g <= m <= %g", mmin, mmax);
+    return lb__check_range(fn, mname, k, m, mmin, 1, mmax, 1, what, err);
 }
 
 lb_status lb__check_setop(const char *fn, lb_setop op, lb_error *err) {

@@ -38,13 +38,19 @@ LB_INTERNAL lb_status lb__check_finite(const char *fn, const char *name, size_t 
 LB_INTERNAL lb_status lb__check_range(const char *fn, const char *name, size_t n, const double *v,
                                       double lo, int lo_closed, double hi, int hi_closed,
                                       const char *what, lb_error *err);
+/* r_i in [LB_MIN_RANGE, min(rmax, LB_MAX_RANGE)] and m_i (m may be NULL) in
+ * [mmin, mmax], with messages naming the range. */
+LB_INTERNAL lb_status lb__check_r_m(const char *fn, const char *rname, const char *mname, size_t k,
+                                    const double *r, const double *m, double rmax, double mmin,
+                                    double mmax, lb_error *err);
 LB_INTERNAL lb_status lb__check_setop(const char *fn, lb_setop op, lb_error *err);
 LB_INTERNAL lb_status lb__check_out(const char *fn, const void *value, lb_error *err);
-/* r in (0, rmax] (rmax = INFINITY: r > 0), 1 < p <= LB_MAX_EXPONENT, m > 0 or NULL. */
+/* r in [LB_MIN_RANGE, min(rmax, LB_MAX_RANGE)], 1 < p <= LB_MAX_EXPONENT,
+ * m in [LB_MIN_SLOPE, LB_MAX_SLOPE] or NULL. */
 LB_INTERNAL lb_status lb__check_blend_params(const char *fn, size_t k, const double *r,
                                              const double *p, const double *m, double rmax,
                                              lb_error *err);
-/* x finite, r > 0, m > 0 or NULL, p < r0 r1 (conic shape). */
+/* x finite, r and m (or NULL) in their accepted ranges, p < r0 r1 (conic shape). */
 LB_INTERNAL lb_status lb__check_conic(const char *fn, const double x[2], const double r[2],
                                       double p, const double m[2], const void *value,
                                       lb_error *err);
@@ -58,10 +64,10 @@ static inline int lb__fast_ok(size_t k, const double *x, const double *r, const 
     if (!x || !r || k == 0 || k > LB_MAX_ARITY) return 0;
     int ok = 1;
     for (size_t i = 0; i < k; ++i) {
-        ok &= (x[i] - x[i] == 0.0); /* finite */
-        ok &= (r[i] > 0.0) & (r[i] <= rmax) & (r[i] < INFINITY);
+        ok &= fabs(x[i]) <= LB_MAX_ABS_ARG; /* finite and in range (false for NaN) */
+        ok &= (r[i] >= LB_MIN_RANGE) & (r[i] <= rmax) & (r[i] <= LB_MAX_RANGE);
         if (p) ok &= (p[i] > 1.0) & (p[i] <= LB_MAX_EXPONENT);
-        if (m) ok &= (m[i] > 0.0) & (m[i] < INFINITY);
+        if (m) ok &= (m[i] >= LB_MIN_SLOPE) & (m[i] <= LB_MAX_SLOPE);
     }
     return ok;
 }
@@ -76,14 +82,22 @@ static inline int lb__fast_mode(size_t k, const double *x, const double *r, cons
     if (!x || !r || !p || k == 0 || k > LB_MAX_ARITY) return -1;
     int ok = 1, two = 1, integer = 1;
     for (size_t i = 0; i < k; ++i) {
-        ok &= (x[i] - x[i] == 0.0);
-        ok &= (r[i] > 0.0) & (r[i] <= rmax) & (r[i] < INFINITY);
+        ok &= fabs(x[i]) <= LB_MAX_ABS_ARG;
+        ok &= (r[i] >= LB_MIN_RANGE) & (r[i] <= rmax) & (r[i] <= LB_MAX_RANGE);
         ok &= (p[i] > 1.0) & (p[i] <= LB_MAX_EXPONENT);
-        if (m) ok &= (m[i] > 0.0) & (m[i] < INFINITY);
+        if (m) ok &= (m[i] >= LB_MIN_SLOPE) & (m[i] <= LB_MAX_SLOPE);
         two &= p[i] == 2.0;
         integer &= (p[i] <= 64.0) & ((double)(long)p[i] == p[i]);
     }
     return !ok ? -1 : two ? LB__P_TWO : integer ? LB__P_INTEGER : LB__P_GENERAL;
+}
+
+/* |v| of a 3-vector without overflow or underflow of the squares. */
+static inline double lb__norm3(const double v[3]) {
+    const double s = fmax(fabs(v[0]), fmax(fabs(v[1]), fabs(v[2])));
+    if (!(s > 0.0)) return 0.0;
+    const double a = v[0] / s, b = v[1] / s, c = v[2] / s;
+    return s * sqrt(a * a + b * b + c * c);
 }
 
 /* ---- exponent helpers ---- */
@@ -118,7 +132,7 @@ static inline double lb__conic_H(double r1, double r2, double p, double u1, doub
 /* ---- kernels (unchecked). Gradient outputs may be NULL. ---- */
 
 /* BT_k union (displacement). m must be non-NULL. dx, dr, dm: d/dx_i, d/dr_i, d/dm_i. */
-LB_INTERNAL LB_READS(2, 1) LB_READS(3, 1)
+LB_INTERNAL LB_READS(2, 1) LB_READS(3, 1) LB_READS(4, 1)
     LB_READS(5, 1) double lb__bt_union(size_t k, const double *x, const double *r, const double *p,
                                        const double *m, int mode, double *dx, double *dr,
                                        double *dm);

@@ -27,8 +27,10 @@ static lb_status bulge_check(lb_bulge_family family, lb_setop op, const lb_bulge
                         fn, (int)family);
     if ((s = lb__check_setop(fn, op, err)) || (s = lb__check_out(fn, value, err)) ||
         (s = lb__check_finite(fn, "x", 2, x, err)) ||
-        (s = lb__check_finite(fn, "g1", 3, g1, err)) ||
-        (s = lb__check_finite(fn, "g2", 3, g2, err)))
+        (s = lb__check_range(fn, "g1", 3, g1, -LB_BULGE_MAX_GRAD, 1, LB_BULGE_MAX_GRAD, 1,
+                             "finite, |g1 component| <= 1e30", err)) ||
+        (s = lb__check_range(fn, "g2", 3, g2, -LB_BULGE_MAX_GRAD, 1, LB_BULGE_MAX_GRAD, 1,
+                             "finite, |g2 component| <= 1e30", err)))
         return s;
     if (bp->flags & ~(unsigned)(LB_BULGE_RANGE | LB_BULGE_SLOPE))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
@@ -56,8 +58,8 @@ static lb_status bulge_check(lb_bulge_family family, lb_setop op, const lb_bulge
                                 fn, i, bp->r[i], rmax);
     }
     if (family == LB_BULGE_CONIC) {
-        if ((s = lb__check_range(fn, "params->r", 2, bp->r, 0.0, 0, INFINITY, 0, "r > 0", err)) ||
-            (s = lb__check_range(fn, "params->m", 2, bp->m, 0.0, 0, INFINITY, 0, "m > 0", err)))
+        if ((s = lb__check_r_m(fn, "params->r", "params->m", 2, bp->r, bp->m, INFINITY,
+                               LB_MIN_SLOPE, LB_MAX_SLOPE, err)))
             return s;
         const double f = range ? bp->omega * bp->omega : 1.0;
         const double pmax = bp->r[0] * bp->r[1] * f;
@@ -81,14 +83,25 @@ lb_status lb_bulge(lb_bulge_family family, lb_setop op, const lb_bulge_params *b
     const int slope = (bp->flags & LB_BULGE_SLOPE) != 0;
     const double sig = op == LB_DIFFERENCE ? -1.0 : 1.0; /* g2 as it enters the union */
 
-    /* cos theta and its derivatives */
-    const double n1 = sqrt(dot3(g1, g1)), n2 = sqrt(dot3(g2, g2));
+    /* cos theta and its derivatives, from unit vectors (so tiny or huge
+     * gradients neither underflow nor overflow) */
+    const double n1 = lb__norm3(g1), n2 = lb__norm3(g2);
+    /* a gradient shorter than LB_BULGE_MIN_GRAD counts as zero: the angle is
+     * undefined there, and d cos / d g ~ 1/|g| would overflow */
+    const int both = n1 >= LB_BULGE_MIN_GRAD && n2 >= LB_BULGE_MIN_GRAD;
     double cs = 0.0, dc1[3] = {0, 0, 0}, dc2[3] = {0, 0, 0};
-    if (n1 > 0.0 && n2 > 0.0) {
-        cs = sig * dot3(g1, g2) / (n1 * n2);
+    if (both) {
+        double e1[3], e2[3];
         for (int a = 0; a < 3; ++a) {
-            dc1[a] = sig * g2[a] / (n1 * n2) - cs * g1[a] / (n1 * n1);
-            dc2[a] = sig * g1[a] / (n1 * n2) - cs * g2[a] / (n2 * n2);
+            e1[a] = g1[a] / n1;
+            e2[a] = g2[a] / n2;
+        }
+        cs = sig * dot3(e1, e2);
+        if (cs > 1.0) cs = 1.0;
+        if (cs < -1.0) cs = -1.0;
+        for (int a = 0; a < 3; ++a) {
+            dc1[a] = (sig * e2[a] - cs * e1[a]) / n1;
+            dc2[a] = (sig * e1[a] - cs * e2[a]) / n2;
         }
     }
     /* ranges */
@@ -100,22 +113,29 @@ lb_status lb_bulge(lb_bulge_family family, lb_setop op, const lb_bulge_params *b
     /* slopes */
     double M[2] = {bp->m[0], bp->m[1]}, dMdc[2] = {0, 0}, dMdG[2] = {0, 0};
     double dG1[3] = {0, 0, 0}, dG2[3] = {0, 0, 0};
-    if (slope && n1 > 0.0 && n2 > 0.0) {
+    if (slope && both) {
         const double G = n1 / n2, cp = cs > 0.0 ? cs : 0.0, on = cs > 0.0 ? 1.0 : 0.0;
         const double m1 = bp->m[0], m2 = bp->m[1];
         if (m1 > m2 * G) {
             M[1] = m2 + (m1 / G - m2) * cp;
             dMdc[1] = (m1 / G - m2) * on;
-            dMdG[1] = -m1 / (G * G) * cp;
+            dMdG[1] = cp > 0.0 ? -(m1 / G) / G * cp : 0.0; /* no 0 * inf when cp = 0 */
         } else {
             M[0] = m1 + (m2 * G - m1) * cp;
             dMdc[0] = (m2 * G - m1) * on;
             dMdG[0] = m2 * cp;
         }
         for (int a = 0; a < 3; ++a) {
-            dG1[a] = g1[a] / (n1 * n2);
-            dG2[a] = -n1 * g2[a] / (n2 * n2 * n2);
+            dG1[a] = g1[a] / n1 / n2;
+            dG2[a] = -G * (g2[a] / n2) / n2;
         }
+        /* gradients of wildly different size push M_i past any sensible
+         * slope: keep it in [LB_MIN_SLOPE, LB_MAX_SLOPE] (flat there) */
+        for (int i = 0; i < 2; ++i)
+            if (!(M[i] >= LB_MIN_SLOPE && M[i] <= LB_MAX_SLOPE)) {
+                M[i] = M[i] > LB_MAX_SLOPE ? LB_MAX_SLOPE : LB_MIN_SLOPE;
+                dMdc[i] = dMdG[i] = 0.0;
+            }
     }
     /* base operator */
     double u, du[2], dr[2] = {0, 0}, dm[2] = {0, 0}, sg[2] = {1, 1}, out = 1.0;

@@ -132,8 +132,7 @@ lb_status lb__check_conic(const char *fn, const double x[2], const double r[2], 
                           const double m[2], const void *value, lb_error *err) {
     lb_status s;
     if ((s = lb__check_out(fn, value, err)) || (s = lb__check_finite(fn, "x", 2, x, err)) ||
-        (s = lb__check_range(fn, "r", 2, r, 0.0, 0, INFINITY, 0, "r > 0", err)) ||
-        (m && (s = lb__check_range(fn, "m", 2, m, 0.0, 0, INFINITY, 0, "m > 0", err))))
+        (s = lb__check_r_m(fn, "r", "m", 2, r, m, INFINITY, LB_MIN_SLOPE, LB_MAX_SLOPE, err)))
         return s;
     if (!isfinite(p) || !(p < r[0] * r[1]))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,

@@ -214,14 +214,9 @@ double lb__bt_union(size_t k, const double *x, const double *r, const double *p,
 
 lb_status lb__check_blend_params(const char *fn, size_t k, const double *r, const double *p,
                                  const double *m, double rmax, lb_error *err) {
-    lb_status s;
-    if ((s = lb__check_range(fn, "r", k, r, 0.0, 0, rmax, 1, rmax == 1.0 ? "0 < r <= 1" : "r > 0",
-                             err)))
-        return s;
-    if ((s = lb__check_range(fn, "p", k, p, 1.0, 0, LB_MAX_EXPONENT, 1, "1 < p <= 1000", err)))
-        return s;
-    if (m && (s = lb__check_range(fn, "m", k, m, 0.0, 0, INFINITY, 0, "m > 0", err))) return s;
-    return LB_OK;
+    lb_status s = lb__check_r_m(fn, "r", "m", k, r, m, rmax, LB_MIN_SLOPE, LB_MAX_SLOPE, err);
+    if (s) return s;
+    return lb__check_range(fn, "p", k, p, 1.0, 0, LB_MAX_EXPONENT, 1, "1 < p <= 1000", err);
 }
 
 lb_status lb_displacement(lb_setop op, size_t k, const double *x, const double *r, const double *p,

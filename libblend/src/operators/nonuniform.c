@@ -9,7 +9,8 @@
  * Conic variants use H of lb__conic_H with u_i = z_i - 1 (intersection,
  * T = H) or u_i = 1 - z_i (union, T = -H), between the non-blending value
  * and the chord u1/r1 + u2/r2 = 1 (found first, by the same solver).
- * Gradient: dh/dx_i = -h (dT/dx_i)/(dT/dlambda). */
+ * Gradient: dh/dx_i = -h (dT/dlambda)^-1 dT/dx_i. lambda is solved to an
+ * absolute tolerance, which is h's relative one. */
 #include "../common/internal.h"
 #include "../solver/root.h"
 
@@ -17,7 +18,7 @@
 
 typedef struct {
     size_t k;
-    const double *a, *r, *p, *m;
+    const double *a, *r, *p, *m; /* a: ln a_i = ln x_i + (1 - m_i) ln 2 */
     int mode, union_like;
 } soft_ctx;
 
@@ -28,7 +29,7 @@ static void soft_T(double lam, const void *vctx, double *T, double *dT, double *
     const soft_ctx *c = vctx;
     double sum = 0.0, dsum = 0.0;
     for (size_t i = 0; i < c->k; ++i) {
-        const double z = c->a[i] * exp(-c->m[i] * lam);
+        const double z = exp(c->a[i] - c->m[i] * lam);
         const double t =
             c->union_like ? (c->r[i] - 1.0 + z) / c->r[i] : (1.0 + c->r[i] - z) / c->r[i];
         if (t > 0.0) {
@@ -53,7 +54,7 @@ static double soft_hyper_kernel(int union_like, size_t k, const double *x, const
             if (!union_like) return 0.0; /* min(x) <= 0: the intersection is 0 */
             continue;                    /* never active in a union */
         }
-        a[n] = x[i] * exp((1.0 - m[i]) * LN2);
+        a[n] = log(x[i]) + (1.0 - m[i]) * LN2; /* ln a_i: no underflow */
         ra[n] = r[i];
         pa[n] = p[i];
         ma[n] = m[i];
@@ -62,9 +63,9 @@ static double soft_hyper_kernel(int union_like, size_t k, const double *x, const
     if (n == 0) return 0.0;
     /* non-blending end of the bracket: min (intersection) / max (union) of ln(a_i)/m_i */
     size_t j = 0;
-    double lam_nb = log(a[0]) / ma[0];
+    double lam_nb = a[0] / ma[0];
     for (size_t i = 1; i < n; ++i) {
-        const double l = log(a[i]) / ma[i];
+        const double l = a[i] / ma[i];
         if (union_like ? l > lam_nb : l < lam_nb) {
             lam_nb = l;
             j = i;
@@ -75,32 +76,32 @@ static double soft_hyper_kernel(int union_like, size_t k, const double *x, const
     int alone = 1;
     for (size_t i = 0; i < n && alone; ++i) {
         if (i == j) continue;
-        const double z = a[i] * exp(-ma[i] * lam_nb);
+        const double z = exp(a[i] - ma[i] * lam_nb);
         const double t = union_like ? (ra[i] - 1.0 + z) / ra[i] : (1.0 + ra[i] - z) / ra[i];
         if (t > 0.0) alone = 0;
     }
     if (alone) {
-        const double h = pow(a[j], 1.0 / ma[j]);
-        if (dx) dx[map[j]] = h / (ma[j] * x[map[j]]);
+        const double h = exp(lam_nb);
+        if (dx) dx[map[j]] = exp((1.0 - ma[j]) * (lam_nb + LN2)) / ma[j]; /* h / (m x) */
         return h;
     }
     double other = union_like ? -INFINITY : INFINITY;
     for (size_t i = 0; i < n; ++i) {
         double l;
         if (union_like)
-            l = ra[i] < 1.0 ? log(a[i] / (1.0 - ra[i])) / ma[i]
-                            : (log(a[i]) + log((double)n) / pa[i]) / ma[i];
+            l = ra[i] < 1.0 ? (a[i] - log1p(-ra[i])) / ma[i]
+                            : (a[i] + log((double)n) / pa[i]) / ma[i];
         else
-            l = log(a[i] / (1.0 + ra[i])) / ma[i];
+            l = (a[i] - log1p(ra[i])) / ma[i];
         if (union_like ? l > other : l < other) other = l;
     }
-    const double lam = union_like ? lb__root_solve(soft_T, &ctx, lam_nb, other, lam_nb)
-                                  : lb__root_solve(soft_T, &ctx, other, lam_nb, lam_nb);
+    const double lam = union_like ? lb__root_solve_scaled(soft_T, &ctx, lam_nb, other, lam_nb, 1.0)
+                                  : lb__root_solve_scaled(soft_T, &ctx, other, lam_nb, lam_nb, 1.0);
     const double h = exp(lam);
     if (dx) {
         double q[LB_MAX_ARITY], E = 0.0;
         for (size_t i = 0; i < n; ++i) {
-            const double z = a[i] * exp(-ma[i] * lam);
+            const double z = exp(a[i] - ma[i] * lam);
             const double t = union_like ? (ra[i] - 1.0 + z) / ra[i] : (1.0 + ra[i] - z) / ra[i];
             q[i] = t > 0.0 ? pa[i] / ra[i] * lb__pow_m1(t, pa[i], ctx.mode) * z : 0.0;
             E += q[i] * ma[i];
@@ -110,20 +111,26 @@ static double soft_hyper_kernel(int union_like, size_t k, const double *x, const
             q[j] = 1.0;
             E = ma[j];
         }
-        for (size_t i = 0; i < n; ++i) dx[map[i]] = h * q[i] / (E * x[map[i]]);
+        /* q_i carries z_i = x_i/s_i; dh/dx_i = h q_i / (E x_i) = (h/s_i) (q_i/z_i) / E,
+         * with h/s_i = exp((1 - m_i)(lambda + ln 2)) (no division by a tiny x_i) */
+        for (size_t i = 0; i < n; ++i) {
+            const double z = exp(a[i] - ma[i] * lam);
+            const double hs = exp((1.0 - ma[i]) * (lam + LN2));
+            dx[map[i]] = q[i] > 0.0 && z > 0.0 ? hs * (q[i] / z) / E : 0.0;
+        }
     }
     return h;
 }
 
 /* ---- conic variants ---- */
 typedef struct {
-    double a[2], r[2], m[2], p;
-    int union_like, chord; /* chord: solve the chord equation instead of H */
+    double a[2], r[2], m[2], p; /* a: ln a_i */
+    int union_like, chord;      /* chord: solve the chord equation instead of H */
 } sconic_ctx;
 
 static void sconic_u(const sconic_ctx *c, double lam, double u[2], double du[2]) {
     for (int i = 0; i < 2; ++i) {
-        const double z = c->a[i] * exp(-c->m[i] * lam);
+        const double z = exp(c->a[i] - c->m[i] * lam);
         u[i] = c->union_like ? 1.0 - z : z - 1.0;
         du[i] = c->union_like ? c->m[i] * z : -c->m[i] * z;
     }
@@ -156,8 +163,8 @@ static double soft_conic_kernel(int union_like, const double x[2], const double 
     sconic_ctx c = {{0, 0}, {r[0], r[1]}, {m[0], m[1]}, p, union_like, 0};
     double lnb[2];
     for (int i = 0; i < 2; ++i) {
-        c.a[i] = x[i] > 0.0 ? x[i] * exp((1.0 - m[i]) * LN2) : 0.0;
-        lnb[i] = x[i] > 0.0 ? log(c.a[i]) / m[i] : -INFINITY;
+        c.a[i] = x[i] > 0.0 ? log(x[i]) + (1.0 - m[i]) * LN2 : -INFINITY; /* ln a_i */
+        lnb[i] = c.a[i] / m[i];
     }
     const int j = union_like ? lnb[1] > lnb[0] : lnb[1] < lnb[0];
     const int o = 1 - j;
@@ -166,21 +173,21 @@ static double soft_conic_kernel(int union_like, const double x[2], const double 
     sconic_u(&c, lam_nb, u, du);
     if (x[o] <= 0.0 || u[o] >= r[o]) { /* outside region II */
         const double h = exp(lam_nb);
-        if (dx) dx[j] = h / (m[j] * x[j]);
+        if (dx) dx[j] = exp((1.0 - m[j]) * (lam_nb + LN2)) / m[j]; /* h / (m x) */
         return h;
     }
     /* chord end of the bracket: where each u_i >= r_i/2 the chord value is >= 0 */
     double far = union_like ? -INFINITY : INFINITY;
     for (int i = 0; i < 2; ++i) {
-        const double l = log(c.a[i] / (union_like ? 1.0 - 0.5 * r[i] : 1.0 + 0.5 * r[i])) / m[i];
+        const double l = (c.a[i] - log1p(union_like ? -0.5 * r[i] : 0.5 * r[i])) / m[i];
         if (union_like ? l > far : l < far) far = l;
     }
     c.chord = 1;
-    const double lam_c = union_like ? lb__root_solve(sconic_T, &c, lam_nb, far, lam_nb)
-                                    : lb__root_solve(sconic_T, &c, far, lam_nb, lam_nb);
+    const double lam_c = union_like ? lb__root_solve_scaled(sconic_T, &c, lam_nb, far, lam_nb, 1.0)
+                                    : lb__root_solve_scaled(sconic_T, &c, far, lam_nb, lam_nb, 1.0);
     c.chord = 0;
-    const double lam = union_like ? lb__root_solve(sconic_T, &c, lam_nb, lam_c, lam_nb)
-                                  : lb__root_solve(sconic_T, &c, lam_c, lam_nb, lam_nb);
+    const double lam = union_like ? lb__root_solve_scaled(sconic_T, &c, lam_nb, lam_c, lam_nb, 1.0)
+                                  : lb__root_solve_scaled(sconic_T, &c, lam_c, lam_nb, lam_nb, 1.0);
     const double h = exp(lam);
     if (dx) {
         double H1, H2;
@@ -188,10 +195,11 @@ static double soft_conic_kernel(int union_like, const double x[2], const double 
         lb__conic_H(r[0], r[1], p, u[0], u[1], &H1, &H2);
         const double dTl = H1 * du[0] + H2 * du[1]; /* dH/dlambda */
         for (int i = 0; i < 2; ++i) {
-            /* u_i = +-(z_i - 1) with z_i = x_i / s_i: du_i/dx_i = +-z_i / x_i */
-            const double z = c.a[i] * exp(-m[i] * lam);
-            const double dudxi = (union_like ? -z : z) / x[i];
-            dx[i] = dTl != 0.0 ? -h * (H1 * (i == 0) + H2 * (i == 1)) * dudxi / dTl : 0.0;
+            /* u_i = +-(z_i - 1) with z_i = x_i / s_i: du_i/dx_i = +-1/s_i, and
+             * h/s_i = exp((1 - m_i)(lambda + ln 2)) */
+            const double hs = exp((1.0 - m[i]) * (lam + LN2));
+            const double g = -(union_like ? -hs : hs) * (i == 0 ? H1 : H2) / dTl;
+            dx[i] = dTl != 0.0 && isfinite(g) ? g : 0.0;
         }
     }
     return h;
@@ -203,23 +211,31 @@ static lb_status soft_dispatch(const char *fn, lb_setop op, size_t k, const doub
     lb_status s;
     if ((s = lb__check_setop(fn, op, err))) return s;
     double ones[LB_MAX_ARITY], xt[LB_MAX_ARITY];
+    const double rmax = op == LB_UNION ? 1.0 : INFINITY;
     if (conic) {
         if ((s = lb__check_conic(fn, x, r, conic_p, m, value, err))) return s;
-        if (op == LB_UNION && (r[0] > 1.0 || r[1] > 1.0))
-            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
-                            "%s: r = (%g, %g) is out of range for a union; allowed: 0 < r <= 1", fn,
-                            r[0], r[1]);
     } else {
         if ((s = lb__check_k(fn, k, 1, LB_MAX_ARITY, err)) || (s = lb__check_out(fn, value, err)) ||
             (s = lb__check_finite(fn, "x", k, x, err)) ||
-            (s = lb__check_blend_params(fn, k, r, p, m, op == LB_UNION ? 1.0 : INFINITY, err)))
+            (s = lb__check_range(fn, "p", k, p, 1.0, 0, LB_MAX_EXPONENT, 1, "1 < p <= 1000", err)))
             return s;
     }
+    /* soft fields lie in [0, 1]; the result grows like x^(1/m), so m is kept
+     * where that stays finite */
+    if ((s = lb__check_range(fn, "x", k, x, 0.0, 1, 1.0, 1, "0 <= x <= 1 (a soft field value)",
+                             err)) ||
+        (s = lb__check_r_m(fn, "r", "m", k, r, m, rmax, LB_SOFT_MIN_SLOPE, LB_SOFT_MAX_SLOPE, err)))
+        return s;
     if (!m) {
         for (size_t i = 0; i < k; ++i) ones[i] = 1.0;
         m = ones;
     }
-    for (size_t i = 0; i < k; ++i) xt[i] = (op == LB_DIFFERENCE && i > 0) ? 1.0 - x[i] : x[i];
+    for (size_t i = 0; i < k; ++i) {
+        xt[i] = (op == LB_DIFFERENCE && i > 0) ? 1.0 - x[i] : x[i];
+        /* below LB_SOFT_MIN_FIELD a soft value counts as 0: the result grows like
+         * x^(1/m), whose slope at such x exceeds the double range when m > 1 */
+        if (xt[i] < LB_SOFT_MIN_FIELD) xt[i] = 0.0;
+    }
     const int u = op == LB_UNION;
     *value = conic ? soft_conic_kernel(u, xt, r, conic_p, m, grad)
                    : soft_hyper_kernel(u, k, xt, r, p, m, grad);

@@ -16,61 +16,60 @@
  * min(r_i, 1), because B_S needs r_i <= 1. */
 #include "../common/internal.h"
 
-double lb__scale_ba(size_t k, const double *y, const double *r, const double *p, int mode,
-                    double *dy, double *dr) {
+/* Both operators are homogeneous of degree 1 (B(c y) = c B(y)). They are
+ * solved on y / s, s = min y (B_A) or max y (B_S), over the arguments that can
+ * be active: B_A's term i is active only where y_i < (1 + r_i) h <= (1 + r_i)
+ * min y; B_S's only where y_i > (1 - r_i) h >= (1 - r_i) max y, and a B_S term
+ * with y_i / max y below 1e-100 adds at most (1e-100)^p: below rounding.
+ * So the kernel sees slopes y_i / s in [1e-100, 1 + r_i]: no overflow or
+ * underflow for any finite input. dB/dy is of degree 0; dB/dr of degree 1. */
+static double scale_kernel(int max_like, size_t k, const double *y, const double *r,
+                           const double *p, int mode, double *dy, double *dr) {
     size_t j = 0;
     for (size_t i = 1; i < k; ++i)
-        if (y[i] < y[j]) j = i;
-    if (y[j] <= 0.0) {
-        for (size_t i = 0; i < k; ++i) {
-            if (dy) dy[i] = i == j;
-            if (dr) dr[i] = 0.0;
-        }
-        return y[j];
-    }
-    double xm1[LB_MAX_ARITY], dm[LB_MAX_ARITY], drb[LB_MAX_ARITY];
-    for (size_t i = 0; i < k; ++i) xm1[i] = -1.0;
-    const double hp = lb__bt_union(k, xm1, r, p, y, mode, NULL, dr ? drb : NULL, dy ? dm : NULL);
-    const double s = 1.0 / (hp * hp);
-    for (size_t i = 0; i < k; ++i) {
-        if (dy) dy[i] = s * dm[i];
-        if (dr) dr[i] = s * drb[i];
-    }
-    return -1.0 / hp;
-}
-
-double lb__scale_bs(size_t k, const double *y, const double *r, const double *p, int mode,
-                    double *dy, double *dr) {
-    size_t j = 0;
-    for (size_t i = 1; i < k; ++i)
-        if (y[i] > y[j]) j = i;
+        if (max_like ? y[i] > y[j] : y[i] < y[j]) j = i;
     for (size_t i = 0; i < k; ++i) {
         if (dy) dy[i] = 0.0;
         if (dr) dr[i] = 0.0;
     }
-    if (y[j] <= 0.0) {
+    if (max_like ? y[j] <= 0.0 : y[j] <= 0.0) { /* Max / Min branch */
         if (dy) dy[j] = 1.0;
         return y[j];
     }
-    /* Compact the positive arguments. */
-    double ya[LB_MAX_ARITY], ra[LB_MAX_ARITY], pa[LB_MAX_ARITY], one[LB_MAX_ARITY];
-    double dm[LB_MAX_ARITY], drb[LB_MAX_ARITY];
+    const double sc = y[j];
+    double ys[LB_MAX_ARITY], ra[LB_MAX_ARITY], pa[LB_MAX_ARITY], xa[LB_MAX_ARITY];
+    double q[LB_MAX_ARITY];
     size_t map[LB_MAX_ARITY], n = 0;
-    for (size_t i = 0; i < k; ++i)
-        if (y[i] > 0.0) {
-            ya[n] = y[i];
-            ra[n] = r[i];
-            pa[n] = p[i];
-            one[n] = 1.0;
-            map[n++] = i;
-        }
-    const double g = lb__bt_union(n, one, ra, pa, ya, mode, NULL, dr ? drb : NULL, dy ? dm : NULL);
-    const double s = -1.0 / (g * g);
-    for (size_t a = 0; a < n; ++a) {
-        if (dy) dy[map[a]] = s * dm[a];
-        if (dr) dr[map[a]] = s * drb[a];
+    for (size_t i = 0; i < k; ++i) {
+        const double u = y[i] / sc;
+        const int can = max_like ? (u > 1.0 - r[i] && u >= 1e-100) : (u < 1.0 + r[i]);
+        if (!can && i != j) continue;
+        ys[n] = u;
+        ra[n] = r[i];
+        pa[n] = p[i];
+        xa[n] = max_like ? 1.0 : -1.0;
+        map[n++] = i;
     }
-    return 1.0 / g;
+    /* B_A: h' = BT(-1; m = u), B = -1/h'; B_S: g = BT(1; m = u), B = 1/g. With
+     * q_i = w_i/D (the kernel's dx): dB/du_i = B q_i, and dB/dr_i =
+     * q_i B (B - u_i)/r_i for both (no h'^2 or B^2 appears) */
+    const double hp = lb__bt_union(n, xa, ra, pa, ys, mode, q, NULL, NULL);
+    const double B = (max_like ? 1.0 : -1.0) / hp;
+    for (size_t a = 0; a < n; ++a) {
+        if (dy) dy[map[a]] = B * q[a];
+        if (dr) dr[map[a]] = sc * (q[a] * B * (B - ys[a]) / ra[a]);
+    }
+    return sc * B;
+}
+
+double lb__scale_ba(size_t k, const double *y, const double *r, const double *p, int mode,
+                    double *dy, double *dr) {
+    return scale_kernel(0, k, y, r, p, mode, dy, dr);
+}
+
+double lb__scale_bs(size_t k, const double *y, const double *r, const double *p, int mode,
+                    double *dy, double *dr) {
+    return scale_kernel(1, k, y, r, p, mode, dy, dr);
 }
 
 /* B_AS (Min-like) or B_SA (Max-like) of y = x' + 1, minus 1, where x' = x or,

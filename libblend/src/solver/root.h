@@ -46,8 +46,10 @@ typedef void (*lb__root_fn)(double h, const void *ctx, double *T, double *dT, do
 #define LB__ALWAYS_INLINE inline
 #endif
 
-static LB__ALWAYS_INLINE double lb__root_solve(lb__root_fn fn, const void *ctx, double lo,
-                                               double hi, double start) {
+/* habs > 0 replaces |h| in the tolerance (for a variable such as ln h whose
+ * absolute, not relative, error matters). */
+static LB__ALWAYS_INLINE double lb__root_solve_scaled(lb__root_fn fn, const void *ctx, double lo,
+                                                      double hi, double start, double habs) {
     if (!(hi > lo)) return lo;
     const double width0 = hi - lo;
     double h = start;
@@ -58,10 +60,10 @@ static LB__ALWAYS_INLINE double lb__root_solve(lb__root_fn fn, const void *ctx, 
     for (int it = 0; it < LB_ROOT_MAX_ITER; ++it) {
         double T, dT, d2T = 0.0, smooth = 0.0;
         fn(h, ctx, &T, &dT, &d2T, &smooth);
-        const double tol = LB_ROOT_RTOL * fabs(h) + LB_ROOT_WTOL * width0;
+        const double hsz = habs > 0.0 ? habs : fabs(h);
+        const double tol = LB_ROOT_RTOL * hsz + LB_ROOT_WTOL * width0;
         /* T at its rounding floor, and the root within 10 LB_ROOT_RTOL |h| of h */
-        if (T == 0.0 ||
-            (fabs(T) <= LB_ROOT_TNOISE && fabs(T) <= 10.0 * LB_ROOT_RTOL * fabs(h) * dT))
+        if (T == 0.0 || (fabs(T) <= LB_ROOT_TNOISE && fabs(T) <= 10.0 * LB_ROOT_RTOL * hsz * dT))
             return h;
         if (T < 0.0)
             lo = h;
@@ -109,6 +111,11 @@ static LB__ALWAYS_INLINE double lb__root_solve(lb__root_fn fn, const void *ctx, 
         h = next;
     }
     return h;
+}
+
+static LB__ALWAYS_INLINE double lb__root_solve(lb__root_fn fn, const void *ctx, double lo,
+                                               double hi, double start) {
+    return lb__root_solve_scaled(fn, ctx, lo, hi, start, 0.0);
 }
 
 #endif
