@@ -132,7 +132,7 @@ static double run_once(fam f, const workload *w) {
         case F_SOFT: {
             double y[8], r1[8];
             for (size_t i = 0; i < w->k; ++i) {
-                y[i] = 0.5 - 0.2 * x[i];
+                y[i] = 0.5 - 0.25 * tanh(x[i]); /* a soft field value in [0, 1] */
                 r1[i] = fmin(w->r[i], 1.0);
             }
             lb_soft_hyper(LB_UNION, w->k, y, r1, w->p, w->m, &v, g, NULL);

@@ -83,8 +83,14 @@ lb_status lb__check_range(const char *fn, const char *name, size_t n, const doub
 lb_status lb__check_r_m(const char *fn, const char *rname, const char *mname, size_t k,
                         const double *r, const double *m, double rmax, double mmin, double mmax,
                         lb_error *err) {
-    char what[64];
     const double rhi = rmax < LB_MAX_RANGE ? rmax : LB_MAX_RANGE;
+    int ok = r != NULL;
+    for (size_t i = 0; ok && i < k; ++i) {
+        ok &= r[i] >= LB_MIN_RANGE && r[i] <= rhi;
+        if (m) ok &= m[i] >= mmin && m[i] <= mmax;
+    }
+    if (ok) return LB_OK; /* the message is formatted only on failure: this runs per call */
+    char what[64];
     snprintf(what, sizeof what, "%g <= r <= %g", LB_MIN_RANGE, rhi);
     lb_status s = lb__check_range(fn, rname, k, r, LB_MIN_RANGE, 1, rhi, 1, what, err);
     if (s || !m) return s;
