@@ -2,13 +2,14 @@
  *
  * Union: the h with T(h) = sum_i [(r_i - x_i + m_i h)/r_i]+^p_i - 1 = 0.
  * T is continuous, increasing and (p_i >= 1) convex in h, with T = -1 at
- * lo = min_i (x_i - r_i)/m_i and T >= 0 at hi = min_i x_i/m_i. Three paths:
+ * lo = min_i (x_i - r_i)/m_i and T >= 0 at hi = min_i x_i/m_i. Paths:
+ *  - non-blending (no argument but the argmin within its range at hi):
+ *    min_i x_i/m_i exactly, no solve;
  *  - all p_i = 2: T is piecewise quadratic between the breakpoints
- *    b_i = (x_i - r_i)/m_i; walk the sorted breakpoints, then solve one
- *    quadratic in the shifted variable s = h - b_j (no cancellation: every
- *    term of its coefficients is non-negative);
- *  - integer p_i: safeguarded Newton from hi with t^(p-1) by products;
- *  - general p_i: the same with pow().
+ *    b_i = (x_i - r_i)/m_i; a closed form per active set (bt_two), with
+ *    cancellation-free quadratics in a shifted variable;
+ *  - integer p_i: the shared solver (Halley from hi) with powers by products;
+ *  - general p_i: the same with one pow() per active term and evaluation.
  * Gradient by the implicit function theorem, with w_i = (p_i/r_i) t_i^(p_i-1):
  * dh/dx_i = w_i / D, dh/dr_i = -w_i (x_i - m_i h)/(r_i D), dh/dm_i = -w_i h / D,
  * D = sum_j m_j w_j. */
