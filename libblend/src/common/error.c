@@ -112,14 +112,8 @@ lb_status lb__check_out(const char *fn, const void *value, lb_error *err) {
     return LB_OK;
 }
 
-int lb__exponent_mode(size_t k, const double *p) {
-    int all_two = 1, all_int = 1;
-    for (size_t i = 0; i < k; ++i) {
-        if (p[i] != 2.0) all_two = 0;
-        /* integer test without floor() (a libm call on baseline x86-64); p <= 1000 */
-        if (p[i] > 64.0 || (double)(long)p[i] != p[i]) all_int = 0;
-    }
-    return all_two ? LB__P_TWO : all_int ? LB__P_INTEGER : LB__P_GENERAL;
+lb_status lb__check_p(const char *fn, size_t k, const double *p, lb_error *err) {
+    return lb__check_range(fn, "p", k, p, 1.0, 0, LB_MAX_EXPONENT, 1, "1 < p <= 1000", err);
 }
 
 void lb__dual_args(lb_setop op, size_t k, const double *x, double *xt, double *sign) {

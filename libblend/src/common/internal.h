@@ -45,6 +45,8 @@ LB_INTERNAL lb_status lb__check_r_m(const char *fn, const char *rname, const cha
                                     double mmax, lb_error *err);
 LB_INTERNAL lb_status lb__check_setop(const char *fn, lb_setop op, lb_error *err);
 LB_INTERNAL lb_status lb__check_out(const char *fn, const void *value, lb_error *err);
+/* 1 < p_i <= LB_MAX_EXPONENT, with the message naming the range. */
+LB_INTERNAL lb_status lb__check_p(const char *fn, size_t k, const double *p, lb_error *err);
 /* r in [LB_MIN_RANGE, min(rmax, LB_MAX_RANGE)], 1 < p <= LB_MAX_EXPONENT,
  * m in [LB_MIN_SLOPE, LB_MAX_SLOPE] or NULL. */
 LB_INTERNAL lb_status lb__check_blend_params(const char *fn, size_t k, const double *r,
@@ -75,21 +77,23 @@ static inline int lb__fast_ok(size_t k, const double *x, const double *r, const 
 /* How the exponents of one operator call can be evaluated. */
 enum { LB__P_GENERAL = 0, LB__P_INTEGER = 1, LB__P_TWO = 2 };
 
-/* lb__fast_ok for blend parameters that also returns the exponent mode
- * (one pass): the mode, or -1 when a check fails. */
-static inline int lb__fast_mode(size_t k, const double *x, const double *r, const double *p,
-                                const double *m, double rmax) {
-    if (!x || !r || !p || k == 0 || k > LB_MAX_ARITY) return -1;
-    int ok = 1, two = 1, integer = 1;
+/* The exponent mode of p[0..k-1]: all 2, all integers <= 64, or general.
+ * The integer test avoids floor() (a libm call on baseline x86-64); p <= 1000. */
+static inline int lb__exponent_mode(size_t k, const double *p) {
+    int two = 1, integer = 1;
     for (size_t i = 0; i < k; ++i) {
-        ok &= fabs(x[i]) <= LB_MAX_ABS_ARG;
-        ok &= (r[i] >= LB_MIN_RANGE) & (r[i] <= rmax) & (r[i] <= LB_MAX_RANGE);
-        ok &= (p[i] > 1.0) & (p[i] <= LB_MAX_EXPONENT);
-        if (m) ok &= (m[i] >= LB_MIN_SLOPE) & (m[i] <= LB_MAX_SLOPE);
         two &= p[i] == 2.0;
         integer &= (p[i] <= 64.0) & ((double)(long)p[i] == p[i]);
     }
-    return !ok ? -1 : two ? LB__P_TWO : integer ? LB__P_INTEGER : LB__P_GENERAL;
+    return two ? LB__P_TWO : integer ? LB__P_INTEGER : LB__P_GENERAL;
+}
+
+/* lb__fast_ok for blend parameters (p required), returning the exponent
+ * mode, or -1 when a check fails. */
+static inline int lb__fast_mode(size_t k, const double *x, const double *r, const double *p,
+                                const double *m, double rmax) {
+    if (!p || !lb__fast_ok(k, x, r, p, m, rmax)) return -1;
+    return lb__exponent_mode(k, p);
 }
 
 /* |v| of a 3-vector without overflow or underflow of the squares. */
@@ -111,8 +115,6 @@ static inline double lb__ipow(double t, unsigned n) {
     }
     return r;
 }
-
-LB_INTERNAL int lb__exponent_mode(size_t k, const double *p);
 
 /* t^(p-1) for t >= 0, using products when mode says the exponents are integers. */
 static inline double lb__pow_m1(double t, double p, int mode) {

@@ -14,8 +14,7 @@ lb_status lb_bounded(lb_setop op, size_t k, const double *x, const double *c, co
     lb_status s;
     if ((s = lb__check_setop(fn, op, err)) || (s = lb__check_k(fn, k, 1, LB_MAX_ARITY, err)) ||
         (s = lb__check_out(fn, value, err)) || (s = lb__check_finite(fn, "x", k, x, err)) ||
-        (s = lb__check_finite(fn, "c", k, c, err)) ||
-        (s = lb__check_range(fn, "p", k, p, 1.0, 0, LB_MAX_EXPONENT, 1, "1 < p <= 1000", err)))
+        (s = lb__check_finite(fn, "c", k, c, err)) || (s = lb__check_p(fn, k, p, err)))
         return s;
     double R[LB_MAX_ARITY], dRdx[LB_MAX_ARITY], dRdc[LB_MAX_ARITY];
     double dv[LB_MAX_ARITY], dr[LB_MAX_ARITY];

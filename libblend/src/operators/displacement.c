@@ -217,7 +217,7 @@ lb_status lb__check_blend_params(const char *fn, size_t k, const double *r, cons
                                  const double *m, double rmax, lb_error *err) {
     lb_status s = lb__check_r_m(fn, "r", "m", k, r, m, rmax, LB_MIN_SLOPE, LB_MAX_SLOPE, err);
     if (s) return s;
-    return lb__check_range(fn, "p", k, p, 1.0, 0, LB_MAX_EXPONENT, 1, "1 < p <= 1000", err);
+    return lb__check_p(fn, k, p, err);
 }
 
 lb_status lb_displacement(lb_setop op, size_t k, const double *x, const double *r, const double *p,

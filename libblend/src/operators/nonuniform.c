@@ -216,8 +216,7 @@ static lb_status soft_dispatch(const char *fn, lb_setop op, size_t k, const doub
         if ((s = lb__check_conic(fn, x, r, conic_p, m, value, err))) return s;
     } else {
         if ((s = lb__check_k(fn, k, 1, LB_MAX_ARITY, err)) || (s = lb__check_out(fn, value, err)) ||
-            (s = lb__check_finite(fn, "x", k, x, err)) ||
-            (s = lb__check_range(fn, "p", k, p, 1.0, 0, LB_MAX_EXPONENT, 1, "1 < p <= 1000", err)))
+            (s = lb__check_finite(fn, "x", k, x, err)) || (s = lb__check_p(fn, k, p, err)))
             return s;
     }
     /* soft fields lie in [0, 1]; the result grows like x^(1/m), so m is kept
