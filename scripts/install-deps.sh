@@ -8,6 +8,7 @@ PACKAGES=(
   clang libclang-rt-14-dev   # libFuzzer and sanitizer runtimes for clang
   libcmocka-dev              # unit-test framework used by tests/
   libcjson-dev               # JSON parser for scene files
+  python3-jsonschema         # tests: scene files against docs/libblend-scene.schema.json
 )
 
 missing=()

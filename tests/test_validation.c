@@ -62,7 +62,7 @@ CALL(softm, const double m[2] = {0.5, -2};
 CALL(softconicr, const double r[2] = {0.5, 2};
      return lb_soft_conic(LB_UNION, X2, r, 0.0, M2, &out, NULL, err);)
 CALL(softconicp, return lb_soft_conic(LB_INTERSECTION, X2, R2, 1.0, M2, &out, NULL, err);)
-CALL(softx, const double x[2] = {0.5, 1.5};
+CALL(softx, const double x[2] = {0.5, -0.5};
      return lb_soft_hyper(LB_UNION, 2, x, R2, P2, M2, &out, NULL, err);)
 CALL(softmsmall, const double m[2] = {1, 1e-4};
      return lb_soft_hyper(LB_INTERSECTION, 2, X2, R2, P2, m, &out, NULL, err);)
@@ -142,8 +142,9 @@ static const row_t rows[] = {
     {"soft conic union r > 1", softconicr, LB_ERR_INVALID_ARGUMENT,
      "lb_soft_conic: r[1] = 2 is out of range; allowed: 1e-09 <= r <= 1"},
     {"soft conic p", softconicp, LB_ERR_INVALID_ARGUMENT, "lb_soft_conic: p = 1"},
-    {"soft x > 1", softx, LB_ERR_INVALID_ARGUMENT,
-     "lb_soft_hyper: x[1] = 1.5 is out of range; allowed: 0 <= x <= 1 (a soft field value)"},
+    {"soft x < 0", softx, LB_ERR_INVALID_ARGUMENT,
+     "lb_soft_hyper: x[1] = -0.5 is out of range; allowed: 0 <= x <= 1e6 (a soft field value; soft "
+     "unions may exceed 1)"},
     {"soft m too small", softmsmall, LB_ERR_INVALID_ARGUMENT,
      "m[1] = 0.0001 is out of range; allowed: 0.05 <= m <= 20"},
     {"r too small", rtiny, LB_ERR_INVALID_ARGUMENT,

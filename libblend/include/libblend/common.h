@@ -45,7 +45,7 @@ typedef enum lb_status {
     LB_ERR_INTERNAL = 4          /* a bug in libblend: please report it */
 } lb_status;
 
-#define LB_ERROR_MESSAGE_SIZE 256
+#define LB_ERROR_MESSAGE_SIZE 512
 
 /* Filled by functions that fail. Zero-initialise it or leave it untouched:
  * the library writes it only on failure. */

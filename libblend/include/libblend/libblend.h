@@ -5,5 +5,6 @@
 #include "common.h"
 #include "operators.h"
 #include "primitives.h"
+#include "scene.h"
 
 #endif

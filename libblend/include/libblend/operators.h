@@ -56,6 +56,9 @@ extern "C" {
 #define LB_MAX_SLOPE 1e6
 #define LB_SOFT_MIN_SLOPE 0.05
 #define LB_SOFT_MIN_FIELD 1e-300 /* soft values below this count as 0 */
+/* Largest soft argument accepted: soft fields start in [0, 1], but a soft
+ * union (B_Sk, soft_sum, Ricci) can exceed 1 and feed a subsequent blend. */
+#define LB_SOFT_MAX_FIELD 1e6
 #define LB_SOFT_MAX_SLOPE 20.0
 
 typedef enum lb_setop {

@@ -131,6 +131,10 @@ static inline double lb__conic_H(double r1, double r2, double p, double u1, doub
            2.0 * r1 * r1 * r2 * u2 + 2.0 * p * u1 * u2;
 }
 
+/* A primitive's field from rho in its convention: rho - 1 or a soft kernel
+ * (decreasing in rho). df may be NULL. */
+LB_INTERNAL double lb__kernel(lb_kernel kernel, double rho, double *df);
+
 /* ---- kernels (unchecked). Gradient outputs may be NULL. ---- */
 
 /* BT_k union (displacement). m must be non-NULL. dx, dr, dm: d/dx_i, d/dr_i, d/dm_i. */

@@ -221,7 +221,8 @@ static lb_status soft_dispatch(const char *fn, lb_setop op, size_t k, const doub
     }
     /* soft fields lie in [0, 1]; the result grows like x^(1/m), so m is kept
      * where that stays finite */
-    if ((s = lb__check_range(fn, "x", k, x, 0.0, 1, 1.0, 1, "0 <= x <= 1 (a soft field value)",
+    if ((s = lb__check_range(fn, "x", k, x, 0.0, 1, LB_SOFT_MAX_FIELD, 1,
+                             "0 <= x <= 1e6 (a soft field value; soft unions may exceed 1)",
                              err)) ||
         (s = lb__check_r_m(fn, "r", "m", k, r, m, rmax, LB_SOFT_MIN_SLOPE, LB_SOFT_MAX_SLOPE, err)))
         return s;

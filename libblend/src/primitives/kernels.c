@@ -13,31 +13,36 @@ lb_status lb_primitive_soften(lb_primitive *prim, lb_kernel kernel, lb_error *er
     return LB_OK;
 }
 
-double lb_primitive_eval(const lb_primitive *P, const double X[3], double grad[3]) {
-    double g[3];
-    const double rho = lb_primitive_rho(P, X, g);
-    double f, df;
-    switch (P->kernel) {
+double lb__kernel(lb_kernel kernel, double rho, double *df) {
+    double f, d;
+    switch (kernel) {
     case LB_KERNEL_WYVILL: {
         const double a = 0.5 * rho;
         if (a >= 1.0) {
-            f = df = 0.0;
+            f = d = 0.0;
         } else {
             const double a2 = a * a;
             f = 1.0 + a2 * (-22.0 / 9.0 + a2 * (17.0 / 9.0 - 4.0 / 9.0 * a2));
-            df = 0.5 * a * (-44.0 / 9.0 + a2 * (68.0 / 9.0 - 24.0 / 9.0 * a2));
+            d = 0.5 * a * (-44.0 / 9.0 + a2 * (68.0 / 9.0 - 24.0 / 9.0 * a2));
         }
         break;
     }
     case LB_KERNEL_BLINN:
         f = exp(-0.69314718055994530942 * rho * rho);
-        df = -2.0 * 0.69314718055994530942 * rho * f;
+        d = -2.0 * 0.69314718055994530942 * rho * f;
         break;
     default:
         f = rho - 1.0;
-        df = 1.0;
+        d = 1.0;
         break;
     }
+    if (df) *df = d;
+    return f;
+}
+
+double lb_primitive_eval(const lb_primitive *P, const double X[3], double grad[3]) {
+    double g[3], df;
+    const double f = lb__kernel(P->kernel, lb_primitive_rho(P, X, g), &df);
     if (grad)
         for (int i = 0; i < 3; ++i) grad[i] = df * g[i];
     return f;

@@ -1,5 +1,5 @@
 /* Ray-linear shapes rho(X) and their constructors [hsu-bounded 2.1]. */
-#include "../common/internal.h"
+#include "rho.h"
 
 #include <string.h>
 
@@ -134,112 +134,6 @@ lb_status lb_primitive_torus(lb_primitive *out, const double c[3], const double 
     return LB_OK;
 }
 
-/* rho = |v| / scale with gradient v / (|v| scale), 0 at v = 0. */
-static double norm_over(const double v[3], double scale, double *g) {
-    const double len = sqrt(dot3(v, v));
-    if (g)
-        for (int i = 0; i < 3; ++i) g[i] = len > 0.0 ? v[i] / (len * scale) : 0.0;
-    return len / scale;
-}
-
 double lb_primitive_rho(const lb_primitive *P, const double X[3], double g[3]) {
-    double d[3] = {X[0] - P->c[0], X[1] - P->c[1], X[2] - P->c[2]};
-    switch (P->kind) {
-    case LB_PRIM_ELLIPSOID: {
-        double u[3];
-        for (int i = 0; i < 3; ++i) u[i] = d[i] / P->a[i];
-        const double f = sqrt(dot3(u, u));
-        if (g)
-            for (int i = 0; i < 3; ++i) g[i] = f > 0.0 ? u[i] / (P->a[i] * f) : 0.0;
-        return f;
-    }
-    case LB_PRIM_LP: {
-        const double n = P->s0;
-        double u[3], mx = 0.0, s = 0.0;
-        for (int i = 0; i < 3; ++i) {
-            u[i] = fabs(d[i]) / P->a[i];
-            if (u[i] > mx) mx = u[i];
-        }
-        if (mx == 0.0) {
-            if (g) g[0] = g[1] = g[2] = 0.0;
-            return 0.0;
-        }
-        for (int i = 0; i < 3; ++i) s += pow(u[i] / mx, n);
-        const double f = mx * pow(s, 1.0 / n);
-        if (g)
-            for (int i = 0; i < 3; ++i)
-                g[i] = pow(u[i] / f, n - 1.0) * (d[i] < 0.0 ? -1.0 : 1.0) / P->a[i];
-        return f;
-    }
-    case LB_PRIM_SUPERQUADRIC: {
-        const double e1 = P->s0, e2 = P->s1, al = 2.0 / e2, be = 2.0 / e1;
-        double u[3];
-        for (int i = 0; i < 3; ++i) u[i] = fabs(d[i]) / P->a[i];
-        /* scale by the largest |u| so the powers cannot overflow: rho is ray-linear */
-        const double mx = fmax(u[0], fmax(u[1], u[2]));
-        if (mx == 0.0) {
-            if (g) g[0] = g[1] = g[2] = 0.0;
-            return 0.0;
-        }
-        for (int i = 0; i < 3; ++i) u[i] /= mx;
-        const double A = pow(u[0], al) + pow(u[1], al);
-        const double B = A > 0.0 ? pow(A, be / al) : 0.0;
-        const double S = B + pow(u[2], be);
-        const double f1 = pow(S, 1.0 / be); /* rho at the scaled point */
-        if (g) {
-            const double k = f1 / S;
-            const double Ab = A > 0.0 ? pow(A, be / al - 1.0) : 0.0;
-            for (int i = 0; i < 2; ++i)
-                g[i] = u[i] > 0.0
-                           ? k * Ab * pow(u[i], al - 1.0) * (d[i] < 0.0 ? -1.0 : 1.0) / P->a[i]
-                           : 0.0;
-            g[2] = u[2] > 0.0 ? k * pow(u[2], be - 1.0) * (d[2] < 0.0 ? -1.0 : 1.0) / P->a[2] : 0.0;
-        }
-        return mx * f1;
-    }
-    case LB_PRIM_SLAB:
-    case LB_PRIM_HALFSPACE: {
-        const double t = dot3(P->n, d);
-        const double sg = t < 0.0 ? (P->kind == LB_PRIM_SLAB ? -1.0 : 0.0) : 1.0;
-        if (g)
-            for (int i = 0; i < 3; ++i) g[i] = sg * P->n[i] / P->s0;
-        return sg * t / P->s0;
-    }
-    case LB_PRIM_CYLINDER: {
-        const double t = dot3(P->n, d);
-        double v[3];
-        for (int i = 0; i < 3; ++i) v[i] = d[i] - t * P->n[i];
-        return norm_over(v, P->s0, g);
-    }
-    case LB_PRIM_CAPSULE: {
-        double e[3], v[3];
-        for (int i = 0; i < 3; ++i) e[i] = P->q[i] - P->c[i];
-        const double ee = dot3(e, e);
-        double t = ee > 0.0 ? dot3(d, e) / ee : 0.0;
-        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-        for (int i = 0; i < 3; ++i) v[i] = d[i] - t * e[i];
-        return norm_over(v, P->s0, g);
-    }
-    case LB_PRIM_TORUS: {
-        const double t = dot3(P->n, d);
-        double rad[3], v[3];
-        for (int i = 0; i < 3; ++i) rad[i] = d[i] - t * P->n[i];
-        const double rl = sqrt(dot3(rad, rad));
-        /* nearest circle point: along the radial direction (any direction on the axis) */
-        for (int i = 0; i < 3; ++i) {
-            const double dir = rl > 0.0 ? rad[i] / rl : 0.0;
-            v[i] = rad[i] - P->s0 * dir + t * P->n[i];
-        }
-        if (!(rl > 0.0)) { /* on the axis: every circle point is equally near */
-            const double f = sqrt(P->s0 * P->s0 + t * t) / P->s1;
-            if (g)
-                for (int i = 0; i < 3; ++i)
-                    g[i] = f > 0.0 ? t * P->n[i] / (f * P->s1 * P->s1) : 0.0;
-            return f;
-        }
-        return norm_over(v, P->s1, g);
-    }
-    }
-    if (g) g[0] = g[1] = g[2] = 0.0;
-    return NAN;
+    return lb__rho(P->kind, P, X, g);
 }

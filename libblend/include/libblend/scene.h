@@ -1,0 +1,138 @@
+/* libblend — scenes: a blend tree read from a JSON scene file (format
+ * "libblend-scene", version 1; docs/scene-format.md), and the compiled
+ * evaluator that answers questions about its field.
+ *
+ * Layering (as in libfive): scene (the parsed, validated tree; a DAG when
+ * "defs" are shared) -> evaluator (compiled once into a flat instruction
+ * tape) -> one entry point per question: values and gradients of point
+ * batches, and interval bounds over boxes. Meshers and exporters build on
+ * those two.
+ *
+ * Contracts shared by every function here:
+ * - Handles are opaque; each has one free function, which accepts NULL.
+ * - A scene or evaluator is immutable once built: any number of threads may
+ *   evaluate the same evaluator at once. No global state, no callbacks.
+ * - Buffers are owned by the caller. Failures return a status and fill `err`
+ *   (may be NULL) with one message naming the file, line:column where known,
+ *   the JSON path (like $.root.args[1].r) and what is allowed.
+ */
+#ifndef LIBBLEND_SCENE_H
+#define LIBBLEND_SCENE_H
+
+#include "common.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Limits a scene must respect; larger input is rejected with a message. */
+#define LB_SCENE_MAX_BYTES (64u * 1024u * 1024u) /* scene file size */
+#define LB_SCENE_MAX_DEPTH 64                    /* nesting of nodes below the root */
+#define LB_SCENE_MAX_NODES 100000                /* nodes in one scene, refs included */
+#define LB_SCENE_MAX_LIGHTS 16
+/* Largest |coordinate| anywhere in a scene (centres, translations, bounds)
+ * and of evaluation points. */
+#define LB_SCENE_MAX_COORD 1e9
+
+typedef struct lb_scene lb_scene;
+
+typedef enum lb_convention {
+    LB_CONVENTION_ZERO = 0, /* inside f < 0, surface f = 0 */
+    LB_CONVENTION_SOFT = 1  /* inside f > 0.5, surface f = 0.5, f in [0, 1] */
+} lb_convention;
+
+/* The optional "render" section, with defaults filled in (docs/scene-format.md). */
+typedef struct lb_render_light {
+    double location[3];
+    double color[3];
+} lb_render_light;
+
+typedef struct lb_render {
+    int has_camera;     /* 0: exporters frame the bounds themselves */
+    double location[3]; /* camera position */
+    double look_at[3];  /* camera target */
+    double angle;       /* horizontal field of view in degrees, (0, 180) */
+    size_t light_count; /* 0: exporters use their default lights */
+    lb_render_light lights[LB_SCENE_MAX_LIGHTS];
+    double color[3];                   /* material colour, each in [0, 1] */
+    double ambient, diffuse, specular; /* material finish, each in [0, 1] */
+} lb_render;
+
+typedef struct lb_scene_stats {
+    size_t nodes;      /* distinct nodes (a shared def counts once) */
+    size_t primitives; /* distinct primitive nodes */
+    size_t operators;  /* distinct blend / set-operator nodes */
+    size_t depth;      /* longest root-to-leaf path, in nodes */
+} lb_scene_stats;
+
+/* Parse and validate a scene held in memory. `text` need not be
+ * NUL-terminated; `name` (may be NULL) is the file name used in messages.
+ * On success *out owns a new scene (free with lb_scene_free). */
+LB_API lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_scene **out,
+                                lb_error *err);
+
+/* Read, parse and validate a scene file. Missing, unreadable or too large
+ * files fail with a message naming the path. */
+LB_API lb_status lb_scene_load(const char *path, lb_scene **out, lb_error *err);
+
+/* Release a scene. Evaluators built from it keep what they need. */
+LB_API void lb_scene_free(lb_scene *scene);
+
+LB_API lb_convention lb_scene_convention(const lb_scene *scene);
+
+/* The declared bounds: returns 1 and fills min/max when the scene has
+ * "bounds", else returns 0 and leaves them untouched. */
+LB_API int lb_scene_bounds(const lb_scene *scene, double min[3], double max[3]);
+
+/* The render section, defaults filled in. Never NULL for a valid scene. */
+LB_API const lb_render *lb_scene_render(const lb_scene *scene);
+
+LB_API void lb_scene_stats_get(const lb_scene *scene, lb_scene_stats *stats);
+
+/* Write the tree as indented text (one node per line, shared defs printed
+ * once and referenced by name afterwards) into buf, NUL-terminated and
+ * truncated to size. Returns the length the whole text needs (without the
+ * NUL), like snprintf. buf may be NULL when size is 0. */
+LB_API size_t lb_scene_describe(const lb_scene *scene, char *buf, size_t size);
+
+/* Reference evaluator: a plain recursive walk over the scene tree, one
+ * point, calling the public per-family functions. Slow on purpose; tests and
+ * benchmarks compare the compiled evaluator against it. grad may be NULL. */
+LB_API lb_status lb_scene_eval_reference(const lb_scene *scene, const double X[3], double *value,
+                                         double grad[3], lb_error *err);
+
+/* ---- compiled evaluator ---------------------------------------------------- */
+
+typedef struct lb_evaluator lb_evaluator;
+
+/* Compile a scene into a flat instruction tape: every distinct node (a
+ * shared def under the same transform) becomes one instruction, transforms
+ * are folded into the primitives, parameters are validated and preprocessed
+ * once. The evaluator does not depend on the scene afterwards. */
+LB_API lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_error *err);
+LB_API void lb_evaluator_free(lb_evaluator *ev);
+
+/* Number of instructions on the tape. */
+LB_API size_t lb_evaluator_size(const lb_evaluator *ev);
+
+/* Values and gradients at n points given as three coordinate arrays
+ * (structure of arrays). value must be non-NULL; gx, gy, gz may each be NULL.
+ * threads: 0 = one per online CPU, 1 = only the calling thread, N = at most
+ * N threads (the batch is split into chunks; small batches use fewer).
+ * Every |coordinate| must be <= LB_SCENE_MAX_COORD. On failure the outputs
+ * are unspecified. */
+LB_API lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const double *x,
+                                   const double *y, const double *z, double *value, double *gx,
+                                   double *gy, double *gz, int threads, lb_error *err);
+
+/* An interval [*lo, *hi] guaranteed to contain the field at every point of
+ * the box [bmin, bmax] (docs/design.md, "Interval bounds"). bmin <= bmax
+ * componentwise; a degenerate box is a point. */
+LB_API lb_status lb_evaluator_bounds(const lb_evaluator *ev, const double bmin[3],
+                                     const double bmax[3], double *lo, double *hi, lb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,303 @@
+/* Scene DAG -> instruction tape (see tape.h). */
+#include "tape.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct memo_entry {
+    const lb__node *node;
+    lb__affine A;
+    uint32_t idx;
+    int used;
+} memo_entry;
+
+typedef struct cctx {
+    lb_evaluator *ev;
+    size_t cap;
+    memo_entry *memo;
+    size_t mcap, mcount;
+    lb_convention conv;
+    lb_error *err;
+} cctx;
+
+static uint64_t memo_hash(const lb__node *n, const lb__affine *A) {
+    uint64_t h = (uint64_t)(uintptr_t)n * 0x9E3779B97F4A7C15ull;
+    const unsigned char *b = (const unsigned char *)A;
+    for (size_t i = 0; i < sizeof *A; ++i) h = (h ^ b[i]) * 0x100000001B3ull;
+    return h;
+}
+
+static memo_entry *memo_find(cctx *c, const lb__node *n, const lb__affine *A) {
+    size_t i = (size_t)memo_hash(n, A) & (c->mcap - 1);
+    while (c->memo[i].used) {
+        if (c->memo[i].node == n && memcmp(&c->memo[i].A, A, sizeof *A) == 0) return &c->memo[i];
+        i = (i + 1) & (c->mcap - 1);
+    }
+    return &c->memo[i];
+}
+
+static lb_status memo_grow(cctx *c) {
+    if (2 * (c->mcount + 1) <= c->mcap) return LB_OK;
+    const size_t ncap = c->mcap ? 2 * c->mcap : 256;
+    memo_entry *old = c->memo;
+    const size_t ocap = c->mcap;
+    c->memo = calloc(ncap, sizeof *c->memo);
+    if (!c->memo) {
+        c->memo = old;
+        return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+    }
+    c->mcap = ncap;
+    for (size_t i = 0; i < ocap; ++i)
+        if (old[i].used) *memo_find(c, old[i].node, &old[i].A) = old[i];
+    free(old);
+    return LB_OK;
+}
+
+static lb_status push(cctx *c, lb__instr **out) {
+    lb_evaluator *ev = c->ev;
+    if (ev->n >= LB__MAX_INSTRUCTIONS)
+        return lb__fail(c->err, LB_ERR_NO_MEMORY,
+                        "lb_evaluator_create: the scene expands to more than %u instructions "
+                        "(shared defs under many different transforms); allowed: fewer "
+                        "distinct transformed copies",
+                        LB__MAX_INSTRUCTIONS);
+    if (ev->n == c->cap) {
+        const size_t ncap = c->cap ? 2 * c->cap : 64;
+        lb__instr *ni = realloc(ev->ins, ncap * sizeof *ni);
+        if (!ni) return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+        ev->ins = ni;
+        c->cap = ncap;
+    }
+    *out = &ev->ins[ev->n++];
+    memset(*out, 0, sizeof **out);
+    return LB_OK;
+}
+
+static double *dup_array(const double *v, size_t k, int *fail) {
+    if (!v) return NULL;
+    double *o = malloc(k * sizeof *o);
+    if (!o) {
+        *fail = 1;
+        return NULL;
+    }
+    memcpy(o, v, k * sizeof *o);
+    return o;
+}
+
+/* Lipschitz factor of rho in its own frame, for the cylinder / capsule /
+ * torus interval bounds (eval_bounds.c). */
+static double rho_lipschitz(const lb_primitive *P) {
+    switch (P->kind) {
+    case LB_PRIM_CYLINDER:
+    case LB_PRIM_CAPSULE:
+        return 1.0 / P->s0;
+    case LB_PRIM_TORUS:
+        return 1.0 / P->s1;
+    default:
+        return 0.0; /* other kinds have exact interval formulas */
+    }
+}
+
+static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, uint32_t *out) {
+    lb__affine A = *Ap;
+    if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
+    if (n->family == LB__F_GROUP) return compile_node(c, n->args[0], &A, out);
+    lb_status s;
+    if ((s = memo_grow(c))) return s;
+    memo_entry *e = memo_find(c, n, &A);
+    if (e->used) {
+        *out = e->idx;
+        return LB_OK;
+    }
+    uint32_t *src = NULL, *srci = NULL, *srcb = NULL;
+    if (n->family != LB__F_PRIMITIVE) {
+        const size_t ns = n->k * (n->bounds ? 2 : 1);
+        src = malloc(ns * sizeof *src);
+        srci = malloc(n->k * sizeof *srci);
+        srcb = n->bounds ? malloc(n->k * sizeof *srcb) : NULL;
+        if (!src || !srci || (n->bounds && !srcb)) {
+            free(src);
+            free(srci);
+            free(srcb);
+            return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+        }
+        for (size_t i = 0; i < n->k && !s; ++i) {
+            s = compile_node(c, n->args[i], &A, &srci[i]);
+            src[i] = srci[i];
+            if (!s && n->bounds) {
+                s = compile_node(c, n->bounds[i], &A, &srcb[i]);
+                src[n->k + i] = srcb[i];
+            }
+        }
+        if (s) {
+            free(src);
+            free(srci);
+            free(srcb);
+            return s;
+        }
+    }
+    lb__instr *in = NULL;
+    if ((s = push(c, &in))) {
+        free(src);
+        free(srci);
+        free(srcb);
+        return s;
+    }
+    const uint32_t idx = (uint32_t)(c->ev->n - 1);
+    if (n->family == LB__F_PRIMITIVE) {
+        in->prim = n->prim;
+        in->A = A;
+        in->lip = rho_lipschitz(&n->prim);
+        static const double id[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        const int linear_id = memcmp(A.M, id, sizeof id) == 0;
+        in->identity = linear_id && A.t[0] == 0.0 && A.t[1] == 0.0 && A.t[2] == 0.0;
+        in->code = LB__I_PRIM;
+        if (linear_id && n->prim.kind == LB_PRIM_ELLIPSOID && n->prim.kernel == LB_KERNEL_NONE) {
+            /* local = X + t, so rho(local - c) = rho(X - (c - t)) */
+            for (int i = 0; i < 3; ++i) in->prim.c[i] -= A.t[i];
+            lb__affine_identity(&in->A);
+            in->identity = 1;
+            in->code = LB__I_ELLIPSOID;
+        }
+    } else {
+        int fail = 0;
+        in->code = LB__I_OP;
+        in->op = *n;
+        in->op.args = in->op.bounds = NULL;
+        in->op.r = dup_array(n->r, n->k, &fail);
+        in->op.p = dup_array(n->p, n->k, &fail);
+        in->op.m = dup_array(n->m, n->k, &fail);
+        in->op.def_name = NULL;
+        in->op.path = malloc(strlen(n->path) + 1);
+        if (in->op.path)
+            strcpy(in->op.path, n->path);
+        else
+            fail = 1;
+        in->src = src;
+        in->srci = srci;
+        in->srcb = srcb;
+        if (fail) return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+        if (!n->bulge && n->family == LB__F_DISPLACEMENT) {
+            in->fast = LB__FAST_DISPLACEMENT;
+            in->mode = lb__exponent_mode(n->k, n->p);
+        } else if (!n->bulge && n->family == LB__F_CONIC) {
+            in->fast = LB__FAST_CONIC;
+        } else if (!n->bulge && n->family == LB__F_SCALE) {
+            in->fast = LB__FAST_SCALE;
+            in->mode = lb__exponent_mode(n->k, n->p);
+        } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
+            in->fast = LB__FAST_MINMAX;
+        }
+        if (n->k >= 2 && (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC ||
+                          in->fast == LB__FAST_MINMAX))
+            c->ev->cullable = 1;
+    }
+    e = memo_find(c, n, &A); /* the table may have grown during recursion */
+    e->node = n;
+    e->A = A;
+    e->idx = idx;
+    e->used = 1;
+    c->mcount++;
+    *out = idx;
+    return LB_OK;
+}
+
+/* Registers by last use: an instruction's output register is released after
+ * its last reader; a reader never writes into one of its own sources. */
+static lb_status allocate_registers(lb_evaluator *ev, uint32_t root, lb_error *err) {
+    const size_t n = ev->n;
+    uint32_t *last = malloc(n * sizeof *last);
+    uint32_t *freelist = malloc(n * sizeof *freelist);
+    if (!last || !freelist) {
+        free(last);
+        free(freelist);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+    }
+    for (size_t i = 0; i < n; ++i) last[i] = (uint32_t)i;
+    last[root] = UINT32_MAX; /* the result lives to the end */
+    for (size_t i = 0; i < n; ++i) {
+        const lb__instr *in = &ev->ins[i];
+        if (in->code != LB__I_OP) continue;
+        const size_t ns = in->op.k * (in->op.bounds || in->op.family == LB__F_BOUNDED ? 2 : 1);
+        for (size_t j = 0; j < ns; ++j)
+            if (last[in->src[j]] != UINT32_MAX) last[in->src[j]] = (uint32_t)i;
+    }
+    size_t nfree = 0, nregs = 0;
+    uint32_t *reg_of = malloc(n * sizeof *reg_of);
+    if (!reg_of) {
+        free(last);
+        free(freelist);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+    }
+    for (size_t i = 0; i < n; ++i) {
+        lb__instr *in = &ev->ins[i];
+        reg_of[i] = nfree ? freelist[--nfree] : (uint32_t)nregs++;
+        in->dst = reg_of[i];
+        in->aoff = ev->total_k;
+        if (in->code == LB__I_OP) ev->total_k += in->op.k;
+        if (in->code == LB__I_OP) {
+            const size_t ns = in->op.k * (in->op.family == LB__F_BOUNDED ? 2 : 1);
+            for (size_t j = 0; j < ns; ++j) {
+                const uint32_t a = in->src[j];
+                int dup = 0; /* an argument used twice is released once */
+                for (size_t q = 0; q < j; ++q) dup |= in->src[q] == a;
+                if (!dup && last[a] == i) freelist[nfree++] = reg_of[a];
+                in->src[j] = reg_of[a];
+            }
+        }
+    }
+    ev->nregs = nregs;
+    ev->out = reg_of[root];
+    free(last);
+    free(freelist);
+    free(reg_of);
+    return LB_OK;
+}
+
+void lb_evaluator_free(lb_evaluator *ev) {
+    if (!ev) return;
+    for (size_t i = 0; i < ev->n; ++i) {
+        lb__instr *in = &ev->ins[i];
+        if (in->code != LB__I_OP) continue;
+        free(in->src);
+        free(in->srci);
+        free(in->srcb);
+        free(in->op.r);
+        free(in->op.p);
+        free(in->op.m);
+        free(in->op.path);
+    }
+    free(ev->ins);
+    free(ev);
+}
+
+size_t lb_evaluator_size(const lb_evaluator *ev) {
+    return ev ? ev->n : 0;
+}
+
+lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_error *err) {
+    if (!out) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "lb_evaluator_create: out is NULL");
+    *out = NULL;
+    if (!scene || !scene->root)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "lb_evaluator_create: scene is NULL");
+    lb_evaluator *ev = calloc(1, sizeof *ev);
+    if (!ev) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+    ev->conv = scene->convention;
+    cctx c;
+    memset(&c, 0, sizeof c);
+    c.ev = ev;
+    c.conv = scene->convention;
+    c.err = err;
+    lb__affine id;
+    lb__affine_identity(&id);
+    uint32_t root = 0;
+    lb_status s = compile_node(&c, scene->root, &id, &root);
+    free(c.memo);
+    if (!s) s = allocate_registers(ev, root, err);
+    if (s) {
+        lb_evaluator_free(ev);
+        return s;
+    }
+    *out = ev;
+    return LB_OK;
+}

@@ -1,0 +1,332 @@
+/* Interval bounds over an axis-aligned box on the compiled tape.
+ *
+ * The scheme (docs/design.md, "Interval bounds"):
+ * - Primitives: the world box is mapped into the primitive's frame (centre
+ *   and radius through |M|, an exact enclosure of the affine image). In that
+ *   frame ellipsoid, LP and superquadric rho grow with each |x_i - c_i|, so
+ *   the nearest and farthest corners give exact bounds; slab and half-space
+ *   are linear in X (exact); cylinder, capsule and torus use their Lipschitz
+ *   constant around the box centre. The kernel maps rho monotonically.
+ * - Operators without bulge elimination are monotone in each argument
+ *   (increasing; a difference decreases in its subtracted arguments), so the
+ *   operator evaluated at the two extreme corners bounds it.
+ * - Bulge elimination and bounded blends make ranges (and slopes) position
+ *   functions; their bounds come from the root brackets of spec sections 4-6
+ *   with the ranges at their extremes.
+ * Every operator bound is widened by 1e-9 (1 + |v|) for the solvers'
+ * tolerance, and clamped to [-1e100, 1e100] (the core's argument range). */
+#include "tape.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef lb__iv iv;
+
+#define BIG LB_MAX_ABS_ARG
+
+static double clampd(double v) {
+    return v < -BIG ? -BIG : v > BIG ? BIG : v;
+}
+
+static void prim_bounds(const lb__instr *in, const double bc[3], const double br[3], iv *out) {
+    const lb_primitive *P = &in->prim;
+    double lc[3], lr[3];
+    lb__affine_apply(&in->A, bc, lc);
+    for (int i = 0; i < 3; ++i)
+        lr[i] = fabs(in->A.M[3 * i]) * br[0] + fabs(in->A.M[3 * i + 1]) * br[1] +
+                fabs(in->A.M[3 * i + 2]) * br[2];
+    double lo = 0.0, hi = 0.0;
+    switch (P->kind) {
+    case LB_PRIM_ELLIPSOID:
+    case LB_PRIM_LP:
+    case LB_PRIM_SUPERQUADRIC: {
+        double pn[3], pf[3];
+        for (int i = 0; i < 3; ++i) {
+            const double d = fabs(lc[i] - P->c[i]);
+            pn[i] = P->c[i] + (d > lr[i] ? d - lr[i] : 0.0);
+            pf[i] = P->c[i] + d + lr[i];
+        }
+        lo = lb_primitive_rho(P, pn, NULL);
+        hi = lb_primitive_rho(P, pf, NULL);
+        /* rounding in rho: keep the corner values conservative */
+        lo *= 1.0 - 1e-12;
+        hi *= 1.0 + 1e-12;
+        break;
+    }
+    case LB_PRIM_SLAB:
+    case LB_PRIM_HALFSPACE: {
+        const double sm =
+            P->n[0] * (lc[0] - P->c[0]) + P->n[1] * (lc[1] - P->c[1]) + P->n[2] * (lc[2] - P->c[2]);
+        const double sr = (fabs(P->n[0]) * lr[0] + fabs(P->n[1]) * lr[1] + fabs(P->n[2]) * lr[2]) *
+                              (1.0 + 1e-12) +
+                          1e-15 * fabs(sm);
+        if (P->kind == LB_PRIM_SLAB) {
+            lo = fabs(sm) > sr ? fabs(sm) - sr : 0.0;
+            hi = fabs(sm) + sr;
+        } else {
+            lo = sm - sr > 0.0 ? sm - sr : 0.0;
+            hi = sm + sr > 0.0 ? sm + sr : 0.0;
+        }
+        lo /= P->s0;
+        hi /= P->s0;
+        break;
+    }
+    default: {
+        const double rc = lb_primitive_rho(P, lc, NULL);
+        const double rad = sqrt(lr[0] * lr[0] + lr[1] * lr[1] + lr[2] * lr[2]) * in->lip;
+        const double slack = 1e-12 * (rc + rad);
+        lo = rc - rad - slack > 0.0 ? rc - rad - slack : 0.0;
+        hi = rc + rad + slack;
+        break;
+    }
+    }
+    /* the kernel is increasing (zero) or decreasing (soft) in rho */
+    if (P->kernel == LB_KERNEL_NONE) {
+        out->lo = lo - 1.0;
+        out->hi = hi - 1.0;
+    } else {
+        out->lo = lb__kernel(P->kernel, hi, NULL);
+        out->hi = lb__kernel(P->kernel, lo, NULL);
+    }
+}
+
+/* dual (union-form) argument interval: intersection -x, difference -x_0 */
+static iv dual_iv(lb_setop op, size_t i, iv x) {
+    const int neg = op == LB_INTERSECTION || (op == LB_DIFFERENCE && i == 0);
+    if (!neg) return x;
+    iv o = {-x.hi, -x.lo};
+    return o;
+}
+
+static void bulge_bounds(const lb__node *n, const iv *x, iv *out) {
+    const lb_bulge_params *bp = &n->bp;
+    const int range = (bp->flags & LB_BULGE_RANGE) != 0, slope = (bp->flags & LB_BULGE_SLOPE) != 0;
+    double L = INFINITY, H = INFINITY;
+    int unknown_lo = 0;
+    for (size_t i = 0; i < 2; ++i) {
+        const iv u = dual_iv(n->op, i, x[i]);
+        const double rhi = range ? bp->r[i] * (2.0 + bp->omega) : bp->r[i];
+        if (n->family == LB__F_SCALE) {
+            const double ylo = u.lo + 1.0;
+            if (ylo > 0.0) {
+                const double t = ylo / (1.0 + rhi) - 1.0;
+                if (t < L) L = t;
+            } else {
+                unknown_lo = 1;
+            }
+            if (u.hi < H) H = u.hi;
+        } else {
+            const double m = bp->m[i];
+            const double num = u.lo - rhi;
+            const double gl = num < 0.0 ? num / m : (slope ? 0.0 : num / m);
+            const double gh = u.hi >= 0.0 ? u.hi / m : (slope ? 0.0 : u.hi / m);
+            if (gl < L) L = gl;
+            if (gh < H) H = gh;
+        }
+    }
+    if (unknown_lo) L = -BIG;
+    if (n->op == LB_UNION) {
+        out->lo = L;
+        out->hi = H;
+    } else {
+        out->lo = -H;
+        out->hi = -L;
+    }
+}
+
+static void bounded_bounds(const lb__node *n, const iv *x, const iv *c, iv *out) {
+    const size_t k = n->k;
+    const double om = LB_BOUNDED_OMEGA;
+    if (n->op == LB_UNION) {
+        double L = INFINITY, H = INFINITY;
+        int unknown = 0;
+        for (size_t i = 0; i < k; ++i) {
+            const double ylo = x[i].lo + 1.0, yclo = c[i].lo + 1.0;
+            if (x[i].hi < H) H = x[i].hi;
+            if (!(ylo > 0.0)) {
+                unknown = 1;
+                continue;
+            }
+            double t = ylo / (1.0 + om);
+            const double tc = yclo > 0.0 ? yclo : 0.0;
+            if (tc < t) t = tc;
+            if (t - 1.0 < L) L = t - 1.0;
+        }
+        out->lo = unknown ? -BIG : L;
+        out->hi = H;
+        return;
+    }
+    double pmin = n->p[0];
+    for (size_t i = 1; i < k; ++i)
+        if (n->p[i] < pmin) pmin = n->p[i];
+    const double grow = pow((double)k, 1.0 / pmin);
+    double L = -INFINITY, Y = -INFINITY;
+    for (size_t i = 0; i < k; ++i) {
+        iv a = x[i];
+        if (n->op == LB_DIFFERENCE && i > 0) {
+            a.lo = -x[i].hi;
+            a.hi = -x[i].lo;
+        }
+        if (a.lo > L) L = a.lo;
+        if (a.hi + 1.0 > Y) Y = a.hi + 1.0;
+    }
+    out->lo = L;
+    out->hi = (Y > 0.0 ? grow * Y : 0.0) - 1.0;
+}
+
+static int is_difference_family(lb__family f) {
+    return f == LB__F_DISPLACEMENT || f == LB__F_CONIC || f == LB__F_SCALE ||
+           f == LB__F_SOFT_HYPER || f == LB__F_SOFT_CONIC || f == LB__F_PERLIN;
+}
+
+static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const iv *c, iv *out) {
+    const size_t k = n->k;
+    if (n->bulge) {
+        bulge_bounds(n, x, out);
+    } else if (n->family == LB__F_BOUNDED) {
+        bounded_bounds(n, x, c, out);
+    } else if (n->family == LB__F_COMPLEMENT) {
+        if (conv == LB_CONVENTION_ZERO) {
+            out->lo = -x[0].hi;
+            out->hi = -x[0].lo;
+        } else { /* max(0, 1 - f) */
+            out->lo = 1.0 - x[0].hi > 0.0 ? 1.0 - x[0].hi : 0.0;
+            out->hi = 1.0 - x[0].lo > 0.0 ? 1.0 - x[0].lo : 0.0;
+        }
+        return; /* exact */
+    } else {
+        double xl[LB_MAX_ARITY], xh[LB_MAX_ARITY], v1 = 0.0, v2 = 0.0;
+        for (size_t i = 0; i < k; ++i) {
+            const int dec = n->op == LB_DIFFERENCE && i > 0 && is_difference_family(n->family);
+            xl[i] = dec ? x[i].hi : x[i].lo;
+            xh[i] = dec ? x[i].lo : x[i].hi;
+        }
+        if (lb__node_apply(n, conv, xl, NULL, NULL, &v1, NULL, NULL, NULL, NULL) ||
+            lb__node_apply(n, conv, xh, NULL, NULL, &v2, NULL, NULL, NULL, NULL)) {
+            out->lo = -BIG; /* outside what the operator accepts: no information */
+            out->hi = BIG;
+            return;
+        }
+        out->lo = v1 < v2 ? v1 : v2;
+        out->hi = v1 < v2 ? v2 : v1;
+    }
+    out->lo -= 1e-9 * (1.0 + fabs(out->lo));
+    out->hi += 1e-9 * (1.0 + fabs(out->hi));
+    if (conv == LB_CONVENTION_SOFT && out->lo < 0.0) out->lo = 0.0; /* soft fields are >= 0 */
+}
+
+/* Argument culling for one operator over a box (the plan's act list):
+ * - displacement and conic (no bulge), in union form u (duals negate): the
+ *   root h <= H = min_i hi(u_i)/m_i, so argument j's term
+ *   [(r_j - u_j + m_j h)/r_j]+ is 0 on the whole box when
+ *   lo(u_j) - m_j H >= r_j; dropping it leaves T, its root and the gradient
+ *   unchanged (the conic is then outside region II: min(u_i/m_i));
+ * - min / max: an argument whose interval lies above the smallest upper
+ *   bound (below the largest lower bound) is never selected.
+ * The argument attaining H (or the extreme bound) always stays. */
+static uint16_t cull(const lb__node *n, const iv *x, uint16_t *act) {
+    const size_t k = n->k;
+    uint16_t na = 0;
+    if (!n->bulge && (n->family == LB__F_DISPLACEMENT || n->family == LB__F_CONIC)) {
+        double H = INFINITY;
+        for (size_t i = 0; i < k; ++i) {
+            const iv u = dual_iv(n->op, i, x[i]);
+            const double t = u.hi / n->m[i];
+            if (t < H) H = t;
+        }
+        for (size_t i = 0; i < k; ++i) {
+            const iv u = dual_iv(n->op, i, x[i]);
+            /* a relative margin keeps rounding in the kernel on the safe side */
+            const double reach = u.lo - n->m[i] * H;
+            if (!(reach >= n->r[i] * (1.0 + 1e-9) + 1e-12 * fabs(u.lo))) act[na++] = (uint16_t)i;
+        }
+        return na;
+    }
+    if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
+        const int mn = n->family == LB__F_MIN;
+        double ext = mn ? INFINITY : -INFINITY;
+        for (size_t i = 0; i < k; ++i) {
+            if (mn && x[i].hi < ext) ext = x[i].hi;
+            if (!mn && x[i].lo > ext) ext = x[i].lo;
+        }
+        for (size_t i = 0; i < k; ++i)
+            if (mn ? !(x[i].lo > ext) : !(x[i].hi < ext)) act[na++] = (uint16_t)i;
+        return na;
+    }
+    for (size_t i = 0; i < k; ++i) act[na++] = (uint16_t)i;
+    return na;
+}
+
+void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br[3], iv *R,
+                     lb__plan *plan) {
+    iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
+    for (size_t i = 0; i < ev->n; ++i) {
+        const lb__instr *in = &ev->ins[i];
+        iv o;
+        if (in->code != LB__I_OP) {
+            prim_bounds(in, bc, br, &o);
+        } else {
+            const size_t k = in->op.k;
+            for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
+            if (in->op.family == LB__F_BOUNDED)
+                for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
+            op_bounds(ev->conv, &in->op, x, c, &o);
+            if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
+        }
+        o.lo = clampd(o.lo);
+        o.hi = clampd(o.hi);
+        R[in->dst] = o;
+    }
+    if (!plan) return;
+    /* what the root needs, backwards */
+    memset(plan->need, 0, ev->n);
+    plan->need[ev->n - 1] = 1;
+    for (size_t i = ev->n; i-- > 0;) {
+        const lb__instr *in = &ev->ins[i];
+        if (!plan->need[i] || in->code != LB__I_OP) continue;
+        const uint16_t *act = plan->act + in->aoff;
+        for (uint16_t a = 0; a < plan->nact[i]; ++a) {
+            plan->need[in->srci[act[a]]] = 1;
+            if (in->op.family == LB__F_BOUNDED) plan->need[in->srcb[act[a]]] = 1;
+        }
+        if (in->op.bulge) /* the Hessian terms re-run both arguments' prefixes */
+            for (size_t a = 0; a < in->op.k; ++a) plan->need[in->srci[a]] = 1;
+    }
+}
+
+lb_status lb_evaluator_bounds(const lb_evaluator *ev, const double bmin[3], const double bmax[3],
+                              double *lo, double *hi, lb_error *err) {
+    static const char fn[] = "lb_evaluator_bounds";
+    if (!ev || !bmin || !bmax || !lo || !hi)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: every pointer must be non-NULL", fn);
+    double bc[3], br[3];
+    for (int d = 0; d < 3; ++d) {
+        if (!(fabs(bmin[d]) <= LB_SCENE_MAX_COORD) || !(fabs(bmax[d]) <= LB_SCENE_MAX_COORD))
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: box %c range [%g, %g]; allowed: finite, |coordinate| <= %g", fn,
+                            "xyz"[d], bmin[d], bmax[d], LB_SCENE_MAX_COORD);
+        if (!(bmin[d] <= bmax[d]))
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: box min %c = %g is above max %c = %g; allowed: min <= max", fn,
+                            "xyz"[d], bmin[d], "xyz"[d], bmax[d]);
+    }
+    lb__box_centre(bmin, bmax, bc, br);
+    iv *R = malloc(ev->nregs * sizeof *R);
+    if (!R) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", fn);
+    lb__bounds_pass(ev, bc, br, R, NULL);
+    *lo = R[ev->out].lo;
+    *hi = R[ev->out].hi;
+    free(R);
+    return LB_OK;
+}
+
+void lb__box_centre(const double bmin[3], const double bmax[3], double bc[3], double br[3]) {
+    for (int d = 0; d < 3; ++d) {
+        bc[d] = 0.5 * (bmin[d] + bmax[d]);
+        br[d] = 0.5 * (bmax[d] - bmin[d]);
+        /* the centre is rounded: cover both ends exactly */
+        const double a = fabs(bc[d] - bmin[d]), b = fabs(bmax[d] - bc[d]);
+        const double e = (a > b ? a : b) * (1.0 + 1e-15);
+        if (e > br[d]) br[d] = e;
+    }
+}

@@ -1,0 +1,530 @@
+/* Values and gradients of point batches on the compiled tape (tape.h).
+ * Each chunk of LB__CHUNK points runs the whole tape; threads take blocks of
+ * chunks from a shared counter, so the result never depends on the thread
+ * count. */
+#include "tape.h"
+#include "../primitives/rho.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* ---- primitives ---- */
+
+static void run_ellipsoid(const lb__instr *in, size_t n, const double *x, const double *y,
+                          const double *z, double *v, double *gx, double *gy, double *gz) {
+    const double c0 = in->prim.c[0], c1 = in->prim.c[1], c2 = in->prim.c[2];
+    const double a0 = in->prim.a[0], a1 = in->prim.a[1], a2 = in->prim.a[2];
+    for (size_t j = 0; j < n; ++j) {
+        const double u0 = (x[j] - c0) / a0, u1 = (y[j] - c1) / a1, u2 = (z[j] - c2) / a2;
+        const double f = sqrt(u0 * u0 + u1 * u1 + u2 * u2);
+        v[j] = f - 1.0;
+        gx[j] = f > 0.0 ? u0 / (a0 * f) : 0.0;
+        gy[j] = f > 0.0 ? u1 / (a1 * f) : 0.0;
+        gz[j] = f > 0.0 ? u2 / (a2 * f) : 0.0;
+    }
+}
+
+#if defined(__GNUC__)
+#define LB__INLINE static inline __attribute__((always_inline))
+#else
+#define LB__INLINE static inline
+#endif
+
+/* One primitive kind over a chunk: the affine map, rho and the kernel
+ * inline, so each kind gets its own specialised loop. */
+LB__INLINE void prim_loop(lb_primitive_kind kind, const lb__instr *in, size_t n, const double *x,
+                          const double *y, const double *z, double *v, double *gx, double *gy,
+                          double *gz) {
+    const lb_primitive *P = &in->prim;
+    const double *M = in->A.M, *t = in->A.t;
+    const int ident = in->identity, zero = P->kernel == LB_KERNEL_NONE;
+    for (size_t j = 0; j < n; ++j) {
+        double L[3], gl[3], df = 1.0;
+        if (ident) {
+            L[0] = x[j];
+            L[1] = y[j];
+            L[2] = z[j];
+        } else {
+            for (int i = 0; i < 3; ++i)
+                L[i] = M[3 * i] * x[j] + M[3 * i + 1] * y[j] + M[3 * i + 2] * z[j] + t[i];
+        }
+        const double rho = lb__rho(kind, P, L, gl);
+        v[j] = zero ? rho - 1.0 : lb__kernel(P->kernel, rho, &df);
+        if (ident) {
+            gx[j] = df * gl[0];
+            gy[j] = df * gl[1];
+            gz[j] = df * gl[2];
+        } else {
+            gx[j] = df * (M[0] * gl[0] + M[3] * gl[1] + M[6] * gl[2]);
+            gy[j] = df * (M[1] * gl[0] + M[4] * gl[1] + M[7] * gl[2]);
+            gz[j] = df * (M[2] * gl[0] + M[5] * gl[1] + M[8] * gl[2]);
+        }
+    }
+}
+
+static void run_prim(const lb__instr *in, size_t n, const double *x, const double *y,
+                     const double *z, double *v, double *gx, double *gy, double *gz) {
+    switch (in->prim.kind) {
+    case LB_PRIM_ELLIPSOID:
+        prim_loop(LB_PRIM_ELLIPSOID, in, n, x, y, z, v, gx, gy, gz);
+        break;
+    case LB_PRIM_LP:
+        prim_loop(LB_PRIM_LP, in, n, x, y, z, v, gx, gy, gz);
+        break;
+    case LB_PRIM_SUPERQUADRIC:
+        prim_loop(LB_PRIM_SUPERQUADRIC, in, n, x, y, z, v, gx, gy, gz);
+        break;
+    case LB_PRIM_SLAB:
+        prim_loop(LB_PRIM_SLAB, in, n, x, y, z, v, gx, gy, gz);
+        break;
+    case LB_PRIM_HALFSPACE:
+        prim_loop(LB_PRIM_HALFSPACE, in, n, x, y, z, v, gx, gy, gz);
+        break;
+    case LB_PRIM_CYLINDER:
+        prim_loop(LB_PRIM_CYLINDER, in, n, x, y, z, v, gx, gy, gz);
+        break;
+    case LB_PRIM_CAPSULE:
+        prim_loop(LB_PRIM_CAPSULE, in, n, x, y, z, v, gx, gy, gz);
+        break;
+    case LB_PRIM_TORUS:
+        prim_loop(LB_PRIM_TORUS, in, n, x, y, z, v, gx, gy, gz);
+        break;
+    }
+}
+
+/* ---- operators ---- */
+
+/* The fast kernels: the same arithmetic as the public functions, without
+ * re-validating parameters the compiler already checked. x, r, p, m hold the
+ * k active arguments (all of them unless a plan culled some). */
+static double fast_op(const lb__instr *in, size_t k, const uint16_t *act, const double *x,
+                      const double *r, const double *p, const double *m, double *dx) {
+    const lb__node *n = &in->op;
+    double xt[LB_MAX_ARITY], sg[LB_MAX_ARITY];
+    switch (in->fast) {
+    case LB__FAST_MINMAX: {
+        size_t j = 0;
+        const int mn = n->family == LB__F_MIN;
+        for (size_t i = 1; i < k; ++i)
+            if (mn ? x[i] < x[j] : x[i] > x[j]) j = i;
+        for (size_t i = 0; i < k; ++i) dx[i] = i == j;
+        return x[j];
+    }
+    case LB__FAST_DISPLACEMENT:
+    case LB__FAST_CONIC: {
+        const int disp = in->fast == LB__FAST_DISPLACEMENT;
+        const double *u = x;
+        if (n->op != LB_UNION) {
+            /* the duals by original argument index (culling may have removed
+             * argument 0 of a difference) */
+            for (size_t i = 0; i < k; ++i) {
+                sg[i] = n->op == LB_INTERSECTION || act[i] == 0 ? -1.0 : 1.0;
+                xt[i] = sg[i] * x[i];
+            }
+            u = xt;
+        }
+        double h;
+        if (k == 1) { /* BT_1 = u / m: one active argument (the others culled) */
+            h = u[0] / m[0];
+            dx[0] = 1.0 / m[0];
+        } else if (disp)
+            h = lb__bt_union(k, u, r, p, m, in->mode, dx, NULL, NULL);
+        else
+            h = lb__conic_union(u, r, n->shape, m, dx, NULL, NULL);
+        if (n->op == LB_UNION) return h;
+        for (size_t i = 0; i < k; ++i) dx[i] *= -sg[i];
+        return -h;
+    }
+    case LB__FAST_SCALE:
+        return lb__scale_setop(n->op, k, x, r, p, in->mode, dx, NULL);
+    }
+    return NAN;
+}
+
+static int point_ok(const double *x, size_t k) {
+    int ok = 1;
+    for (size_t i = 0; i < k; ++i) ok &= fabs(x[i]) <= LB_MAX_ABS_ARG;
+    return ok;
+}
+
+static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
+                           const double *y, const double *z, const double *dg, double *G,
+                           lb_error *err);
+
+static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__plan *plan, size_t n,
+                        const double *px, const double *py, const double *pz, double *regs,
+                        lb_error *err) {
+    const lb__node *nd = &in->op;
+    const size_t kf = nd->k;
+    const int bounded = nd->family == LB__F_BOUNDED;
+    /* the active arguments: all, or those the plan kept (fast kernels only) */
+    uint16_t all[LB_MAX_ARITY];
+    const uint16_t *act = all;
+    size_t k = kf;
+    if (plan && in->fast) {
+        act = plan->act + in->aoff;
+        k = plan->nact[in - ev->ins];
+    } else {
+        for (size_t i = 0; i < kf; ++i) all[i] = (uint16_t)i;
+    }
+    double x[LB_MAX_ARITY], c[LB_MAX_ARITY], dx[LB_MAX_ARITY], dc[LB_MAX_ARITY];
+    double r[LB_MAX_ARITY], p[LB_MAX_ARITY], m[LB_MAX_ARITY];
+    const double *vs[LB_MAX_ARITY], *gxs[LB_MAX_ARITY], *gys[LB_MAX_ARITY], *gzs[LB_MAX_ARITY];
+    for (size_t i = 0; i < k; ++i) {
+        const uint16_t a = act[i];
+        vs[i] = lb__reg(regs, in->src[a], 0);
+        gxs[i] = lb__reg(regs, in->src[a], 1);
+        gys[i] = lb__reg(regs, in->src[a], 2);
+        gzs[i] = lb__reg(regs, in->src[a], 3);
+        r[i] = nd->r ? nd->r[a] : 0.0;
+        p[i] = nd->p ? nd->p[a] : 0.0;
+        m[i] = nd->m ? nd->m[a] : 1.0;
+    }
+    double ga[6], dg[6];
+    double *dgall = NULL;
+    if (nd->bulge) {
+        dgall = malloc(6 * LB__CHUNK * sizeof *dgall);
+        if (!dgall) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", nd->path);
+    }
+    double *ov = lb__reg(regs, in->dst, 0), *ox = lb__reg(regs, in->dst, 1),
+           *oy = lb__reg(regs, in->dst, 2), *oz = lb__reg(regs, in->dst, 3);
+    for (size_t j = 0; j < n; ++j) {
+        for (size_t i = 0; i < k; ++i) x[i] = vs[i][j];
+        double v;
+        if (in->fast && point_ok(x, k)) {
+            v = fast_op(in, k, act, x, r, p, m, dx);
+        } else {
+            if (bounded)
+                for (size_t i = 0; i < k; ++i) c[i] = lb__reg(regs, in->src[k + i], 0)[j];
+            if (nd->bulge)
+                for (size_t i = 0; i < 2; ++i)
+                    for (int d = 0; d < 3; ++d) ga[3 * i + d] = lb__reg(regs, in->src[i], 1 + d)[j];
+            lb_status s = lb__node_apply(nd, ev->conv, x, c, ga, &v, dx, dc, dg, err);
+            if (s) {
+                free(dgall);
+                if (err) {
+                    char msg[LB_ERROR_MESSAGE_SIZE];
+                    snprintf(msg, sizeof msg, "%s", err->message);
+                    return lb__fail(err, s, "at (%.17g, %.17g, %.17g): node %s: %s", px[j], py[j],
+                                    pz[j], nd->path, msg);
+                }
+                return s;
+            }
+            if (nd->bulge) memcpy(dgall + 6 * j, dg, sizeof dg);
+        }
+        double g0 = 0.0, g1 = 0.0, g2 = 0.0;
+        for (size_t i = 0; i < k; ++i) {
+            g0 += dx[i] * gxs[i][j];
+            g1 += dx[i] * gys[i][j];
+            g2 += dx[i] * gzs[i][j];
+        }
+        if (bounded)
+            for (size_t i = 0; i < k; ++i) {
+                const uint32_t rg = in->src[k + i];
+                g0 += dc[i] * lb__reg(regs, rg, 1)[j];
+                g1 += dc[i] * lb__reg(regs, rg, 2)[j];
+                g2 += dc[i] * lb__reg(regs, rg, 3)[j];
+            }
+        ov[j] = v;
+        ox[j] = g0;
+        oy[j] = g1;
+        oz[j] = g2;
+    }
+    lb_status s = LB_OK;
+    if (nd->bulge) {
+        double G[3 * LB__CHUNK];
+        s = bulge_hvp(ev, in, n, px, py, pz, dgall, G, err);
+        for (size_t j = 0; j < n && !s; ++j) {
+            ox[j] += G[3 * j];
+            oy[j] += G[3 * j + 1];
+            oz[j] += G[3 * j + 2];
+        }
+    }
+    free(dgall);
+    return s;
+}
+
+/* The Hessian-vector terms of bulge elimination (the operator depends on the
+ * argument gradients): each argument's analytic gradient is differenced
+ * along d value / d g_i, re-running the tape prefix that computes it. */
+static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
+                           const double *y, const double *z, const double *dg, double *G,
+                           lb_error *err) {
+    memset(G, 0, 3 * n * sizeof *G);
+    double *regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
+    if (!regs) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+    double sx[LB__CHUNK], sy[LB__CHUNK], sz[LB__CHUNK], eps[LB__CHUNK], len[LB__CHUNK];
+    lb_status s = LB_OK;
+    for (int i = 0; i < 2 && !s; ++i) {
+        const uint32_t child = in->srci[i], reg = in->src[i];
+        double gp[3][LB__CHUNK];
+        for (int sign = 1; sign >= -1 && !s; sign -= 2) {
+            for (size_t j = 0; j < n; ++j) {
+                const double *d = dg + 6 * j + 3 * i;
+                len[j] = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                eps[j] = 1e-5 * (1.0 + fabs(x[j]) + fabs(y[j]) + fabs(z[j]));
+                const double f = len[j] > 0.0 ? sign * eps[j] / len[j] : 0.0;
+                sx[j] = x[j] + f * d[0];
+                sy[j] = y[j] + f * d[1];
+                sz[j] = z[j] + f * d[2];
+            }
+            s = lb__tape_run(ev, child, n, sx, sy, sz, regs, err);
+            for (size_t j = 0; j < n && !s; ++j)
+                for (int d = 0; d < 3; ++d) {
+                    const double gv = lb__reg(regs, reg, 1 + d)[j];
+                    if (sign > 0)
+                        gp[d][j] = gv;
+                    else if (len[j] > 0.0)
+                        G[3 * j + d] += (gp[d][j] - gv) / (2.0 * eps[j]) * len[j];
+                }
+        }
+    }
+    free(regs);
+    return s;
+}
+
+static lb_status run_range(const lb_evaluator *ev, const lb__plan *plan, size_t upto, size_t n,
+                           const double *x, const double *y, const double *z, double *regs,
+                           lb_error *err) {
+    for (size_t i = 0; i <= upto; ++i) {
+        if (plan && !plan->need[i]) continue;
+        const lb__instr *in = &ev->ins[i];
+        double *v = lb__reg(regs, in->dst, 0), *gx = lb__reg(regs, in->dst, 1),
+               *gy = lb__reg(regs, in->dst, 2), *gz = lb__reg(regs, in->dst, 3);
+        switch (in->code) {
+        case LB__I_ELLIPSOID:
+            run_ellipsoid(in, n, x, y, z, v, gx, gy, gz);
+            break;
+        case LB__I_PRIM:
+            run_prim(in, n, x, y, z, v, gx, gy, gz);
+            break;
+        default: {
+            lb_status s = run_op(ev, in, plan, n, x, y, z, regs, err);
+            if (s) return s;
+        }
+        }
+    }
+    return LB_OK;
+}
+
+lb_status lb__tape_run(const lb_evaluator *ev, size_t upto, size_t n, const double *x,
+                       const double *y, const double *z, double *regs, lb_error *err) {
+    return run_range(ev, NULL, upto, n, x, y, z, regs, err);
+}
+
+lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *plan, size_t n, const double *x,
+                            const double *y, const double *z, double *regs, lb_error *err) {
+    return run_range(ev, plan, ev->n - 1, n, x, y, z, regs, err);
+}
+
+/* ---- batches and threads ----
+ * Points are visited in Morton (Z-curve) order of their position in the
+ * batch's bounding box, so each chunk is spatially compact; each chunk gets
+ * an interval pass over its own box that culls arguments and subtrees that
+ * cannot contribute there (lb__bounds_pass), then runs what is left. Results
+ * go back to the caller's order. The order, the chunks and the plans depend
+ * only on the points, never on the thread count. */
+
+#define BLOCK_CHUNKS 16
+
+typedef struct job {
+    const lb_evaluator *ev;
+    size_t n;
+    const double *x, *y, *z;
+    double *v, *gx, *gy, *gz;
+    const uint32_t *order; /* visiting order (NULL: input order) */
+    atomic_size_t next;
+    pthread_mutex_t lock;
+    size_t err_block; /* smallest failing block, SIZE_MAX if none */
+    lb_error err;
+} job;
+
+static uint32_t spread3(uint32_t v) { /* 10 bits -> every third bit */
+    v &= 0x3ffu;
+    v = (v | (v << 16)) & 0x030000ffu;
+    v = (v | (v << 8)) & 0x0300f00fu;
+    v = (v | (v << 4)) & 0x030c30c3u;
+    v = (v | (v << 2)) & 0x09249249u;
+    return v;
+}
+
+/* Morton order of the points (a stable LSD radix sort on 30-bit codes).
+ * Returns NULL when memory is short: the input order is then used. */
+static uint32_t *morton_order(size_t n, const double *x, const double *y, const double *z) {
+    if (n > UINT32_MAX) return NULL;
+    uint32_t *key = malloc(2 * n * sizeof *key), *idx = malloc(2 * n * sizeof *idx);
+    if (!key || !idx) {
+        free(key);
+        free(idx);
+        return NULL;
+    }
+    double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
+    const double *P[3] = {x, y, z};
+    for (int d = 0; d < 3; ++d)
+        for (size_t i = 1; i < n; ++i) {
+            if (P[d][i] < lo[d]) lo[d] = P[d][i];
+            if (P[d][i] > hi[d]) hi[d] = P[d][i];
+        }
+    double sc[3];
+    for (int d = 0; d < 3; ++d) sc[d] = hi[d] > lo[d] ? 1023.999 / (hi[d] - lo[d]) : 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        key[i] = spread3((uint32_t)((x[i] - lo[0]) * sc[0])) |
+                 spread3((uint32_t)((y[i] - lo[1]) * sc[1])) << 1 |
+                 spread3((uint32_t)((z[i] - lo[2]) * sc[2])) << 2;
+        idx[i] = (uint32_t)i;
+    }
+    uint32_t *k0 = key, *k1 = key + n, *i0 = idx, *i1 = idx + n;
+    for (int shift = 0; shift < 32; shift += 8) {
+        size_t count[257] = {0};
+        for (size_t i = 0; i < n; ++i) count[((k0[i] >> shift) & 0xffu) + 1]++;
+        for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
+        for (size_t i = 0; i < n; ++i) {
+            const size_t dst = count[(k0[i] >> shift) & 0xffu]++;
+            k1[dst] = k0[i];
+            i1[dst] = i0[i];
+        }
+        uint32_t *t = k0;
+        k0 = k1;
+        k1 = t;
+        t = i0;
+        i0 = i1;
+        i1 = t;
+    }
+    /* four passes: the sorted order is back in the first half */
+    free(key);
+    return idx;
+}
+
+static void run_blocks(job *J) {
+    const lb_evaluator *ev = J->ev;
+    const size_t chunk_bytes = ev->nregs * 4 * LB__CHUNK * sizeof(double);
+    double *regs = malloc(chunk_bytes);
+    lb__iv *R = malloc(ev->nregs * sizeof *R);
+    lb__plan plan = {malloc(ev->n), malloc(ev->n * sizeof *plan.nact),
+                     malloc((ev->total_k ? ev->total_k : 1) * sizeof *plan.act)};
+    const int ok = regs && R && plan.need && plan.nact && plan.act;
+    const size_t nblocks = (J->n + BLOCK_CHUNKS * LB__CHUNK - 1) / (BLOCK_CHUNKS * LB__CHUNK);
+    for (;;) {
+        const size_t b = atomic_fetch_add(&J->next, 1);
+        if (b >= nblocks) break;
+        lb_error e = {LB_OK, ""};
+        lb_status s = LB_OK;
+        if (!ok) s = lb__fail(&e, LB_ERR_NO_MEMORY, "lb_evaluator_eval: out of memory");
+        const size_t end =
+            (b + 1) * BLOCK_CHUNKS * LB__CHUNK < J->n ? (b + 1) * BLOCK_CHUNKS * LB__CHUNK : J->n;
+        for (size_t o = b * BLOCK_CHUNKS * LB__CHUNK; o < end && !s; o += LB__CHUNK) {
+            const size_t m = end - o < LB__CHUNK ? end - o : LB__CHUNK;
+            double cx[LB__CHUNK], cy[LB__CHUNK], cz[LB__CHUNK];
+            double lo[3] = {INFINITY, INFINITY, INFINITY},
+                   hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+            for (size_t j = 0; j < m; ++j) {
+                const size_t q = J->order ? J->order[o + j] : o + j;
+                cx[j] = J->x[q];
+                cy[j] = J->y[q];
+                cz[j] = J->z[q];
+                const double P[3] = {cx[j], cy[j], cz[j]};
+                for (int d = 0; d < 3; ++d) {
+                    if (P[d] < lo[d]) lo[d] = P[d];
+                    if (P[d] > hi[d]) hi[d] = P[d];
+                }
+            }
+            double bc[3], br[3];
+            lb__box_centre(lo, hi, bc, br);
+            lb__bounds_pass(ev, bc, br, R, &plan);
+            s = lb__tape_run_plan(ev, &plan, m, cx, cy, cz, regs, &e);
+            if (s) break;
+            const double *rv = lb__reg(regs, ev->out, 0), *rx = lb__reg(regs, ev->out, 1),
+                         *ry = lb__reg(regs, ev->out, 2), *rz = lb__reg(regs, ev->out, 3);
+            for (size_t j = 0; j < m; ++j) {
+                const size_t q = J->order ? J->order[o + j] : o + j;
+                J->v[q] = rv[j];
+                if (J->gx) J->gx[q] = rx[j];
+                if (J->gy) J->gy[q] = ry[j];
+                if (J->gz) J->gz[q] = rz[j];
+            }
+        }
+        if (s) {
+            pthread_mutex_lock(&J->lock);
+            if (b < J->err_block) {
+                J->err_block = b;
+                J->err = e;
+            }
+            pthread_mutex_unlock(&J->lock);
+            atomic_store(&J->next, nblocks); /* stop handing out work */
+        }
+    }
+    free(regs);
+    free(R);
+    free(plan.need);
+    free(plan.nact);
+    free(plan.act);
+}
+
+static void *worker(void *arg) {
+    run_blocks(arg);
+    return NULL;
+}
+
+lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const double *x, const double *y,
+                            const double *z, double *value, double *gx, double *gy, double *gz,
+                            int threads, lb_error *err) {
+    static const char fn[] = "lb_evaluator_eval";
+    if (!ev || !value || (n && (!x || !y || !z)))
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: ev, value and the coordinate arrays must be non-NULL", fn);
+    if (threads < 0)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: threads = %d; allowed: 0 (one per CPU) or a positive count", fn,
+                        threads);
+    for (size_t i = 0; i < n; ++i) {
+        const double p[3] = {x[i], y[i], z[i]};
+        for (int d = 0; d < 3; ++d)
+            if (!(fabs(p[d]) <= LB_SCENE_MAX_COORD))
+                return lb__fail(err, isfinite(p[d]) ? LB_ERR_INVALID_ARGUMENT : LB_ERR_NOT_FINITE,
+                                "%s: point %zu has %c = %g; allowed: finite, |coordinate| <= %g",
+                                fn, i, "xyz"[d], p[d], LB_SCENE_MAX_COORD);
+    }
+    if (n == 0) return LB_OK;
+    job J;
+    memset(&J, 0, sizeof J);
+    J.ev = ev;
+    J.n = n;
+    J.x = x;
+    J.y = y;
+    J.z = z;
+    J.v = value;
+    J.gx = gx;
+    J.gy = gy;
+    J.gz = gz;
+    /* spatial order pays off only when there is something to cull */
+    uint32_t *order =
+        n > 4 * LB__CHUNK && ev->cullable ? morton_order(n, x, y, z) : NULL;
+    J.order = order;
+    atomic_init(&J.next, 0);
+    J.err_block = SIZE_MAX;
+    pthread_mutex_init(&J.lock, NULL);
+    size_t nt = threads == 0 ? (size_t)sysconf(_SC_NPROCESSORS_ONLN) : (size_t)threads;
+    const size_t nblocks = (n + BLOCK_CHUNKS * LB__CHUNK - 1) / (BLOCK_CHUNKS * LB__CHUNK);
+    if (nt < 1) nt = 1;
+    if (nt > nblocks) nt = nblocks;
+    if (nt > 256) nt = 256;
+    pthread_t tid[256];
+    size_t started = 0;
+    for (size_t t = 1; t < nt; ++t) {
+        if (pthread_create(&tid[started], NULL, worker, &J) != 0) break;
+        ++started;
+    }
+    run_blocks(&J); /* the caller's thread works too */
+    for (size_t t = 0; t < started; ++t) pthread_join(tid[t], NULL);
+    pthread_mutex_destroy(&J.lock);
+    free(order);
+    if (J.err_block != SIZE_MAX) {
+        if (err) *err = J.err;
+        return J.err.status;
+    }
+    return LB_OK;
+}

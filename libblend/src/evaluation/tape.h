@@ -1,0 +1,99 @@
+/* The compiled evaluator: a flat instruction tape over registers.
+ *
+ * Compilation (compile.c) walks the scene DAG once from the root, carrying
+ * the world -> local affine map; each distinct (node, map) pair becomes one
+ * instruction, so shared defs stay shared and transforms are folded into the
+ * primitives (group nodes vanish). Instructions are in dependency order and
+ * write registers assigned by last use, so the register file stays small.
+ *
+ * Evaluation (eval_points.c) runs the tape over chunks of LB__CHUNK points:
+ * each register holds value and gradient for a chunk as four arrays
+ * (structure of arrays), primitives run as tight loops over the chunk.
+ * Bounds (eval_bounds.c) run the same tape over intervals. */
+#ifndef LIBBLEND_TAPE_H
+#define LIBBLEND_TAPE_H
+
+#include "../scene/scene_internal.h"
+
+#include <stdint.h>
+
+#define LB__CHUNK 64
+/* Largest tape a scene may compile to (shared defs under many different
+ * transforms multiply). */
+#define LB__MAX_INSTRUCTIONS 1000000u
+
+enum lb__code {
+    LB__I_PRIM = 0,  /* general primitive with affine map */
+    LB__I_ELLIPSOID, /* zero-convention ellipsoid, translation-only map folded into c */
+    LB__I_OP         /* operator node */
+};
+
+typedef struct lb__instr {
+    int code;
+    uint32_t dst; /* output register */
+    /* primitives */
+    lb_primitive prim;
+    lb__affine A; /* world -> primitive frame */
+    int identity;
+    /* operators: a copy of the node (args/bounds NULL) and source registers */
+    lb__node op;
+    uint32_t *src;  /* k argument registers, then k bounding registers (bounded) */
+    uint32_t *srci; /* k argument instruction indices (bulge: prefix re-evaluation) */
+    uint32_t *srcb; /* k bounding-solid instruction indices (bounded), else NULL */
+    int fast;       /* LB__FAST_* */
+    int mode;       /* exponent mode for the fast kernels */
+    double lip;     /* primitives: Lipschitz factor of rho in the primitive frame */
+    size_t aoff;    /* operators: offset of this instruction's slots in a plan's act */
+} lb__instr;
+
+enum { LB__FAST_NONE = 0, LB__FAST_DISPLACEMENT, LB__FAST_CONIC, LB__FAST_SCALE, LB__FAST_MINMAX };
+
+struct lb_evaluator {
+    lb_convention conv;
+    lb__instr *ins;
+    size_t n;
+    size_t nregs;
+    uint32_t out;   /* register of the root */
+    size_t total_k; /* sum of operator arities */
+    int cullable;   /* some operator can drop arguments per box (lb__bounds_pass) */
+};
+
+/* An interval. */
+typedef struct lb__iv {
+    double lo, hi;
+} lb__iv;
+
+/* What one box needs (argument culling, libfive-style tape specialisation):
+ * need[i] says whether instruction i contributes to the root anywhere in the
+ * box; act + ins[i].aoff lists the nact[i] arguments of operator i that can
+ * contribute (the others provably leave value and gradient unchanged). */
+typedef struct lb__plan {
+    uint8_t *need;
+    uint16_t *nact;
+    uint16_t *act;
+} lb__plan;
+
+/* Interval pass over the box centre bc, half-size br: R (nregs entries)
+ * receives every register's interval; the root's is R[ev->out]. With a plan,
+ * also decides argument culling and what each instruction is needed for. */
+LB_INTERNAL void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br[3],
+                                 lb__iv *R, lb__plan *plan);
+
+/* Centre and half-size of a box, the half-size rounded up to cover it. */
+LB_INTERNAL void lb__box_centre(const double bmin[3], const double bmax[3], double bc[3],
+                                double br[3]);
+
+/* Run instructions [0, upto] on n <= LB__CHUNK points into regs
+ * (nregs * 4 * LB__CHUNK doubles). */
+LB_INTERNAL lb_status lb__tape_run(const lb_evaluator *ev, size_t upto, size_t n, const double *x,
+                                   const double *y, const double *z, double *regs, lb_error *err);
+/* The same for the instructions a plan needs, with culled arguments skipped. */
+LB_INTERNAL lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *plan, size_t n,
+                                        const double *x, const double *y, const double *z,
+                                        double *regs, lb_error *err);
+
+static inline double *lb__reg(double *regs, uint32_t r, int comp) {
+    return regs + ((size_t)r * 4u + (size_t)comp) * LB__CHUNK;
+}
+
+#endif

@@ -1,0 +1,254 @@
+/* Scene lifetime, accessors, the tree description and the reference
+ * evaluator (a plain recursive walk: the baseline the compiled evaluator is
+ * tested and benchmarked against). */
+#include "scene_internal.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void lb_scene_free(lb_scene *s) {
+    if (!s) return;
+    for (size_t i = 0; i < s->nnodes; ++i) {
+        lb__node *n = s->nodes[i];
+        free(n->args);
+        free(n->bounds);
+        free(n->r);
+        free(n->p);
+        free(n->m);
+        free(n->path);
+        free(n->def_name);
+        free(n);
+    }
+    free(s->nodes);
+    free(s->name);
+    free(s);
+}
+
+lb_convention lb_scene_convention(const lb_scene *s) {
+    return s ? s->convention : LB_CONVENTION_ZERO;
+}
+
+int lb_scene_bounds(const lb_scene *s, double min[3], double max[3]) {
+    if (!s || !s->has_bounds) return 0;
+    if (min) memcpy(min, s->bmin, sizeof s->bmin);
+    if (max) memcpy(max, s->bmax, sizeof s->bmax);
+    return 1;
+}
+
+const lb_render *lb_scene_render(const lb_scene *s) {
+    return s ? &s->render : NULL;
+}
+
+void lb_scene_stats_get(const lb_scene *s, lb_scene_stats *st) {
+    if (!st) return;
+    memset(st, 0, sizeof *st);
+    if (!s) return;
+    for (size_t i = 0; i < s->nnodes; ++i) {
+        const lb__node *n = s->nodes[i];
+        if (n->family == LB__F_GROUP) continue;
+        st->nodes++;
+        if (n->family == LB__F_PRIMITIVE)
+            st->primitives++;
+        else
+            st->operators++;
+    }
+    st->depth = s->root ? s->root->depth : 0;
+}
+
+/* ---- describe ---- */
+
+typedef struct sbuf {
+    char *buf;
+    size_t size, len;
+} sbuf;
+
+static void put(sbuf *b, const char *fmt, ...) LB_PRINTF(2, 3);
+static void put(sbuf *b, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    const size_t room = b->len < b->size ? b->size - b->len : 0;
+    int n = vsnprintf(room ? b->buf + b->len : NULL, room, fmt, ap);
+    va_end(ap);
+    if (n > 0) b->len += (size_t)n;
+}
+
+static void put_params(sbuf *b, const char *name, size_t k, const double *v) {
+    if (!v) return;
+    int same = 1;
+    for (size_t i = 1; i < k; ++i) same &= v[i] == v[0];
+    if (same) {
+        put(b, " %s=%g", name, v[0]);
+        return;
+    }
+    put(b, " %s=[", name);
+    for (size_t i = 0; i < k; ++i) put(b, "%s%g", i ? "," : "", v[i]);
+    put(b, "]");
+}
+
+static const char *op_name(lb_setop op) {
+    return op == LB_UNION ? "union" : op == LB_INTERSECTION ? "intersection" : "difference";
+}
+
+static void describe(sbuf *b, const lb__node *n, int indent, const char *role, const void **seen,
+                     size_t *nseen) {
+    put(b, "%*s%s", 2 * indent, "", role);
+    if (n->def_name) {
+        for (size_t i = 0; i < *nseen; ++i)
+            if (seen[i] == n) {
+                put(b, "ref %s (shared, described above)\n", n->def_name);
+                return;
+            }
+        seen[(*nseen)++] = n;
+        put(b, "[def %s] ", n->def_name);
+    }
+    if (n->family == LB__F_GROUP) {
+        put(b, "transform\n");
+        describe(b, n->args[0], indent + 1, "", seen, nseen);
+        return;
+    }
+    put(b, "%s", n->type);
+    if (n->family == LB__F_PRIMITIVE) {
+        const lb_primitive *P = &n->prim;
+        switch (P->kind) {
+        case LB_PRIM_ELLIPSOID:
+        case LB_PRIM_LP:
+        case LB_PRIM_SUPERQUADRIC:
+            put(b, " center=(%g,%g,%g) semi_axes=(%g,%g,%g)", P->c[0], P->c[1], P->c[2], P->a[0],
+                P->a[1], P->a[2]);
+            break;
+        case LB_PRIM_CAPSULE:
+            put(b, " start=(%g,%g,%g) end=(%g,%g,%g) radius=%g", P->c[0], P->c[1], P->c[2], P->q[0],
+                P->q[1], P->q[2], P->s0);
+            break;
+        default:
+            put(b, " point=(%g,%g,%g) direction=(%g,%g,%g)", P->c[0], P->c[1], P->c[2], P->n[0],
+                P->n[1], P->n[2]);
+            break;
+        }
+        if (P->kernel != LB_KERNEL_NONE)
+            put(b, " kernel=%s", P->kernel == LB_KERNEL_WYVILL ? "wyvill" : "blinn");
+    } else {
+        if (n->family == LB__F_DISPLACEMENT || n->family == LB__F_CONIC ||
+            n->family == LB__F_SCALE || n->family == LB__F_BOUNDED ||
+            n->family == LB__F_SOFT_HYPER || n->family == LB__F_SOFT_CONIC ||
+            n->family == LB__F_PERLIN || n->family == LB__F_RFUNCTION)
+            put(b, " %s", op_name(n->op));
+        put(b, " k=%zu", n->k);
+        put_params(b, "r", n->k, n->r);
+        put_params(b, "p", n->k, n->p);
+        put_params(b, "m", n->k, n->m);
+        if (n->family == LB__F_CONIC || n->family == LB__F_SOFT_CONIC) put(b, " p=%g", n->shape);
+        if (n->family == LB__F_RICCI) put(b, " n=%g", n->shape);
+        if (n->bulge)
+            put(b, " bulge(%s%s omega=%g)", n->bp.flags & LB_BULGE_RANGE ? "range " : "",
+                n->bp.flags & LB_BULGE_SLOPE ? "slope" : "", n->bp.omega);
+    }
+    if (n->has_transform) put(b, " +transform");
+    put(b, "\n");
+    for (size_t i = 0; i < n->k && n->family != LB__F_PRIMITIVE; ++i) {
+        describe(b, n->args[i], indent + 1, "", seen, nseen);
+        if (n->bounds) describe(b, n->bounds[i], indent + 2, "bound: ", seen, nseen);
+    }
+}
+
+size_t lb_scene_describe(const lb_scene *s, char *buf, size_t size) {
+    sbuf b = {buf, size, 0};
+    if (buf && size) buf[0] = '\0';
+    if (!s || !s->root) return 0;
+    const void **seen = calloc(s->nnodes + 1, sizeof *seen);
+    if (!seen) return 0;
+    size_t nseen = 0;
+    describe(&b, s->root, 0, "", seen, &nseen);
+    free(seen);
+    if (buf && size && b.len >= size) buf[size - 1] = '\0';
+    return b.len;
+}
+
+/* ---- reference evaluator ---- */
+
+/* Everything is evaluated in world coordinates: A maps world points into the
+ * parent frame of node n, so gradients (and bulge angles) are world ones. */
+static lb_status ref_eval(const lb__node *n, lb_convention conv, const lb__affine *A,
+                          const double X[3], double *v, double g[3], lb_error *err);
+
+/* Hessian-vector term of bulge elimination: the operator depends on the
+ * argument gradients g_i, so its gradient has a term H_i dg_i. The analytic
+ * first derivatives of the argument are differenced along dg_i. */
+static lb_status hvp(const lb__node *a, lb_convention conv, const lb__affine *A, const double X[3],
+                     const double d[3], double out[3], lb_error *err) {
+    const double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    out[0] = out[1] = out[2] = 0.0;
+    if (!(len > 0.0)) return LB_OK;
+    const double eps = 1e-5 * (1.0 + fabs(X[0]) + fabs(X[1]) + fabs(X[2]));
+    double Xp[3], Xm[3], vp, vm, gp[3], gm[3];
+    for (int i = 0; i < 3; ++i) {
+        Xp[i] = X[i] + eps * d[i] / len;
+        Xm[i] = X[i] - eps * d[i] / len;
+    }
+    lb_status s;
+    if ((s = ref_eval(a, conv, A, Xp, &vp, gp, err)) ||
+        (s = ref_eval(a, conv, A, Xm, &vm, gm, err)))
+        return s;
+    for (int i = 0; i < 3; ++i) out[i] = (gp[i] - gm[i]) / (2.0 * eps) * len;
+    return LB_OK;
+}
+
+static lb_status ref_eval(const lb__node *n, lb_convention conv, const lb__affine *Ap,
+                          const double X[3], double *v, double g[3], lb_error *err) {
+    lb__affine A = *Ap;
+    if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
+    lb_status s = LB_OK;
+    if (n->family == LB__F_PRIMITIVE) {
+        double L[3], gl[3];
+        lb__affine_apply(&A, X, L);
+        *v = lb_primitive_eval(&n->prim, L, gl);
+        lb__affine_pullback(&A, gl, g);
+        return LB_OK;
+    }
+    const size_t k = n->k;
+    double small[8 * 10];
+    double *x = k <= 8 ? small : malloc(k * (2 + 3 + 2 + 3) * sizeof *x);
+    if (!x) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", n->path);
+    double *c = x + k, *ga = c + k, *dx = ga + 3 * k, *dc = dx + k, *gb = dc + k;
+    double dg[6] = {0, 0, 0, 0, 0, 0};
+    for (size_t i = 0; i < k && !s; ++i) {
+        s = ref_eval(n->args[i], conv, &A, X, &x[i], ga + 3 * i, err);
+        if (!s && n->bounds) s = ref_eval(n->bounds[i], conv, &A, X, &c[i], gb + 3 * i, err);
+    }
+    if (!s) s = lb__node_apply(n, conv, x, c, ga, v, dx, dc, dg, err);
+    if (!s) {
+        g[0] = g[1] = g[2] = 0.0;
+        for (size_t i = 0; i < k; ++i)
+            for (int d = 0; d < 3; ++d) {
+                g[d] += dx[i] * ga[3 * i + d];
+                if (n->bounds) g[d] += dc[i] * gb[3 * i + d];
+            }
+        for (size_t i = 0; i < 2 && n->bulge && !s; ++i) {
+            double h[3];
+            s = hvp(n->args[i], conv, &A, X, dg + 3 * i, h, err);
+            for (int d = 0; d < 3; ++d) g[d] += h[d];
+        }
+    }
+    if (x != small) free(x);
+    return s;
+}
+
+lb_status lb_scene_eval_reference(const lb_scene *s, const double X[3], double *value,
+                                  double grad[3], lb_error *err) {
+    if (!s || !s->root || !X || !value)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "lb_scene_eval_reference: scene, X and value must be non-NULL");
+    for (int i = 0; i < 3; ++i)
+        if (!(fabs(X[i]) <= LB_SCENE_MAX_COORD))
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "lb_scene_eval_reference: X[%d] = %g; allowed: |X| <= %g", i, X[i],
+                            LB_SCENE_MAX_COORD);
+    double g[3];
+    lb__affine id;
+    lb__affine_identity(&id);
+    lb_status st = ref_eval(s->root, s->convention, &id, X, value, g, err);
+    if (!st && grad) memcpy(grad, g, sizeof g);
+    return st;
+}

@@ -1,0 +1,184 @@
+#!/usr/bin/python3
+"""Writes the paper-figure and benchmark scenes in this folder.
+
+The papers give the CSG trees and the parameters that vary (m, bulge
+elimination, bounding solids) but not every size and position; those are
+chosen here once, so the variants of one figure differ only in what the
+figure varies. Run it after changing a figure: `scenes/make_scenes.py`.
+"""
+import json
+import os
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def scene(title, description, convention, root, bounds, defs=None, render=None):
+    s = {"format": "libblend-scene", "version": 1, "title": title,
+         "description": description, "convention": convention,
+         "bounds": {"min": bounds[0], "max": bounds[1]}}
+    if defs:
+        s["defs"] = defs
+    s["root"] = root
+    s["render"] = render or {
+        "camera": {"location": [4.0, -6.0, 4.5], "look_at": [0, 0, 0], "angle": 35},
+        "lights": [{"location": [10, -10, 20], "color": [1, 1, 1]},
+                   {"location": [-10, -5, 8], "color": [0.4, 0.4, 0.4]}],
+        "material": {"color": [0.85, 0.7, 0.45], "ambient": 0.1, "diffuse": 0.7,
+                     "specular": 0.3}}
+    return s
+
+
+def write(name, s):
+    with open(os.path.join(HERE, name), "w") as f:
+        json.dump(s, f, indent=2)
+        f.write("\n")
+
+
+def slab(axis, half_width=1.0, center=(0, 0, 0), kernel=None):
+    n = [0, 0, 0]
+    n[axis] = 1
+    node = {"type": "slab", "point": list(center), "normal": n, "half_width": half_width}
+    if kernel:
+        node["kernel"] = kernel
+    return node
+
+
+def halfspace(normal, offset):
+    """inside: normal . X < offset (|normal| = 1, width 1)"""
+    return {"type": "halfspace", "point": [normal[i] * (offset - 1.0) for i in range(3)],
+            "normal": list(normal), "width": 1.0}
+
+
+B2 = ([-2.2, -2.2, -2.2], [2.2, 2.2, 2.2])
+
+# hsu2006 Fig. 7: S(-BT3(-f1,-f2,-f3), 0) (rounded cube) in union with a
+# super-ellipsoid; m2 of the cube's f2 (the y slab, facing the
+# super-ellipsoid) is lowered 1.2, 0.9, 0.6, 0.3: only f2's subsequent
+# blend with the super-ellipsoid shrinks, the cube itself does not change.
+for m2 in (1.2, 0.9, 0.6, 0.3):
+    cube = {"type": "displacement", "op": "intersection",
+            "args": [slab(0), slab(1), slab(2)], "r": 0.3, "p": 2, "m": [1, m2, 1]}
+    blob = {"type": "superquadric", "center": [0.0, 1.35, 0.0], "semi_axes": [0.55, 0.55, 0.55],
+            "e1": 0.6, "e2": 0.6}
+    root = {"type": "displacement", "op": "union", "args": [cube, blob], "r": 0.45, "p": 2}
+    write("hsu2006-fig7-m%s.json" % m2, scene(
+        "hsu2006 Fig. 7, m2 = %s" % m2,
+        "BT2(S(-BT3(-f1,-f2,-f3)), super-ellipsoid) with m2 = %s for the cube's f2" % m2,
+        "zero", root, B2))
+
+# hsu2006 Fig. 8: S(-BT2(-b2, b1), 0): the six-plane box b2 (a slot) cut
+# from the six-plane box b1. The slot floor f12 is 0.35 below the top face
+# f6, closer than the difference's range 0.5: with m = 1 they blend
+# (unwanted); lowering m6 and m12 to 0.3 removes it, b1 and b2 unchanged.
+for tag, mlow in (("plain", 1.0), ("lowered-m", 0.3)):
+    b1 = {"type": "displacement", "op": "intersection", "r": 0.2, "p": 2,
+          "m": [1, 1, 1, 1, 1, mlow],
+          "args": [halfspace((1, 0, 0), 1), halfspace((-1, 0, 0), 1),
+                   halfspace((0, 1, 0), 1), halfspace((0, -1, 0), 1),
+                   halfspace((0, 0, -1), 1), halfspace((0, 0, 1), 1)]}
+    b2 = {"type": "displacement", "op": "intersection", "r": 0.2, "p": 2,
+          "m": [1, 1, 1, 1, 1, mlow],
+          "args": [halfspace((1, 0, 0), 0.45), halfspace((-1, 0, 0), 0.45),
+                   halfspace((0, 1, 0), 1.6), halfspace((0, -1, 0), 1.6),
+                   halfspace((0, 0, 1), 1.6), halfspace((0, 0, -1), -0.65)]}
+    root = {"type": "displacement", "op": "difference", "args": [b1, b2], "r": 0.5, "p": 2}
+    write("hsu2006-fig8-%s.json" % tag, scene(
+        "hsu2006 Fig. 8, %s" % tag,
+        "difference of two six-plane intersections, m6 = m12 = %s" % mlow,
+        "zero", root, B2))
+
+# hsu2006 Fig. 9: the wheel S(BT2(BT2(f1, f2), f3), 0): crossing spokes f1,
+# f2 joined with bulge elimination, then the toroidal rim f3; m1 = 1 and 0.3
+# change only f1's corners at the rim, not the joint of the spokes.
+for m1 in (1, 0.3):
+    spokes = {"type": "displacement", "op": "union", "r": 0.3, "p": 2, "m": [m1, 1],
+              "bulge": {"range": True, "slope": False, "omega": 0.001},
+              "args": [{"type": "cylinder", "point": [0, 0, 0], "axis": [1, 0, 0], "radius": 0.18},
+                       {"type": "cylinder", "point": [0, 0, 0], "axis": [0, 1, 0], "radius": 0.18}]}
+    rim = {"type": "torus", "center": [0, 0, 0], "axis": [0, 0, 1], "major_radius": 1.4,
+           "minor_radius": 0.2}
+    # the spokes end at the rim: intersect them with a slab-bounded disc
+    disc = {"type": "cylinder", "point": [0, 0, 0], "axis": [0, 0, 1], "radius": 1.45}
+    spokes_in = {"type": "max", "args": [spokes, disc]}
+    root = {"type": "displacement", "op": "union", "r": 0.3, "p": 2,
+            "args": [spokes_in, rim]}
+    write("hsu2006-fig9-m%s.json" % m1, scene(
+        "hsu2006 Fig. 9, m1 = %s" % m1,
+        "wheel BT2(BT2(f1, f2) with bulge elimination, f3), m1 = %s" % m1,
+        "zero", root, ([-1.9, -1.9, -0.6], [1.9, 1.9, 0.6])))
+
+# hsu-bounded Fig. 2: the wheel B_D2(B_U2(B_U2(f1, f2), f3), f4) by the
+# scale method: spokes f1, f2, rim f3, axle hole f4.
+spokes = {"type": "scale", "op": "union", "r": 0.4, "p": 2,
+          "args": [{"type": "capsule", "start": [-1.3, 0, 0], "end": [1.3, 0, 0], "radius": 0.16},
+                   {"type": "capsule", "start": [0, -1.3, 0], "end": [0, 1.3, 0], "radius": 0.16}]}
+wheel = {"type": "scale", "op": "union", "r": 0.3, "p": 2,
+         "args": [spokes, {"type": "torus", "center": [0, 0, 0], "axis": [0, 0, 1],
+                           "major_radius": 1.35, "minor_radius": 0.18}]}
+root = {"type": "scale", "op": "difference", "r": 0.3, "p": 2,
+        "args": [wheel, {"type": "cylinder", "point": [0, 0, 0], "axis": [0, 0, 1],
+                         "radius": 0.07}]}
+write("hsu-bounded-fig2-wheel.json", scene(
+    "hsu-bounded Fig. 2, wheel", "B_D2(B_U2(B_U2(f1, f2), f3), f4) by the scale method",
+    "zero", root, ([-1.8, -1.8, -0.6], [1.8, 1.8, 0.6])))
+
+# hsu-bounded Fig. 7: a stool, four legs and a plate in one bounded union;
+# the plate's bounding solid keeps its blending region off the corners.
+legs = []
+leg_bounds = []
+for sx in (-1, 1):
+    for sy in (-1, 1):
+        legs.append({"type": "capsule", "start": [0.55 * sx, 0.55 * sy, -1.2],
+                     "end": [0.55 * sx, 0.55 * sy, 0.2], "radius": 0.1})
+        leg_bounds.append({"type": "capsule", "start": [0.55 * sx, 0.55 * sy, -1.2],
+                           "end": [0.55 * sx, 0.55 * sy, 0.2], "radius": 0.35})
+plate = {"type": "ellipsoid", "center": [0, 0, 0.25], "semi_axes": [1.0, 1.0, 0.12]}
+plate_bound = {"type": "ellipsoid", "center": [0, 0, 0.25], "semi_axes": [1.0, 1.0, 0.4]}
+root = {"type": "bounded", "op": "union", "p": 2, "args": [plate] + legs,
+        "bounds": [plate_bound] + leg_bounds}
+write("hsu-bounded-fig7-stool.json", scene(
+    "hsu-bounded Fig. 7, stool with a bounded plate",
+    "bounded union of a plate and four legs; the plate's bounding solid is a taller ellipsoid",
+    "zero", root, ([-1.4, -1.4, -1.5], [1.4, 1.4, 0.8])))
+
+# hsu-nonuniform Fig. 6: B_S2(B_A3(f1, f2, f3), f4) = 0.5 on soft slabs and a
+# soft super-ellipsoid, m2 = 2.8 fixed, m1 = 0.3, 0.65, 1, 1.5.
+for m1 in (0.3, 0.65, 1, 1.5):
+    cube = {"type": "soft_hyper", "op": "intersection", "r": 0.5, "p": 2, "m": [m1, 2.8, 1],
+            "args": [slab(0, kernel="wyvill"), slab(1, kernel="wyvill"), slab(2, kernel="wyvill")]}
+    blob = {"type": "superquadric", "center": [1.3, 0.0, 0.9], "semi_axes": [0.6, 0.6, 0.6],
+            "e1": 0.6, "e2": 0.6, "kernel": "wyvill"}
+    root = {"type": "soft_hyper", "op": "union", "r": 0.6, "p": 2, "args": [cube, blob]}
+    write("hsu-nonuniform-fig6-m%s.json" % m1, scene(
+        "hsu-nonuniform Fig. 6, m1 = %s" % m1,
+        "soft B_S2(B_A3(f1, f2, f3), f4) = 0.5, m1 = %s, m2 = 2.8" % m1,
+        "soft", root, ([-2.2, -2.2, -2.2], [2.6, 2.2, 2.2])))
+
+# Benchmark scenes (issues 3 and 4). S1: three spheres in one BT_3 union.
+S1 = {"type": "displacement", "op": "union", "r": 0.25, "p": 2,
+      "args": [{"type": "sphere", "center": c, "radius": 1.0}
+               for c in ([0, 0, 0], [1.2, 0, 0], [0, 1.2, 0])]}
+write("bench-s1-three-spheres.json", scene(
+    "S1: three spheres", "three unit spheres in one BT_3 union, r = 0.25, p = 2", "zero", S1,
+    ([-2, -2, -2], [3, 3, 3])))
+# S2: 64 spheres of radius 0.3 on a 4x4x4 lattice of spacing 0.5.
+S2 = {"type": "displacement", "op": "union", "r": 0.1, "p": 2,
+      "args": [{"type": "sphere", "center": [-0.25 + 0.5 * i, -0.25 + 0.5 * j, -0.25 + 0.5 * k],
+                "radius": 0.3} for i in range(4) for j in range(4) for k in range(4)]}
+write("bench-s2-64-spheres.json", scene(
+    "S2: 64 spheres", "64 spheres (radius 0.3, 4x4x4 lattice, spacing 0.5) in one BT_64 union",
+    "zero", S2, ([-2, -2, -2], [3, 3, 3])))
+
+# The README's main job: the hsu2006 Fig. 7 setting with a shared cube def.
+cube = {"type": "displacement", "op": "intersection", "args": [slab(0), slab(1), slab(2)],
+        "r": 0.3, "p": 2, "m": [1, 0.6, 1]}
+root = {"type": "displacement", "op": "union", "r": 0.45, "p": 2,
+        "args": [{"ref": "cube"},
+                 {"type": "superquadric", "center": [0.0, 1.35, 0.0],
+                  "semi_axes": [0.55, 0.55, 0.55], "e1": 0.6, "e2": 0.6},
+                 {"ref": "cube", "translate": [0, -2.6, 0], "rotate": [0, 0, 45], "scale": 0.6}]}
+write("default.json", scene(
+    "libblend default scene",
+    "a rounded cube blended with a super-ellipsoid (m2 = 0.6, hsu2006 Fig. 7) and a rotated, "
+    "scaled copy of the same cube (a shared def)",
+    "zero", root, ([-2.2, -4.0, -2.2], [2.2, 2.2, 2.2]), defs={"cube": cube}))
