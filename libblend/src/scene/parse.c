@@ -4,7 +4,10 @@
  * Line and column are known for syntax errors (cJSON keeps no positions for
  * values); the JSON path is always given. docs/scene-format.md is the
  * reference for every name accepted here. */
+#define _POSIX_C_SOURCE 200809L
 #include "scene_internal.h"
+
+#include <sys/stat.h>
 
 #include <cjson/cJSON.h>
 #include <errno.h>
@@ -45,6 +48,9 @@ static lb_status perr(pctx *c, lb_status st, const char *fmt, ...) {
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
+    if (c->plen > 160) /* deep paths: the start and the end say where */
+        return lb__fail(c->err, st, "%s: %.60s...%s: %s", c->file, c->path,
+                        c->path + c->plen - 80, msg);
     return lb__fail(c->err, st, "%s: %s: %s", c->file, c->path, msg);
 }
 
@@ -147,7 +153,7 @@ static lb_status number_value(pctx *c, const cJSON *j, double lo, double hi, con
     if (!isfinite(v))
         return perr(c, LB_ERR_NOT_FINITE, "%g is not finite; allowed: %s", v, allowed);
     if (!(v >= lo && v <= hi))
-        return perr(c, LB_ERR_INVALID_ARGUMENT, "%.17g is out of range; allowed: %s", v, allowed);
+        return perr(c, LB_ERR_INVALID_ARGUMENT, "%.15g is out of range; allowed: %s", v, allowed);
     *out = v;
     return LB_OK;
 }
@@ -228,8 +234,8 @@ static lb_status get_param(pctx *c, const cJSON *obj, const char *key, size_t k,
     } else if (!j) {
         if (required)
             s = perr(c, LB_ERR_INVALID_ARGUMENT,
-                     "missing required field; allowed: a number or an array of %zu numbers, "
-                     "each %s",
+                     "missing required field; allowed: a number (for every argument) or an "
+                     "array of %zu numbers (one per argument), each %s",
                      k, allowed);
         for (size_t i = 0; i < k; ++i) v[i] = def;
     } else if (cJSON_IsNumber(j)) {
@@ -1166,6 +1172,9 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
     if (!doc) {
         size_t off = end && end >= text ? (size_t)(end - text) : 0;
         if (off > length) off = length;
+        while (off < length && (text[off] == ' ' || text[off] == '\t' || text[off] == '\r' ||
+                                text[off] == '\n'))
+            ++off;
         size_t line, col;
         line_col(text, length, off, &line, &col);
         char near[24] = "";
@@ -1229,6 +1238,20 @@ lb_status lb_scene_load(const char *path, lb_scene **out, lb_error *err) {
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: cannot open the scene file (%s); allowed: a readable file", path,
                         strerror(errno));
+    struct stat sb;
+    if (fstat(fileno(f), &sb) == 0) {
+        if (S_ISDIR(sb.st_mode)) {
+            fclose(f);
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: is a directory; allowed: a scene file", path);
+        }
+        if (S_ISREG(sb.st_mode) && (unsigned long long)sb.st_size > LB_SCENE_MAX_BYTES) {
+            fclose(f);
+            return lb__fail(err, LB_ERR_NO_MEMORY,
+                            "%s: the scene file is %lld bytes; allowed: at most %u bytes", path,
+                            (long long)sb.st_size, LB_SCENE_MAX_BYTES);
+        }
+    }
     char *buf = NULL;
     size_t len = 0, cap = 0;
     lb_status st = LB_OK;
