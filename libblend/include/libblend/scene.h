@@ -30,6 +30,9 @@ extern "C" {
 #define LB_SCENE_MAX_DEPTH 64                    /* nesting of nodes below the root */
 #define LB_SCENE_MAX_NODES 100000                /* nodes in one scene, refs included */
 #define LB_SCENE_MAX_LIGHTS 16
+/* Bulge-eliminated blends nested inside each other's arguments: each level
+ * re-evaluates its arguments 4 times for the Hessian terms of its gradient. */
+#define LB_SCENE_MAX_BULGE_NESTING 4
 /* Largest |coordinate| anywhere in a scene (centres, translations, bounds)
  * and of evaluation points. */
 #define LB_SCENE_MAX_COORD 1e9

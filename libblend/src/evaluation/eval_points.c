@@ -501,8 +501,7 @@ lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const double *x, c
     J.gy = gy;
     J.gz = gz;
     /* spatial order pays off only when there is something to cull */
-    uint32_t *order =
-        n > 4 * LB__CHUNK && ev->cullable ? morton_order(n, x, y, z) : NULL;
+    uint32_t *order = n > 4 * LB__CHUNK && ev->cullable ? morton_order(n, x, y, z) : NULL;
     J.order = order;
     atomic_init(&J.next, 0);
     J.err_block = SIZE_MAX;

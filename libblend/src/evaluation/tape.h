@@ -20,7 +20,7 @@
 #define LB__CHUNK 64
 /* Largest tape a scene may compile to (shared defs under many different
  * transforms multiply). */
-#define LB__MAX_INSTRUCTIONS 1000000u
+#define LB__MAX_INSTRUCTIONS 200000u
 
 enum lb__code {
     LB__I_PRIM = 0,  /* general primitive with affine map */

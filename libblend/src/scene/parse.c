@@ -49,8 +49,8 @@ static lb_status perr(pctx *c, lb_status st, const char *fmt, ...) {
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
     if (c->plen > 160) /* deep paths: the start and the end say where */
-        return lb__fail(c->err, st, "%s: %.60s...%s: %s", c->file, c->path,
-                        c->path + c->plen - 80, msg);
+        return lb__fail(c->err, st, "%s: %.60s...%s: %s", c->file, c->path, c->path + c->plen - 80,
+                        msg);
     return lb__fail(c->err, st, "%s: %s: %s", c->file, c->path, msg);
 }
 
@@ -571,6 +571,7 @@ static lb_status parse_ref(pctx *c, const cJSON *j, size_t depth, lb__node **out
     g->to_local = tmp.to_local;
     g->to_parent = tmp.to_parent;
     g->depth = target->depth + 1;
+    g->bulge_depth = target->bulge_depth;
     *out = g;
     return LB_OK;
 }
@@ -887,7 +888,19 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
     for (size_t i = 0; i < k; ++i) {
         const lb__node *a = n->args[i];
         if (a->depth + 1 > n->depth) n->depth = a->depth + 1;
+        if (a->bulge_depth > n->bulge_depth) n->bulge_depth = a->bulge_depth;
         if (n->bounds && n->bounds[i]->depth + 1 > n->depth) n->depth = n->bounds[i]->depth + 1;
+        if (n->bounds && n->bounds[i]->bulge_depth > n->bulge_depth)
+            n->bulge_depth = n->bounds[i]->bulge_depth;
+    }
+    if (n->bulge && ++n->bulge_depth > LB_SCENE_MAX_BULGE_NESTING) {
+        const size_t old = push_key(c, "bulge");
+        s = perr(c, LB_ERR_INVALID_ARGUMENT,
+                 "bulge elimination nested %zu deep (each level evaluates its arguments 4 more "
+                 "times); allowed: at most %d bulge-eliminated blends on any path",
+                 n->bulge_depth, LB_SCENE_MAX_BULGE_NESTING);
+        pop(c, old);
+        return s;
     }
     /* backstop: the operator itself accepts the parameters at a neutral point */
     {
@@ -1172,8 +1185,8 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
     if (!doc) {
         size_t off = end && end >= text ? (size_t)(end - text) : 0;
         if (off > length) off = length;
-        while (off < length && (text[off] == ' ' || text[off] == '\t' || text[off] == '\r' ||
-                                text[off] == '\n'))
+        while (off < length &&
+               (text[off] == ' ' || text[off] == '\t' || text[off] == '\r' || text[off] == '\n'))
             ++off;
         size_t line, col;
         line_col(text, length, off, &line, &col);

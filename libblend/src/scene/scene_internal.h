@@ -49,9 +49,10 @@ struct lb__node {
     int has_transform;
     lb__affine to_local; /* parent coordinates -> this node's coordinates */
     lb__affine to_parent;
-    char *path;     /* JSON path of the node, for messages */
-    char *def_name; /* name when the node is a def, else NULL */
-    size_t depth;   /* height: 1 for a leaf */
+    char *path;         /* JSON path of the node, for messages */
+    char *def_name;     /* name when the node is a def, else NULL */
+    size_t depth;       /* height: 1 for a leaf */
+    size_t bulge_depth; /* bulge nodes on the longest path down (4 re-evaluations each) */
 };
 
 struct lb_scene {
