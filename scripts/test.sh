@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite: install what is missing, then a Release build and a
-# sanitizer (ASan + UBSan) build, each built from scratch and run by ctest.
+# sanitizer (ASan + UBSan) build, each run by ctest, then the scene parser
+# under libFuzzer (clang, ASan + UBSan) for LIBBLEND_FUZZ_SECONDS (60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -16,3 +17,10 @@ for cfg in "build-release:-DCMAKE_BUILD_TYPE=Release" \
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir "$dir" --output-on-failure -j "$JOBS"
 done
+
+echo "== build-fuzz (clang, libFuzzer, ASan + UBSan)"
+CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_FUZZ=ON \
+  -DLIBBLEND_BENCH=OFF -DLIBBLEND_FUZZ_SECONDS="${LIBBLEND_FUZZ_SECONDS:-60}"
+cmake --build build-fuzz -j "$JOBS" --target fuzz_scene
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  ctest --test-dir build-fuzz --output-on-failure -R '^fuzz_scene$'
