@@ -1,0 +1,141 @@
+#!/usr/bin/python3
+"""The JSON Schema in docs/ agrees with libblend's own parser.
+
+usage: test_schema.py BLENDTOOL SOURCE_DIR
+
+- the schema is a valid Draft 2020-12 schema;
+- every scene shipped in scenes/ and tests/data/scenes/ passes both the schema
+  and `blendtool validate`;
+- the node kinds the schema names are exactly the kinds the library names in
+  its "unknown node type" message;
+- mutations that break a scene (unknown key, unknown kind, wrong-typed or
+  out-of-range value, an operator of the other convention, a kernel in a zero
+  scene) are rejected by both.
+"""
+import copy
+import glob
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import jsonschema
+
+blendtool, src = sys.argv[1], sys.argv[2]
+schema = json.load(open(os.path.join(src, "docs", "libblend-scene.schema.json")))
+jsonschema.Draft202012Validator.check_schema(schema)
+validator = jsonschema.Draft202012Validator(schema)
+failures = []
+
+
+def library_accepts(doc):
+    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
+        json.dump(doc, f)
+        name = f.name
+    try:
+        r = subprocess.run([blendtool, "validate", "--quiet", name], capture_output=True, text=True)
+    finally:
+        os.unlink(name)
+    if r.returncode not in (0, 2):
+        failures.append("blendtool exited %d: %s" % (r.returncode, r.stderr))
+    return r.returncode == 0, r.stderr.strip()
+
+
+def schema_accepts(doc):
+    return validator.is_valid(doc)
+
+
+def nodes(doc):
+    """Every node object of a scene (root, defs, args and bounds, recursively)."""
+    todo = [doc["root"]] + list(doc.get("defs", {}).values())
+    while todo:
+        n = todo.pop()
+        yield n
+        todo.extend(n.get("args", []))
+        todo.extend(n.get("bounds", []))
+
+
+scenes = sorted(glob.glob(os.path.join(src, "scenes", "*.json")) +
+                glob.glob(os.path.join(src, "tests", "data", "scenes", "*.json")))
+if len(scenes) < 10:
+    failures.append("only %d scenes found under %s" % (len(scenes), src))
+mutations = 0
+for path in scenes:
+    doc = json.load(open(path))
+    ok, msg = library_accepts(doc)
+    if not ok:
+        failures.append("%s: blendtool rejects it: %s" % (path, msg))
+    errs = list(validator.iter_errors(doc))
+    if errs:
+        failures.append("%s: the schema rejects it: %s" % (path, errs[0].message[:300]))
+    other = "soft" if doc["convention"] == "zero" else "zero"
+    cases = []
+    for i, n in enumerate(nodes(doc)):
+        if "ref" in n:
+            continue
+        def mutate(fn, what, i=i):
+            d = copy.deepcopy(doc)
+            fn(list(nodes(d))[i])
+            cases.append((what, d))
+        mutate(lambda n: n.__setitem__("colour", 1), "unknown key on node %d" % i)
+        mutate(lambda n: n.__setitem__("type", n["type"] + "x"), "unknown kind on node %d" % i)
+        for key in ("radius", "r", "half_width", "minor_radius", "e1", "exponent"):
+            if key in n:
+                mutate(lambda n, key=key: n.__setitem__(key, "1"), "string %s on node %d" % (key, i))
+                mutate(lambda n, key=key: n.__setitem__(key, -1), "negative %s on node %d" % (key, i))
+        if "p" in n and n["type"] in ("displacement", "scale", "bounded", "soft_hyper"):
+            mutate(lambda n: n.__setitem__("p", 1), "p = 1 on node %d" % i)
+        if "args" in n:
+            mutate(lambda n: n.__setitem__("args", []), "no args on node %d" % i)
+        if n["type"] in ("displacement", "conic", "scale", "bounded", "rfunction", "soft_sum",
+                         "ricci", "soft_hyper", "soft_conic", "perlin"):
+            mutate(lambda n: n.__setitem__("type", {"zero": "soft_sum", "soft": "rfunction"}[doc["convention"]]),
+                   "%s-convention operator on node %d" % (other, i))
+        if doc["convention"] == "zero" and "args" not in n:
+            mutate(lambda n: n.__setitem__("kernel", "wyvill"), "kernel in a zero scene on node %d" % i)
+    d = copy.deepcopy(doc)
+    d["version"] = 2
+    cases.append(("version 2", d))
+    d = copy.deepcopy(doc)
+    d["bounds"] = {"min": [0, 0, 0]}
+    cases.append(("bounds without max", d))
+    for what, d in cases[:: max(1, len(cases) // 40)]:  # at most ~40 per scene: blendtool runs each
+        mutations += 1
+        s_ok = schema_accepts(d)
+        l_ok, msg = library_accepts(d)
+        if s_ok or l_ok:
+            failures.append("%s, %s: schema %s, library %s (%s)" % (
+                os.path.basename(path), what, "accepts" if s_ok else "rejects",
+                "accepts" if l_ok else "rejects", msg))
+
+# the complete scenes in docs/scene-format.md are valid for both
+doc_scenes = 0
+for block in re.findall(r"```json\n(.*?)```", open(os.path.join(src, "docs", "scene-format.md")).read(), re.S):
+    try:
+        d = json.loads(block)
+    except ValueError:
+        continue  # a fragment
+    if not isinstance(d, dict) or "format" not in d:
+        continue  # a node, not a scene
+    doc_scenes += 1
+    ok, msg = library_accepts(d)
+    if not ok or not schema_accepts(d):
+        failures.append("docs/scene-format.md example: library %s, schema %s" % (msg or "accepts", schema_accepts(d)))
+if doc_scenes == 0:
+    failures.append("docs/scene-format.md has no complete example scene")
+
+# the kinds: the schema's node kinds against the library's list
+doc = {"format": "libblend-scene", "version": 1, "convention": "zero", "root": {"type": "nosuchkind"}}
+ok, msg = library_accepts(doc)
+m = re.search(r"allowed: ([a-z_, ]*)", msg)
+library_kinds = set(re.findall(r"[a-z_]+", m.group(1))) if m else set()
+schema_kinds = {k.split("_", 1)[1] for k in schema["$defs"] if k.startswith(("zero_", "soft_")) and k not in ("zero_node", "soft_node")}
+if not library_kinds or library_kinds != schema_kinds:
+    failures.append("node kinds differ: library %s, schema %s" % (sorted(library_kinds), sorted(schema_kinds)))
+
+for f in failures:
+    print("FAIL:", f)
+print("%d scenes, %d mutations, %d node kinds, %d failures" % (len(scenes), mutations, len(schema_kinds), len(failures)))
+sys.exit(1 if failures else 0)
