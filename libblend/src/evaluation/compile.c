@@ -98,6 +98,33 @@ static double rho_lipschitz(const lb_primitive *P) {
     }
 }
 
+/* Per-node precomputation, once per (node, world -> local map): whatever an
+ * operator can decide before seeing a point goes into its instruction here.
+ * Today that is the fast kernel and its exponent mode, and whether the tape
+ * can cull arguments per box. The map A (and the already compiled argument
+ * instructions, c->ev->ins[in->srci[i]]) is what a node that depends on its
+ * children's geometry needs: the local blend of the Bernhardt paper computes
+ * its children's intersection curves here, stores them in the instruction,
+ * and lb_evaluator_free releases them with the instruction. */
+static lb_status precompute_op(cctx *c, lb__instr *in, const lb__node *n, const lb__affine *A) {
+    (void)A;
+    if (!n->bulge && n->family == LB__F_DISPLACEMENT) {
+        in->fast = LB__FAST_DISPLACEMENT;
+        in->mode = lb__exponent_mode(n->k, n->p);
+    } else if (!n->bulge && n->family == LB__F_CONIC) {
+        in->fast = LB__FAST_CONIC;
+    } else if (!n->bulge && n->family == LB__F_SCALE) {
+        in->fast = LB__FAST_SCALE;
+        in->mode = lb__exponent_mode(n->k, n->p);
+    } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
+        in->fast = LB__FAST_MINMAX;
+    }
+    if (n->k >= 2 && (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC ||
+                      in->fast == LB__FAST_MINMAX))
+        c->ev->cullable = 1;
+    return LB_OK;
+}
+
 static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, uint32_t *out) {
     lb__affine A = *Ap;
     if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
@@ -177,20 +204,7 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         in->srci = srci;
         in->srcb = srcb;
         if (fail) return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
-        if (!n->bulge && n->family == LB__F_DISPLACEMENT) {
-            in->fast = LB__FAST_DISPLACEMENT;
-            in->mode = lb__exponent_mode(n->k, n->p);
-        } else if (!n->bulge && n->family == LB__F_CONIC) {
-            in->fast = LB__FAST_CONIC;
-        } else if (!n->bulge && n->family == LB__F_SCALE) {
-            in->fast = LB__FAST_SCALE;
-            in->mode = lb__exponent_mode(n->k, n->p);
-        } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
-            in->fast = LB__FAST_MINMAX;
-        }
-        if (n->k >= 2 && (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC ||
-                          in->fast == LB__FAST_MINMAX))
-            c->ev->cullable = 1;
+        if ((s = precompute_op(c, in, n, &A))) return s;
     }
     e = memo_find(c, n, &A); /* the table may have grown during recursion */
     e->node = n;
