@@ -5,7 +5,7 @@
  * evaluator are timed alternately in the same process (wall clock, since
  * threads are involved) and the median per-round ratio is reported.
  *
- * Usage: bench_eval [--quick] SCENE_DIR */
+ * Usage: bench_eval [--quick] SCENE_DIR [SCENE.json...] (default: the five below) */
 #define _POSIX_C_SOURCE 200809L
 #include <libblend/libblend.h>
 
@@ -112,14 +112,18 @@ static void bench(const char *dir, const char *file, size_t n, int rounds, int g
 int main(int argc, char **argv) {
     int quick = 0;
     const char *dir = NULL;
+    const char *chosen[32];
+    size_t nchosen = 0;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--quick") == 0)
             quick = 1;
-        else
+        else if (!dir)
             dir = argv[i];
+        else if (nchosen < 32)
+            chosen[nchosen++] = argv[i];
     }
     if (!dir) {
-        fprintf(stderr, "usage: bench_eval [--quick] SCENE_DIR\n");
+        fprintf(stderr, "usage: bench_eval [--quick] SCENE_DIR [SCENE.json...]\n");
         return 2;
     }
     const size_t n = quick ? 4096 : 100000;
@@ -127,11 +131,12 @@ int main(int argc, char **argv) {
     printf("bench_eval: %zu points in the scene bounds (random order, then a grid in scan order), "
            "median of %d alternating rounds; ratio = compiled speed / naive walk speed\n",
            n, rounds);
-    static const char *const scenes[] = {
+    static const char *const defaults[] = {
         "bench-s2-64-spheres.json", "hsu2006-fig7-m0.6.json", "bench-s1-three-spheres.json",
         "hsu-bounded-fig7-stool.json", "hsu-nonuniform-fig6-m0.65.json"};
+    const char *const *scenes = nchosen ? chosen : defaults;
+    const size_t nscenes = nchosen ? nchosen : sizeof defaults / sizeof defaults[0];
     for (int grid = 0; grid < 2; ++grid)
-        for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; ++i)
-            bench(dir, scenes[i], n, rounds, grid);
+        for (size_t i = 0; i < nscenes; ++i) bench(dir, scenes[i], n, rounds, grid);
     return 0;
 }

@@ -184,14 +184,29 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
         p[i] = nd->p ? nd->p[a] : 0.0;
         m[i] = nd->m ? nd->m[a] : 1.0;
     }
+    double *ov = lb__reg(regs, in->dst, 0), *ox = lb__reg(regs, in->dst, 1),
+           *oy = lb__reg(regs, in->dst, 2), *oz = lb__reg(regs, in->dst, 3);
+    if (k == 1 && (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC ||
+                   in->fast == LB__FAST_MINMAX)) {
+        /* one argument left (the plan culled the others): BT_1 is u / m, min
+         * and max the argument itself; a difference that kept only a
+         * subtracted argument negates it (fast_op's duals). One vector loop. */
+        const double sgn = nd->op == LB_DIFFERENCE && act[0] != 0 ? -1.0 : 1.0;
+        const double w = in->fast == LB__FAST_MINMAX ? 1.0 : sgn / m[0];
+        for (size_t j = 0; j < n; ++j) {
+            ov[j] = w * vs[0][j];
+            ox[j] = w * gxs[0][j];
+            oy[j] = w * gys[0][j];
+            oz[j] = w * gzs[0][j];
+        }
+        return LB_OK;
+    }
     double ga[6], dg[6];
     double *dgall = NULL;
     if (nd->bulge) {
         dgall = malloc(6 * LB__CHUNK * sizeof *dgall);
         if (!dgall) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", nd->path);
     }
-    double *ov = lb__reg(regs, in->dst, 0), *ox = lb__reg(regs, in->dst, 1),
-           *oy = lb__reg(regs, in->dst, 2), *oz = lb__reg(regs, in->dst, 3);
     for (size_t j = 0; j < n; ++j) {
         for (size_t i = 0; i < k; ++i) x[i] = vs[i][j];
         double v;
@@ -343,8 +358,8 @@ typedef struct job {
     lb_error err;
 } job;
 
-static uint32_t spread3(uint32_t v) { /* 10 bits -> every third bit */
-    v &= 0x3ffu;
+static uint32_t spread3(uint32_t v) { /* 8 bits -> every third bit */
+    v &= 0xffu;
     v = (v | (v << 16)) & 0x030000ffu;
     v = (v | (v << 8)) & 0x0300f00fu;
     v = (v | (v << 4)) & 0x030c30c3u;
@@ -352,7 +367,8 @@ static uint32_t spread3(uint32_t v) { /* 10 bits -> every third bit */
     return v;
 }
 
-/* Morton order of the points (a stable LSD radix sort on 30-bit codes).
+/* Morton order of the points (a stable LSD radix sort on 24-bit codes:
+ * 256 cells per axis is finer than any chunk of a batch worth sorting).
  * Returns NULL when memory is short: the input order is then used. */
 static uint32_t *morton_order(size_t n, const double *x, const double *y, const double *z) {
     if (n > UINT32_MAX) return NULL;
@@ -370,7 +386,7 @@ static uint32_t *morton_order(size_t n, const double *x, const double *y, const 
             if (P[d][i] > hi[d]) hi[d] = P[d][i];
         }
     double sc[3];
-    for (int d = 0; d < 3; ++d) sc[d] = hi[d] > lo[d] ? 1023.999 / (hi[d] - lo[d]) : 0.0;
+    for (int d = 0; d < 3; ++d) sc[d] = hi[d] > lo[d] ? 255.999 / (hi[d] - lo[d]) : 0.0;
     for (size_t i = 0; i < n; ++i) {
         key[i] = spread3((uint32_t)((x[i] - lo[0]) * sc[0])) |
                  spread3((uint32_t)((y[i] - lo[1]) * sc[1])) << 1 |
@@ -378,7 +394,7 @@ static uint32_t *morton_order(size_t n, const double *x, const double *y, const 
         idx[i] = (uint32_t)i;
     }
     uint32_t *k0 = key, *k1 = key + n, *i0 = idx, *i1 = idx + n;
-    for (int shift = 0; shift < 32; shift += 8) {
+    for (int shift = 0; shift < 24; shift += 8) {
         size_t count[257] = {0};
         for (size_t i = 0; i < n; ++i) count[((k0[i] >> shift) & 0xffu) + 1]++;
         for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
@@ -394,7 +410,8 @@ static uint32_t *morton_order(size_t n, const double *x, const double *y, const 
         i0 = i1;
         i1 = t;
     }
-    /* four passes: the sorted order is back in the first half */
+    /* three passes: the sorted order is in the second half */
+    memmove(idx, i0, n * sizeof *idx);
     free(key);
     return idx;
 }
@@ -406,7 +423,11 @@ static void run_blocks(job *J) {
     lb__iv *R = malloc(ev->nregs * sizeof *R);
     lb__plan plan = {malloc(ev->n), malloc(ev->n * sizeof *plan.nact),
                      malloc((ev->total_k ? ev->total_k : 1) * sizeof *plan.act)};
-    const int ok = regs && R && plan.need && plan.nact && plan.act;
+    /* a block's points gathered into visiting order, and its results: the
+     * random reads and writes of a Morton order happen in two tight loops
+     * (many loads in flight) instead of between chunks */
+    double *buf = J->order ? malloc(7 * BLOCK_CHUNKS * LB__CHUNK * sizeof *buf) : NULL;
+    const int ok = regs && R && plan.need && plan.nact && plan.act && (buf || !J->order);
     const size_t nblocks = (J->n + BLOCK_CHUNKS * LB__CHUNK - 1) / (BLOCK_CHUNKS * LB__CHUNK);
     for (;;) {
         const size_t b = atomic_fetch_add(&J->next, 1);
@@ -414,18 +435,34 @@ static void run_blocks(job *J) {
         lb_error e = {LB_OK, ""};
         lb_status s = LB_OK;
         if (!ok) s = lb__fail(&e, LB_ERR_NO_MEMORY, "lb_evaluator_eval: out of memory");
+        const size_t begin = b * BLOCK_CHUNKS * LB__CHUNK;
         const size_t end =
             (b + 1) * BLOCK_CHUNKS * LB__CHUNK < J->n ? (b + 1) * BLOCK_CHUNKS * LB__CHUNK : J->n;
-        for (size_t o = b * BLOCK_CHUNKS * LB__CHUNK; o < end && !s; o += LB__CHUNK) {
-            const size_t m = end - o < LB__CHUNK ? end - o : LB__CHUNK;
-            double cx[LB__CHUNK], cy[LB__CHUNK], cz[LB__CHUNK];
+        const size_t nb = end - begin;
+        /* coordinates and outputs of this block, in visiting order */
+        const double *bx = J->x + begin, *by = J->y + begin, *bz = J->z + begin;
+        double *ov = J->v + begin, *ogx = J->gx ? J->gx + begin : NULL,
+               *ogy = J->gy ? J->gy + begin : NULL, *ogz = J->gz ? J->gz + begin : NULL;
+        if (J->order && ok) {
+            const uint32_t *ord = J->order + begin;
+            double *gxb = buf, *gyb = buf + nb, *gzb = buf + 2 * nb;
+            for (size_t j = 0; j < nb; ++j) gxb[j] = J->x[ord[j]];
+            for (size_t j = 0; j < nb; ++j) gyb[j] = J->y[ord[j]];
+            for (size_t j = 0; j < nb; ++j) gzb[j] = J->z[ord[j]];
+            bx = gxb;
+            by = gyb;
+            bz = gzb;
+            ov = buf + 3 * nb;
+            ogx = J->gx ? buf + 4 * nb : NULL;
+            ogy = J->gy ? buf + 5 * nb : NULL;
+            ogz = J->gz ? buf + 6 * nb : NULL;
+        }
+        for (size_t o = 0; o < nb && !s; o += LB__CHUNK) {
+            const size_t m = nb - o < LB__CHUNK ? nb - o : LB__CHUNK;
+            const double *cx = bx + o, *cy = by + o, *cz = bz + o;
             double lo[3] = {INFINITY, INFINITY, INFINITY},
                    hi[3] = {-INFINITY, -INFINITY, -INFINITY};
             for (size_t j = 0; j < m; ++j) {
-                const size_t q = J->order ? J->order[o + j] : o + j;
-                cx[j] = J->x[q];
-                cy[j] = J->y[q];
-                cz[j] = J->z[q];
                 const double P[3] = {cx[j], cy[j], cz[j]};
                 for (int d = 0; d < 3; ++d) {
                     if (P[d] < lo[d]) lo[d] = P[d];
@@ -439,13 +476,20 @@ static void run_blocks(job *J) {
             if (s) break;
             const double *rv = lb__reg(regs, ev->out, 0), *rx = lb__reg(regs, ev->out, 1),
                          *ry = lb__reg(regs, ev->out, 2), *rz = lb__reg(regs, ev->out, 3);
-            for (size_t j = 0; j < m; ++j) {
-                const size_t q = J->order ? J->order[o + j] : o + j;
-                J->v[q] = rv[j];
-                if (J->gx) J->gx[q] = rx[j];
-                if (J->gy) J->gy[q] = ry[j];
-                if (J->gz) J->gz[q] = rz[j];
-            }
+            memcpy(ov + o, rv, m * sizeof *rv);
+            if (ogx) memcpy(ogx + o, rx, m * sizeof *rx);
+            if (ogy) memcpy(ogy + o, ry, m * sizeof *ry);
+            if (ogz) memcpy(ogz + o, rz, m * sizeof *rz);
+        }
+        if (J->order && ok && !s) {
+            const uint32_t *ord = J->order + begin;
+            for (size_t j = 0; j < nb; ++j) J->v[ord[j]] = ov[j];
+            if (ogx)
+                for (size_t j = 0; j < nb; ++j) J->gx[ord[j]] = ogx[j];
+            if (ogy)
+                for (size_t j = 0; j < nb; ++j) J->gy[ord[j]] = ogy[j];
+            if (ogz)
+                for (size_t j = 0; j < nb; ++j) J->gz[ord[j]] = ogz[j];
         }
         if (s) {
             pthread_mutex_lock(&J->lock);
@@ -459,6 +503,7 @@ static void run_blocks(job *J) {
     }
     free(regs);
     free(R);
+    free(buf);
     free(plan.need);
     free(plan.nact);
     free(plan.act);

@@ -43,12 +43,19 @@ static inline double lb__rho(lb_primitive_kind kind, const lb_primitive *P, cons
             if (g) g[0] = g[1] = g[2] = 0.0;
             return 0.0;
         }
-        for (int i = 0; i < 3; ++i) s += pow(u[i] / mx, n);
-        const double f = mx * pow(s, 1.0 / n);
+        /* four pow() calls: (u_i/f)^(n-1) = (u_i/mx)^n / (u_i/mx) * (f/mx) / s */
+        double Pn[3];
+        for (int i = 0; i < 3; ++i) {
+            Pn[i] = u[i] > 0.0 ? pow(u[i] / mx, n) : 0.0;
+            s += Pn[i];
+        }
+        const double f1 = pow(s, 1.0 / n); /* rho at the scaled point, in [1, 3] */
         if (g)
             for (int i = 0; i < 3; ++i)
-                g[i] = pow(u[i] / f, n - 1.0) * (d[i] < 0.0 ? -1.0 : 1.0) / P->a[i];
-        return f;
+                g[i] = u[i] > 0.0
+                           ? Pn[i] / (u[i] / mx) * (f1 / s) * (d[i] < 0.0 ? -1.0 : 1.0) / P->a[i]
+                           : 0.0;
+        return mx * f1;
     }
     case LB_PRIM_SUPERQUADRIC: {
         const double e1 = P->s0, e2 = P->s1, al = 2.0 / e2, be = 2.0 / e1;
@@ -61,12 +68,13 @@ static inline double lb__rho(lb_primitive_kind kind, const lb_primitive *P, cons
             return 0.0;
         }
         for (int i = 0; i < 3; ++i) u[i] /= mx;
-        /* five pow() calls; the gradient reuses them (u^(a-1) = u^a / u) */
+        /* five pow() calls (four when e1 = e2); the gradient reuses them
+         * (u^(a-1) = u^a / u) */
         const double P0 = u[0] > 0.0 ? pow(u[0], al) : 0.0;
         const double P1 = u[1] > 0.0 ? pow(u[1], al) : 0.0;
         const double P2 = u[2] > 0.0 ? pow(u[2], be) : 0.0;
         const double A = P0 + P1;
-        const double B = A > 0.0 ? pow(A, be / al) : 0.0;
+        const double B = al == be ? A : A > 0.0 ? pow(A, be / al) : 0.0;
         const double S = B + P2;
         const double f1 = pow(S, 1.0 / be); /* rho at the scaled point */
         if (g) {
