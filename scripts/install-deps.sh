@@ -9,6 +9,7 @@ PACKAGES=(
   libcmocka-dev              # unit-test framework used by tests/
   libcjson-dev               # JSON parser for scene files
   python3-jsonschema         # tests: scene files against docs/libblend-scene.schema.json
+  python3-numpy              # tests: independent mesh readers and checks (tests/mesh/)
 )
 
 missing=()

@@ -8,7 +8,8 @@
 #include <string.h>
 #include <unistd.h>
 
-static const bt_command *const COMMANDS[] = {&bt_cmd_validate, &bt_cmd_info, &bt_cmd_eval};
+static const bt_command *const COMMANDS[] = {&bt_cmd_validate, &bt_cmd_info, &bt_cmd_eval,
+                                             &bt_cmd_mesh};
 #define NCOMMANDS (sizeof COMMANDS / sizeof COMMANDS[0])
 
 int bt_exit_for(lb_status s) {

@@ -42,7 +42,9 @@ typedef enum lb_status {
     LB_ERR_INVALID_ARGUMENT = 1, /* a parameter is outside its documented range */
     LB_ERR_NOT_FINITE = 2,       /* an input value is NaN or infinite */
     LB_ERR_NO_MEMORY = 3,        /* an allocation failed or a size limit was hit */
-    LB_ERR_INTERNAL = 4          /* a bug in libblend: please report it */
+    LB_ERR_INTERNAL = 4,         /* a bug in libblend: please report it */
+    LB_ERR_CANCELLED = 5,        /* the caller cancelled a long run (progress callback, flag) */
+    LB_ERR_IO = 6                /* a file could not be read or written */
 } lb_status;
 
 #define LB_ERROR_MESSAGE_SIZE 512

@@ -6,5 +6,6 @@
 #include "operators.h"
 #include "primitives.h"
 #include "scene.h"
+#include "mesh.h"
 
 #endif

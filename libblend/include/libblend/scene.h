@@ -115,6 +115,9 @@ typedef struct lb_evaluator lb_evaluator;
 LB_API lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_error *err);
 LB_API void lb_evaluator_free(lb_evaluator *ev);
 
+/* The convention of the scene the evaluator was compiled from. */
+LB_API lb_convention lb_evaluator_convention(const lb_evaluator *ev);
+
 /* Number of instructions on the tape. */
 LB_API size_t lb_evaluator_size(const lb_evaluator *ev);
 

@@ -20,6 +20,10 @@ const char *lb_status_string(lb_status status) {
         return "out of memory or over a size limit";
     case LB_ERR_INTERNAL:
         return "internal error";
+    case LB_ERR_CANCELLED:
+        return "cancelled";
+    case LB_ERR_IO:
+        return "input/output error";
     }
     return "unknown status";
 }

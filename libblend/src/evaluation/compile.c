@@ -315,3 +315,7 @@ lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_erro
     *out = ev;
     return LB_OK;
 }
+
+lb_convention lb_evaluator_convention(const lb_evaluator *ev) {
+    return ev ? ev->conv : LB_CONVENTION_ZERO;
+}

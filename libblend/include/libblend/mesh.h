@@ -1,0 +1,109 @@
+/* libblend meshing: watertight, manifold triangle meshes of a compiled scene.
+ *
+ * Contract (stated once for the whole header):
+ *  - lb_mesh_create reads a compiled evaluator (read-only, so several meshes
+ *    of one evaluator may be built at once) and returns a mesh the caller
+ *    frees with lb_mesh_free, the only free function. All arrays in the mesh
+ *    belong to it.
+ *  - The mesh is the surface of the scene's solid (zero convention f < 0,
+ *    soft convention f > 0.5) inside the region: indexed triangles with
+ *    shared vertices, counter-clockwise seen from outside, every vertex on
+ *    the surface (refined along its grid edge by a safeguarded root solve to
+ *    |f| / |grad f| <= 1e-7 cell sizes) with its normal from the analytic
+ *    gradient. Closed (every edge in exactly two triangles) and 2-manifold;
+ *    where the region cuts the solid the mesh is closed by a cap on the
+ *    region's faces, or left open with LB_MESH_OPEN_BOUNDARY.
+ *  - The output does not depend on the thread count: the same vertices and
+ *    triangles in the same order, bit for bit.
+ *  - Threads: opt->threads (0 = one per online CPU, 1 = the calling thread
+ *    only). The progress callback runs only on the calling thread.
+ *  - Limits: the region is cut into at most LB_MESH_MAX_CELLS_PER_AXIS cells
+ *    per axis; the memory a run may use is capped (opt->max_memory); a run
+ *    that would exceed either fails before the large allocations, with a
+ *    message naming the limit and the resolution that would fit.
+ *
+ * Method (docs/meshing.md): the grid is split into blocks of 8^3 cells; an
+ * octree over the blocks skips every box whose interval bound
+ * (lb_evaluator_bounds) excludes the surface, so the cost grows with the
+ * surface area, not the volume. Each remaining cell is split into six
+ * tetrahedra along its main diagonal (the Kuhn/Freudenthal triangulation,
+ * the same split in every cell, so neighbouring cells agree on every shared
+ * face): marching tetrahedra has no ambiguous cases, which is why the result
+ * is always a closed 2-manifold. */
+#ifndef LIBBLEND_MESH_H
+#define LIBBLEND_MESH_H
+
+#include "scene.h"
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LB_MESH_MAX_CELLS_PER_AXIS 8192
+#define LB_MESH_DEFAULT_RESOLUTION 128
+#define LB_MESH_DEFAULT_MAX_MEMORY ((size_t)8 << 30) /* 8 GiB */
+
+/* flags */
+#define LB_MESH_OPEN_BOUNDARY 1u /* do not close the mesh where the region cuts the solid */
+
+/* Called on the calling thread with the fraction of work done, in [0, 1];
+ * return non-zero to cancel the run (lb_mesh_create then fails with
+ * LB_ERR_CANCELLED and returns no mesh). */
+typedef int (*lb_mesh_progress_fn)(double fraction, void *user);
+
+typedef struct lb_mesh_options {
+    double bmin[3], bmax[3];      /* the region (required: bmin < bmax on every axis) */
+    unsigned resolution;          /* cells along the region's longest side, 1..8192 */
+    double cell_size;             /* > 0: use this cell size instead of resolution */
+    unsigned flags;               /* LB_MESH_* */
+    int threads;                  /* 0 = one per online CPU, 1 = calling thread only */
+    size_t max_memory;            /* bytes; 0 = LB_MESH_DEFAULT_MAX_MEMORY */
+    lb_mesh_progress_fn progress; /* may be NULL */
+    void *user;                   /* passed to progress */
+    const volatile int *cancel;   /* may be NULL; non-zero cancels (from any thread) */
+} lb_mesh_options;
+
+typedef struct lb_mesh {
+    size_t nvertices;
+    size_t ntriangles;
+    double *positions;   /* 3 per vertex */
+    double *normals;     /* 3 per vertex, unit length, pointing out of the solid */
+    uint32_t *triangles; /* 3 vertex indices per triangle, counter-clockwise from outside */
+    /* the grid that was used */
+    double origin[3];  /* the first grid node */
+    double cell[3];    /* cell size per axis (equal unless the region forced otherwise) */
+    unsigned cells[3]; /* cells per axis covering the region */
+} lb_mesh;
+
+/* Defaults: resolution LB_MESH_DEFAULT_RESOLUTION, closed, all CPUs, the
+ * default memory cap; the region is left empty (bmin = bmax = 0) and must
+ * be set. */
+LB_API void lb_mesh_options_init(lb_mesh_options *opt);
+
+/* Mesh the field of ev over opt's region. On failure *out is NULL. */
+LB_API lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_mesh **out,
+                                lb_error *err);
+
+LB_API void lb_mesh_free(lb_mesh *mesh);
+
+typedef enum lb_mesh_format {
+    LB_MESH_FORMAT_AUTO = 0, /* from the file name's extension */
+    LB_MESH_FORMAT_PLY = 1,  /* binary little-endian PLY, float positions and normals */
+    LB_MESH_FORMAT_OBJ = 2,  /* Wavefront OBJ with normals (v, vn, f v//vn) */
+    LB_MESH_FORMAT_STL = 3,  /* binary STL, facet normals from the triangles */
+    LB_MESH_FORMAT_GLB = 4   /* glTF 2.0 binary: POSITION, NORMAL, indices */
+} lb_mesh_format;
+
+/* Write the mesh to path, atomically: a temporary file in the same folder
+ * is renamed over path only when everything was written, so a failure
+ * leaves no partial file. */
+LB_API lb_status lb_mesh_write(const lb_mesh *mesh, const char *path, lb_mesh_format format,
+                               lb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

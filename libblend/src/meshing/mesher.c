@@ -1,0 +1,507 @@
+/* lb_mesh_create: grid, sparse block selection, parallel phases, merge.
+ *
+ * 1. The region is cut into cells (resolution along the longest side); for
+ *    a closed mesh the grid gets half a cell of margin on every side, so
+ *    every outermost node lies outside the region box and the surface of
+ *    max(phi, box) closes on the region's faces.
+ * 2. Blocks of 8^3 cells: an octree over block ranges keeps the blocks whose
+ *    interval bound of phi_c (lb_evaluator_bounds) contains 0.
+ * 3. In parallel, each kept block evaluates its (8+1)^3 node values.
+ * 4. Nodes on a block's far faces are also nodes of the next block: they
+ *    take that block's value, so both sides see the same signs (the
+ *    evaluator's per-batch culling may differ in the last bit).
+ * 5. In parallel, marching tetrahedra per block (tetra.c, refine.c).
+ * 6. One thread merges the blocks in block order, sharing the vertex of an
+ *    edge two blocks both cut (the first block's copy), so the output is the
+ *    same for every thread count.
+ * Threads take blocks from a shared counter; the calling thread works too
+ * and is the only one that calls the progress callback. */
+#include "mesh_internal.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static const char FN[] = "lb_mesh_create";
+
+void lb_mesh_options_init(lb_mesh_options *opt) {
+    if (!opt) return;
+    memset(opt, 0, sizeof *opt);
+    opt->resolution = LB_MESH_DEFAULT_RESOLUTION;
+}
+
+void lb_mesh_free(lb_mesh *mesh) {
+    if (!mesh) return;
+    free(mesh->positions);
+    free(mesh->normals);
+    free(mesh->triangles);
+    free(mesh);
+}
+
+/* ---- the grid ---- */
+
+static lb_status make_grid(const lb_evaluator *ev, const lb_mesh_options *o, lb__grid *g,
+                           lb_error *err) {
+    memset(g, 0, sizeof *g);
+    double ext[3], longest = 0.0;
+    for (int d = 0; d < 3; ++d) {
+        if (!isfinite(o->bmin[d]) || !isfinite(o->bmax[d]) ||
+            fabs(o->bmin[d]) > LB_SCENE_MAX_COORD || fabs(o->bmax[d]) > LB_SCENE_MAX_COORD)
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: region %s[%d] = %g; allowed: finite, |value| <= %g", FN,
+                            !isfinite(o->bmin[d]) || fabs(o->bmin[d]) > LB_SCENE_MAX_COORD ? "bmin"
+                                                                                           : "bmax",
+                            d, !isfinite(o->bmin[d]) ? o->bmin[d] : o->bmax[d], LB_SCENE_MAX_COORD);
+        if (!(o->bmin[d] < o->bmax[d]))
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: region min[%d] = %g is not below max[%d] = %g; allowed: "
+                            "min < max on every axis",
+                            FN, d, o->bmin[d], d, o->bmax[d]);
+        ext[d] = o->bmax[d] - o->bmin[d];
+        if (ext[d] > longest) longest = ext[d];
+    }
+    double h;
+    if (o->cell_size != 0.0) {
+        if (!(o->cell_size > 0.0) || !isfinite(o->cell_size))
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: cell_size = %g; allowed: a positive number (or 0 to use the "
+                            "resolution)",
+                            FN, o->cell_size);
+        h = o->cell_size;
+    } else {
+        if (o->resolution < 1 || o->resolution > LB_MESH_MAX_CELLS_PER_AXIS)
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: resolution = %u; allowed: 1 to %d cells along the longest side",
+                            FN, o->resolution, LB_MESH_MAX_CELLS_PER_AXIS);
+        h = longest / o->resolution;
+    }
+    g->closed = !(o->flags & LB_MESH_OPEN_BOUNDARY);
+    g->soft = lb_evaluator_convention(ev) == LB_CONVENTION_SOFT;
+    for (int d = 0; d < 3; ++d) {
+        const double nf = ceil(ext[d] / h - 1e-9);
+        if (!(nf <= LB_MESH_MAX_CELLS_PER_AXIS))
+            return lb__fail(err, LB_ERR_NO_MEMORY,
+                            "%s: %.0f cells along axis %d (cell size %g); allowed: at most %d "
+                            "cells per axis (a cell size of at least %g)",
+                            FN, nf, d, h, LB_MESH_MAX_CELLS_PER_AXIS,
+                            longest / LB_MESH_MAX_CELLS_PER_AXIS);
+        const uint32_t n = nf < 1.0 ? 1u : (uint32_t)nf;
+        g->h[d] = ext[d] / n;
+        g->bmin[d] = o->bmin[d];
+        g->bmax[d] = o->bmax[d];
+        g->cells[d] = n + (g->closed ? 1u : 0u);
+        g->N[d] = g->cells[d] + 1;
+        g->origin[d] = o->bmin[d] - (g->closed ? 0.5 * g->h[d] : 0.0);
+    }
+    return LB_OK;
+}
+
+/* An interval of phi_c over the nodes [n0, n1] (inclusive) of the grid. */
+static lb_status box_phi(const lb_evaluator *ev, const lb__grid *g, const uint64_t n0[3],
+                         const uint64_t n1[3], double *lo, double *hi, lb_error *err) {
+    double bl[3], bh[3];
+    lb__node_pos(g, n0[0], n0[1], n0[2], bl);
+    lb__node_pos(g, n1[0], n1[1], n1[2], bh);
+    double flo, fhi;
+    lb_status s = lb_evaluator_bounds(ev, bl, bh, &flo, &fhi, err);
+    if (s) return s;
+    double plo = g->soft ? 0.5 - fhi : flo, phi = g->soft ? 0.5 - flo : fhi;
+    if (g->closed) {
+        for (int d = 0; d < 3; ++d) {
+            /* max of the box terms g->bmin - X and X - g->bmax, each linear */
+            const double l1 = g->bmin[d] - bh[d], h1 = g->bmin[d] - bl[d];
+            const double l2 = bl[d] - g->bmax[d], h2 = bh[d] - g->bmax[d];
+            if (l1 > plo) plo = l1;
+            if (l2 > plo) plo = l2;
+            if (h1 > phi) phi = h1;
+            if (h2 > phi) phi = h2;
+        }
+    }
+    *lo = plo;
+    *hi = phi;
+    return LB_OK;
+}
+
+/* ---- block selection (octree over block ranges) ---- */
+
+typedef struct blist {
+    lb__block *b;
+    size_t n, cap;
+} blist;
+
+static lb_status select_blocks(const lb_evaluator *ev, const lb__grid *g, const uint32_t r0[3],
+                               const uint32_t r1[3], const uint32_t nb[3], blist *L,
+                               size_t max_blocks, lb_error *err) {
+    uint64_t n0[3], n1[3];
+    for (int d = 0; d < 3; ++d) {
+        n0[d] = (uint64_t)r0[d] * LB__MB;
+        n1[d] = (uint64_t)r1[d] * LB__MB;
+        if (n1[d] > g->cells[d]) n1[d] = g->cells[d];
+    }
+    double lo, hi;
+    lb_status s = box_phi(ev, g, n0, n1, &lo, &hi, err);
+    if (s) return s;
+    if (lo >= 0.0 || hi < 0.0) return LB_OK; /* all outside, or all inside */
+    int axis = -1;
+    uint32_t span = 1;
+    for (int d = 0; d < 3; ++d)
+        if (r1[d] - r0[d] > span) {
+            span = r1[d] - r0[d];
+            axis = d;
+        }
+    if (axis < 0) {
+        if (L->n >= max_blocks)
+            return lb__fail(err, LB_ERR_NO_MEMORY, "%s: more than %zu blocks", FN, max_blocks);
+        if (L->n == L->cap) {
+            const size_t nc = L->cap ? 2 * L->cap : 256;
+            lb__block *q = realloc(L->b, nc * sizeof *q);
+            if (!q) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+            L->b = q;
+            L->cap = nc;
+        }
+        lb__block *B = &L->b[L->n++];
+        memset(B, 0, sizeof *B);
+        for (int d = 0; d < 3; ++d) {
+            B->b[d] = r0[d];
+            B->nc[d] = (uint32_t)(n1[d] - n0[d]);
+        }
+        B->id = ((uint64_t)r0[2] * nb[1] + r0[1]) * nb[0] + r0[0];
+        return LB_OK;
+    }
+    const uint32_t mid = r0[axis] + span / 2;
+    uint32_t a1[3] = {r1[0], r1[1], r1[2]}, b0[3] = {r0[0], r0[1], r0[2]};
+    a1[axis] = mid;
+    b0[axis] = mid;
+    if ((s = select_blocks(ev, g, r0, a1, nb, L, max_blocks, err))) return s;
+    return select_blocks(ev, g, b0, r1, nb, L, max_blocks, err);
+}
+
+static int cmp_block(const void *a, const void *b) {
+    const uint64_t x = ((const lb__block *)a)->id, y = ((const lb__block *)b)->id;
+    return x < y ? -1 : x > y;
+}
+
+/* ---- parallel phases ---- */
+
+enum { PH_NODES, PH_SHARE, PH_MESH };
+
+typedef struct run {
+    const lb_evaluator *ev;
+    const lb__grid *g;
+    lb__block *blocks;
+    size_t nblocks;
+    uint32_t nb[3];
+    int phase;
+    atomic_size_t next, done;
+    atomic_int stop;
+    const volatile int *cancel;
+    pthread_mutex_t lock;
+    size_t err_block;
+    lb_error err;
+} run;
+
+static lb__block *find_block(run *R, const uint32_t b[3]) {
+    const uint64_t id = ((uint64_t)b[2] * R->nb[1] + b[1]) * R->nb[0] + b[0];
+    size_t lo = 0, hi = R->nblocks;
+    while (lo < hi) {
+        const size_t m = lo + (hi - lo) / 2;
+        if (R->blocks[m].id < id)
+            lo = m + 1;
+        else
+            hi = m;
+    }
+    return lo < R->nblocks && R->blocks[lo].id == id ? &R->blocks[lo] : NULL;
+}
+
+static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
+    const lb__grid *g = R->g;
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
+    const size_t n = (size_t)D0 * D1 * D2;
+    double *mem = malloc(7 * n * sizeof *mem);
+    B->vals = malloc(n * sizeof *B->vals);
+    if (!mem || !B->vals) {
+        free(mem);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    }
+    double *x = mem, *y = x + n, *z = y + n, *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
+    size_t q = 0;
+    for (uint32_t k = 0; k < D2; ++k)
+        for (uint32_t j = 0; j < D1; ++j)
+            for (uint32_t i = 0; i < D0; ++i, ++q) {
+                double X[3];
+                lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + i, (uint64_t)B->b[1] * LB__MB + j,
+                             (uint64_t)B->b[2] * LB__MB + k, X);
+                x[q] = X[0];
+                y[q] = X[1];
+                z[q] = X[2];
+            }
+    lb_status s = lb_evaluator_eval(R->ev, n, x, y, z, v, gx, gy, gz, 1, err);
+    for (size_t i = 0; i < n && !s; ++i) {
+        const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
+        double gp[3];
+        B->vals[i] = lb__mesh_phi(g, X, v[i], gf, gp);
+    }
+    free(mem);
+    return s;
+}
+
+/* Far-face nodes take the value of the block that owns them. */
+static void block_share(run *R, lb__block *B) {
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
+    for (uint32_t k = 0; k < D2; ++k)
+        for (uint32_t j = 0; j < D1; ++j)
+            for (uint32_t i = 0; i < D0; ++i) {
+                const uint32_t l[3] = {i, j, k};
+                uint32_t ob[3], ol[3];
+                int other = 0;
+                for (int d = 0; d < 3; ++d) {
+                    ob[d] = B->b[d];
+                    ol[d] = l[d];
+                    if (l[d] == LB__MB && B->b[d] + 1 < R->nb[d]) {
+                        ob[d] = B->b[d] + 1;
+                        ol[d] = 0;
+                        other = 1;
+                    }
+                }
+                if (!other) continue;
+                const lb__block *O = find_block(R, ob);
+                if (!O) continue;
+                const uint32_t E0 = O->nc[0] + 1, E1 = O->nc[1] + 1;
+                B->vals[((size_t)k * D1 + j) * D0 + i] =
+                    O->vals[((size_t)ol[2] * E1 + ol[1]) * E0 + ol[0]];
+            }
+}
+
+/* One block of the current phase; failures keep the first block's error. */
+static void do_block(run *R, size_t i) {
+    lb_error e = {LB_OK, ""};
+    lb_status s = LB_OK;
+    lb__block *B = &R->blocks[i];
+    if (R->phase == PH_NODES)
+        s = block_nodes(R, B, &e);
+    else if (R->phase == PH_SHARE)
+        block_share(R, B);
+    else
+        s = lb__mesh_block(R->ev, R->g, B, &e);
+    if (s) {
+        pthread_mutex_lock(&R->lock);
+        if (i < R->err_block) {
+            R->err_block = i;
+            R->err = e;
+        }
+        pthread_mutex_unlock(&R->lock);
+        atomic_store(&R->stop, 1);
+    }
+    atomic_fetch_add(&R->done, 1);
+}
+
+static int stopped(run *R) {
+    if (atomic_load(&R->stop)) return 1;
+    if (R->cancel && *R->cancel) {
+        atomic_store(&R->stop, 1);
+        return 1;
+    }
+    return 0;
+}
+
+static void *worker(void *arg) {
+    run *R = arg;
+    while (!stopped(R)) {
+        const size_t i = atomic_fetch_add(&R->next, 1);
+        if (i >= R->nblocks) break;
+        do_block(R, i);
+    }
+    return NULL;
+}
+
+typedef struct progress {
+    lb_mesh_progress_fn fn;
+    void *user;
+    double base, weight;
+    int cancelled;
+} progress;
+
+/* One phase on nt threads; the calling thread works too and is the only
+ * one that reports progress (between its own blocks). */
+static lb_status phase(run *R, int ph, size_t nt, progress *P) {
+    R->phase = ph;
+    atomic_store(&R->next, 0);
+    atomic_store(&R->done, 0);
+    pthread_t tid[256];
+    size_t started = 0;
+    for (size_t t = 1; t < nt && t < 256; ++t) {
+        if (pthread_create(&tid[started], NULL, worker, R) != 0) break;
+        ++started;
+    }
+    while (!stopped(R)) {
+        if (P->fn) {
+            const double f = P->base + P->weight * (double)atomic_load(&R->done) /
+                                           (double)(R->nblocks ? R->nblocks : 1);
+            if (P->fn(f, P->user)) {
+                P->cancelled = 1;
+                atomic_store(&R->stop, 1);
+                break;
+            }
+        }
+        const size_t i = atomic_fetch_add(&R->next, 1);
+        if (i >= R->nblocks) break;
+        do_block(R, i);
+    }
+    for (size_t t = 0; t < started; ++t) pthread_join(tid[t], NULL);
+    P->base += P->weight;
+    if (R->cancel && *R->cancel) P->cancelled = 1;
+    return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
+}
+
+/* ---- merge ---- */
+
+static lb_status merge(const run *R, lb_mesh *M, lb_error *err) {
+    size_t tv = 0, tt = 0;
+    for (size_t i = 0; i < R->nblocks; ++i) {
+        tv += R->blocks[i].nv;
+        tt += R->blocks[i].nt;
+    }
+    if (tv > UINT32_MAX)
+        return lb__fail(err, LB_ERR_NO_MEMORY,
+                        "%s: more than %u vertices; allowed: fewer (a coarser resolution)", FN,
+                        UINT32_MAX);
+    size_t cap = 64;
+    while (cap < 2 * tv) cap *= 2;
+    uint64_t *keys = calloc(cap, sizeof *keys);
+    uint32_t *vals = malloc(cap * sizeof *vals);
+    uint32_t *local = malloc((LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1) * 8 * sizeof *local);
+    M->positions = malloc(3 * (tv ? tv : 1) * sizeof *M->positions);
+    M->normals = malloc(3 * (tv ? tv : 1) * sizeof *M->normals);
+    M->triangles = malloc(3 * (tt ? tt : 1) * sizeof *M->triangles);
+    lb_status s = LB_OK;
+    if (!keys || !vals || !local || !M->positions || !M->normals || !M->triangles) {
+        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        goto done;
+    }
+    size_t nv = 0, nt = 0;
+    for (size_t b = 0; b < R->nblocks; ++b) {
+        const lb__block *B = &R->blocks[b];
+        for (size_t i = 0; i < B->nv; ++i) {
+            const uint64_t key = B->vkey[i];
+            size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
+            while (keys[h] && keys[h] != key) h = (h + 1) & (cap - 1);
+            if (!keys[h]) {
+                keys[h] = key;
+                vals[h] = (uint32_t)nv;
+                memcpy(M->positions + 3 * nv, B->vpos + 3 * i, 3 * sizeof(double));
+                memcpy(M->normals + 3 * nv, B->vnrm + 3 * i, 3 * sizeof(double));
+                ++nv;
+            }
+            local[i] = vals[h];
+        }
+        for (size_t t = 0; t < 3 * B->nt; ++t) M->triangles[3 * nt + t] = local[B->tri[t]];
+        nt += B->nt;
+    }
+    M->nvertices = nv;
+    M->ntriangles = nt;
+    if (nv) {
+        double *p = realloc(M->positions, 3 * nv * sizeof *p);
+        if (p) M->positions = p;
+        double *q = realloc(M->normals, 3 * nv * sizeof *q);
+        if (q) M->normals = q;
+    }
+done:
+    free(keys);
+    free(vals);
+    free(local);
+    return s;
+}
+
+/* Estimated bytes per kept block (node values, crossing edges, output). */
+#define BLOCK_BYTES ((size_t)128 * 1024)
+
+lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_mesh **out,
+                         lb_error *err) {
+    if (out) *out = NULL;
+    if (!ev || !opt || !out)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: ev, opt and out must be non-NULL", FN);
+    if (opt->threads < 0)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: threads = %d; allowed: 0 (one per CPU) or a positive count", FN,
+                        opt->threads);
+    if (opt->flags & ~(unsigned)LB_MESH_OPEN_BOUNDARY)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: flags = %#x; allowed: 0 or LB_MESH_OPEN_BOUNDARY", FN, opt->flags);
+    lb__grid g;
+    lb_status s = make_grid(ev, opt, &g, err);
+    if (s) return s;
+    const size_t max_memory = opt->max_memory ? opt->max_memory : LB_MESH_DEFAULT_MAX_MEMORY;
+    const size_t max_blocks = max_memory / BLOCK_BYTES;
+    run R;
+    memset(&R, 0, sizeof R);
+    R.ev = ev;
+    R.g = &g;
+    R.cancel = opt->cancel;
+    R.err_block = SIZE_MAX;
+    for (int d = 0; d < 3; ++d) R.nb[d] = (g.cells[d] + LB__MB - 1) / LB__MB;
+    progress P = {opt->progress, opt->user, 0.0, 0.05, 0};
+    blist L = {NULL, 0, 0};
+    const uint32_t zero[3] = {0, 0, 0};
+    s = select_blocks(ev, &g, zero, R.nb, R.nb, &L, max_blocks, err);
+    if (s == LB_ERR_NO_MEMORY && L.n >= max_blocks) {
+        const double res = (double)g.cells[0] > g.cells[1] ? g.cells[0] : g.cells[1];
+        s = lb__fail(err, LB_ERR_NO_MEMORY,
+                     "%s: the surface crosses more than %zu blocks of %d^3 cells at %u x %u x %u "
+                     "cells, over the memory cap of %zu MiB; allowed: a coarser resolution "
+                     "(about %.0f along the longest side) or a larger max_memory",
+                     FN, max_blocks, LB__MB, g.cells[0], g.cells[1], g.cells[2], max_memory >> 20,
+                     0.7 * res * sqrt((double)max_blocks / (double)L.n));
+    }
+    if (s) {
+        free(L.b);
+        return s;
+    }
+    qsort(L.b, L.n, sizeof *L.b, cmp_block);
+    R.blocks = L.b;
+    R.nblocks = L.n;
+    pthread_mutex_init(&R.lock, NULL);
+    size_t nt = opt->threads == 0 ? (size_t)sysconf(_SC_NPROCESSORS_ONLN) : (size_t)opt->threads;
+    if (nt < 1) nt = 1;
+    if (nt > R.nblocks) nt = R.nblocks ? R.nblocks : 1;
+    if (P.fn && P.fn(0.05, P.user)) P.cancelled = 1;
+    P.base = 0.05;
+    lb_mesh *M = calloc(1, sizeof *M);
+    if (!M) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    P.weight = 0.45;
+    if (!s && !P.cancelled) s = phase(&R, PH_NODES, nt, &P);
+    P.weight = 0.05;
+    if (!s && !P.cancelled) s = phase(&R, PH_SHARE, nt, &P);
+    P.weight = 0.40;
+    if (!s && !P.cancelled) s = phase(&R, PH_MESH, nt, &P);
+    if (s && R.err_block != SIZE_MAX && err) *err = R.err;
+    if (!s && !P.cancelled) s = merge(&R, M, err);
+    if (!s && P.cancelled) s = lb__fail(err, LB_ERR_CANCELLED, "%s: cancelled by the caller", FN);
+    if (!s && P.fn && P.fn(1.0, P.user)) {
+        /* cancelling at 100 % is too late to matter: the mesh is done */
+    }
+    for (size_t i = 0; i < R.nblocks; ++i) {
+        lb__block *B = &R.blocks[i];
+        free(B->vals);
+        free(B->vkey);
+        free(B->vpos);
+        free(B->vnrm);
+        free(B->tri);
+    }
+    free(R.blocks);
+    pthread_mutex_destroy(&R.lock);
+    if (s) {
+        lb_mesh_free(M);
+        return s;
+    }
+    for (int d = 0; d < 3; ++d) {
+        M->origin[d] = g.origin[d];
+        M->cell[d] = g.h[d];
+        M->cells[d] = g.cells[d];
+    }
+    *out = M;
+    return LB_OK;
+}
