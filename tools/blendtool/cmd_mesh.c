@@ -172,8 +172,9 @@ static int run(int argc, char **argv) {
     if (s) {
         bt_error(CMD, "%s%s%s", s == LB_ERR_INVALID_ARGUMENT ? scene_path : "",
                  s == LB_ERR_INVALID_ARGUMENT ? ": " : "", e.message);
-        rc = s == LB_ERR_INVALID_ARGUMENT || s == LB_ERR_NO_MEMORY ? BT_EXIT_BAD_INPUT
-                                                                   : BT_EXIT_INTERNAL;
+        rc = s == LB_ERR_INVALID_ARGUMENT || s == LB_ERR_NO_MEMORY || s == LB_ERR_IO
+                 ? BT_EXIT_BAD_INPUT
+                 : BT_EXIT_INTERNAL;
     }
     lb_mesh_free(mesh);
     lb_evaluator_free(ev);

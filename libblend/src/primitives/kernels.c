@@ -21,9 +21,11 @@ double lb__kernel(lb_kernel kernel, double rho, double *df) {
         if (a >= 1.0) {
             f = d = 0.0;
         } else {
-            const double a2 = a * a;
-            f = 1.0 + a2 * (-22.0 / 9.0 + a2 * (17.0 / 9.0 - 4.0 / 9.0 * a2));
-            d = 0.5 * a * (-44.0 / 9.0 + a2 * (68.0 / 9.0 - 24.0 / 9.0 * a2));
+            /* factored, W = (1 - a^2)^2 (1 - 4/9 a^2): never negative, and
+             * exact to rounding near a = 1 where the expanded form cancels */
+            const double b = a * a, u = 1.0 - b;
+            f = u * u * (1.0 - 4.0 / 9.0 * b);
+            d = a * u * (-22.0 / 9.0 + 12.0 / 9.0 * b);
         }
         break;
     }

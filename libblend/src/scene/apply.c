@@ -38,11 +38,20 @@ lb_status lb__node_apply(const lb__node *n, lb_convention conv, const double *x,
         return lb_classic(LB_SOFT_SUM, k, x, 0.0, value, dx, err);
     case LB__F_RICCI:
         return lb_classic(LB_RICCI_UNION, k, x, n->shape, value, dx, err);
-    case LB__F_PERLIN:
-        return lb_classic(n->op == LB_UNION          ? LB_PERLIN_UNION
-                          : n->op == LB_INTERSECTION ? LB_PERLIN_INTERSECTION
-                                                     : LB_PERLIN_DIFFERENCE,
-                          k, x, 0.0, value, dx, err);
+    case LB__F_PERLIN: {
+        const lb_status s = lb_classic(n->op == LB_UNION          ? LB_PERLIN_UNION
+                                       : n->op == LB_INTERSECTION ? LB_PERLIN_INTERSECTION
+                                                                  : LB_PERLIN_DIFFERENCE,
+                                       k, x, 0.0, value, dx, err);
+        /* the products leave [0, 1] where a soft union took an argument
+         * above 1: floored at 0, so the result stays a soft field */
+        if (!s && *value < 0.0) {
+            *value = 0.0;
+            if (dx)
+                for (size_t i = 0; i < k; ++i) dx[i] = 0.0;
+        }
+        return s;
+    }
     case LB__F_COMPLEMENT:
         /* soft: 1 - f, floored at 0 where a soft union took f above 1, so the
          * result stays a soft field (>= 0) */

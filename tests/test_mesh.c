@@ -1,0 +1,696 @@
+/* Meshing: topology (closed, consistently oriented, 2-manifold, Euler
+ * characteristic), accuracy (every vertex on the surface, normals from the
+ * gradient), volumes against exact formulas, no self-intersections, thread
+ * independence, fields built to be ambiguous, the region cap, progress,
+ * cancel and bad options. Topology and volume are computed here from the
+ * arrays, independently of the mesher. */
+#define _POSIX_C_SOURCE 200809L
+#include "testlib.h"
+
+#include <dirent.h>
+#include <stdlib.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#ifndef SOURCE_DIR
+#error "SOURCE_DIR must be defined"
+#endif
+
+/* ---- helpers ---- */
+
+typedef struct built {
+    lb_scene *sc;
+    lb_evaluator *ev;
+    lb_mesh *m;
+} built;
+
+static void build_text(const char *text, const lb_mesh_options *o, built *B) {
+    lb_error e = {LB_OK, ""};
+    memset(B, 0, sizeof *B);
+    if (lb_scene_parse(text, strlen(text), "test.json", &B->sc, &e) ||
+        lb_evaluator_create(B->sc, &B->ev, &e) || lb_mesh_create(B->ev, o, &B->m, &e))
+        fail_msg("%s", e.message);
+}
+
+static void build_file(const char *path, unsigned res, unsigned flags, int threads, built *B) {
+    lb_error e = {LB_OK, ""};
+    memset(B, 0, sizeof *B);
+    if (lb_scene_load(path, &B->sc, &e) || lb_evaluator_create(B->sc, &B->ev, &e))
+        fail_msg("%s: %s", path, e.message);
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    assert_true(lb_scene_bounds(B->sc, o.bmin, o.bmax));
+    o.resolution = res;
+    o.flags = flags;
+    o.threads = threads;
+    if (lb_mesh_create(B->ev, &o, &B->m, &e)) fail_msg("%s: %s", path, e.message);
+}
+
+static void unbuild(built *B) {
+    lb_mesh_free(B->m);
+    lb_evaluator_free(B->ev);
+    lb_scene_free(B->sc);
+}
+
+static int cmp_u64(const void *a, const void *b) {
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+typedef struct topo {
+    int closed, oriented, manifold;
+    long euler;
+    size_t boundary_edges;
+    double volume;
+} topo;
+
+/* Every directed edge once; closed when each has its reverse; manifold
+ * when, in addition, the triangles around every vertex form one cycle. */
+static topo topology(const lb_mesh *m) {
+    topo t = {1, 1, 1, 0, 0, 0.0};
+    const size_t nt = m->ntriangles, nv = m->nvertices;
+    uint64_t *d = malloc((3 * nt + 1) * sizeof *d);
+    assert_non_null(d);
+    for (size_t i = 0; i < nt; ++i)
+        for (int c = 0; c < 3; ++c) {
+            const uint64_t a = m->triangles[3 * i + c], b = m->triangles[3 * i + (c + 1) % 3];
+            d[3 * i + c] = a * nv + b;
+            if (a == b) t.manifold = 0;
+        }
+    qsort(d, 3 * nt, sizeof *d, cmp_u64);
+    size_t undirected = 0;
+    for (size_t i = 0; i < 3 * nt; ++i) {
+        if (i && d[i] == d[i - 1]) t.oriented = 0;
+        const uint64_t a = d[i] / nv, b = d[i] % nv, r = b * nv + a;
+        if (!bsearch(&r, d, 3 * nt, sizeof *d, cmp_u64)) {
+            t.closed = 0;
+            t.boundary_edges++;
+            undirected++;
+        } else if (a < b) {
+            undirected++;
+        }
+    }
+    /* vertex links: next[corner] around each vertex must be one cycle */
+    size_t *first = calloc(nv + 1, sizeof *first);
+    uint64_t *link = malloc((3 * nt + 1) * sizeof *link); /* (vertex, next, prev) packed */
+    uint32_t *lnext = malloc((3 * nt + 1) * sizeof *lnext), *lprev = malloc((3 * nt + 1) * 4);
+    assert_true(first && link && lnext && lprev);
+    for (size_t i = 0; i < 3 * nt; ++i) first[m->triangles[i] + 1]++;
+    for (size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+    size_t *fill = malloc((nv + 1) * sizeof *fill);
+    assert_non_null(fill);
+    memcpy(fill, first, (nv + 1) * sizeof *fill);
+    for (size_t i = 0; i < nt; ++i)
+        for (int c = 0; c < 3; ++c) {
+            const uint32_t v = m->triangles[3 * i + c];
+            const size_t k = fill[v]++;
+            lnext[k] = m->triangles[3 * i + (c + 1) % 3];
+            lprev[k] = m->triangles[3 * i + (c + 2) % 3];
+        }
+    size_t used = 0;
+    for (size_t v = 0; v < nv; ++v) {
+        const size_t s = first[v], e = first[v + 1];
+        if (s == e) continue;
+        ++used;
+        if (!t.closed) continue;
+        /* walk: from corner s, the next corner is the one whose lnext is our lprev */
+        size_t cur = s, steps = 0;
+        do {
+            size_t nx = e;
+            for (size_t k = s; k < e; ++k)
+                if (lnext[k] == lprev[cur]) {
+                    nx = k;
+                    break;
+                }
+            if (nx == e) break;
+            cur = nx;
+            ++steps;
+        } while (cur != s && steps <= e - s);
+        if (cur != s || steps != e - s) t.manifold = 0;
+    }
+    t.euler = (long)used - (long)undirected + (long)nt;
+    for (size_t i = 0; i < nt; ++i) {
+        const double *p = m->positions + 3 * (size_t)m->triangles[3 * i];
+        const double *q = m->positions + 3 * (size_t)m->triangles[3 * i + 1];
+        const double *r = m->positions + 3 * (size_t)m->triangles[3 * i + 2];
+        t.volume += (p[0] * (q[1] * r[2] - q[2] * r[1]) - p[1] * (q[0] * r[2] - q[2] * r[0]) +
+                     p[2] * (q[0] * r[1] - q[1] * r[0])) /
+                    6.0;
+    }
+    if (!t.closed) t.manifold = 0;
+    free(d);
+    free(first);
+    free(link);
+    free(lnext);
+    free(lprev);
+    free(fill);
+    return t;
+}
+
+static void expect_closed_manifold(const char *what, const lb_mesh *m) {
+    const topo t = topology(m);
+    if (!t.closed || !t.oriented || !t.manifold || !(t.volume > 0.0))
+        fail_msg("%s: closed %d oriented %d manifold %d volume %g (%zu triangles, %zu boundary "
+                 "edges)",
+                 what, t.closed, t.oriented, t.manifold, t.volume, m->ntriangles, t.boundary_edges);
+}
+
+#define MAX_SCENES 64
+static char scene_paths[MAX_SCENES][1024];
+static size_t nscenes;
+
+static int setup(void **state) {
+    (void)state;
+    const char *dirs[2] = {"scenes", "tests/data/scenes"};
+    for (int i = 0; i < 2; ++i) {
+        char full[512];
+        snprintf(full, sizeof full, "%s/%s", SOURCE_DIR, dirs[i]);
+        DIR *d = opendir(full);
+        if (!d) return -1;
+        struct dirent *e;
+        while ((e = readdir(d)) && nscenes < MAX_SCENES) {
+            const size_t len = strlen(e->d_name);
+            if (len > 5 && strcmp(e->d_name + len - 5, ".json") == 0)
+                snprintf(scene_paths[nscenes++], sizeof scene_paths[0], "%.500s/%.500s", full,
+                         e->d_name);
+        }
+        closedir(d);
+    }
+    return nscenes >= 17 ? 0 : -1;
+}
+
+#define HEAD "{\"format\": \"libblend-scene\", \"version\": 1, "
+
+/* ---- tests ---- */
+
+/* Every scene, two resolutions: closed, oriented, manifold, positive volume;
+ * every vertex on the surface of max(phi, region box) to 1e-6 cells, with
+ * the normal of the gradient there. */
+static void test_scenes_closed_and_accurate(void **state) {
+    (void)state;
+    tally_t acc = {"vertices on the surface", 0, 0, 0};
+    tally_t nrm = {"normals from the gradient", 0, 0, 0};
+    const unsigned res[2] = {24, 56};
+    for (size_t s = 0; s < nscenes; ++s)
+        for (int r = 0; r < 2; ++r) {
+            built B;
+            build_file(scene_paths[s], res[r], 0, 0, &B);
+            char what[1100];
+            snprintf(what, sizeof what, "%.1000s at %u", scene_paths[s], res[r]);
+            assert_true(B.m->ntriangles > 100);
+            expect_closed_manifold(what, B.m);
+            const size_t n = B.m->nvertices;
+            double *x = malloc(7 * n * sizeof *x);
+            assert_non_null(x);
+            double *y = x + n, *z = y + n, *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
+            for (size_t i = 0; i < n; ++i) {
+                x[i] = B.m->positions[3 * i];
+                y[i] = B.m->positions[3 * i + 1];
+                z[i] = B.m->positions[3 * i + 2];
+            }
+            lb_error e = {LB_OK, ""};
+            assert_int_equal(lb_evaluator_eval(B.ev, n, x, y, z, v, gx, gy, gz, 0, &e), LB_OK);
+            double lo[3], hi[3];
+            lb_scene_bounds(B.sc, lo, hi);
+            const int soft = lb_scene_convention(B.sc) == LB_CONVENTION_SOFT;
+            const double h = fmin(B.m->cell[0], fmin(B.m->cell[1], B.m->cell[2]));
+            for (size_t i = 0; i < n; ++i) {
+                /* phi_c written out here: the field, or the region box where it is larger */
+                double phi = soft ? 0.5 - v[i] : v[i];
+                double g[3] = {soft ? -gx[i] : gx[i], soft ? -gy[i] : gy[i], soft ? -gz[i] : gz[i]};
+                const double P[3] = {x[i], y[i], z[i]};
+                for (int d = 0; d < 3; ++d) {
+                    if (lo[d] - P[d] > phi) {
+                        phi = lo[d] - P[d];
+                        g[0] = g[1] = g[2] = 0.0;
+                        g[d] = -1.0;
+                    }
+                    if (P[d] - hi[d] > phi) {
+                        phi = P[d] - hi[d];
+                        g[0] = g[1] = g[2] = 0.0;
+                        g[d] = 1.0;
+                    }
+                }
+                const double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+                tally_check(&acc, fabs(phi) <= 1e-6 * h * gl,
+                            "%s: vertex %zu: |phi| = %g, |grad| = %g, h = %g", what, i, fabs(phi),
+                            gl, h);
+                const double *N = B.m->normals + 3 * i;
+                const double dot = gl > 0.0 ? (N[0] * g[0] + N[1] * g[1] + N[2] * g[2]) / gl : 1.0;
+                const double nl = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+                tally_check(&nrm, fabs(nl - 1.0) < 1e-9 && dot > 1.0 - 1e-9,
+                            "%s: vertex %zu: normal length %g, cosine to the gradient %g", what, i,
+                            nl, dot);
+            }
+            free(x);
+            unbuild(&B);
+        }
+    tally_end(&acc, 100000);
+    tally_end(&nrm, 100000);
+}
+
+/* The same mesh, bit for bit, for 1, 2 and 3 threads. */
+static void test_threads_identical(void **state) {
+    (void)state;
+    for (size_t s = 0; s < nscenes; ++s) {
+        built A, B, C;
+        build_file(scene_paths[s], 40, 0, 1, &A);
+        build_file(scene_paths[s], 40, 0, 2, &B);
+        build_file(scene_paths[s], 40, 0, 3, &C);
+        const lb_mesh *ms[2] = {B.m, C.m};
+        for (int k = 0; k < 2; ++k) {
+            const lb_mesh *m = ms[k];
+            if (m->nvertices != A.m->nvertices || m->ntriangles != A.m->ntriangles ||
+                memcmp(m->positions, A.m->positions, 3 * m->nvertices * sizeof(double)) ||
+                memcmp(m->normals, A.m->normals, 3 * m->nvertices * sizeof(double)) ||
+                memcmp(m->triangles, A.m->triangles, 3 * m->ntriangles * sizeof(uint32_t)))
+                fail_msg("%s: %d threads differ from 1", scene_paths[s], k + 2);
+        }
+        unbuild(&A);
+        unbuild(&B);
+        unbuild(&C);
+    }
+}
+
+/* Volumes at 128 cells across against the exact ones, and the Euler
+ * characteristic of a sphere (2) and a torus (0). */
+static void test_volumes_and_euler(void **state) {
+    (void)state;
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    o.resolution = 128;
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -1.5;
+        o.bmax[d] = 1.5;
+    }
+    static const struct {
+        const char *text;
+        double volume;
+        long euler;
+    } cases[] = {
+        {HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"sphere\", \"radius\": 1}}",
+         4.0 / 3.0 * M_PI, 2},
+        {HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"ellipsoid\", \"semi_axes\": [1.2, "
+              "0.7, 0.45], \"rotate\": [20, 35, -10], \"translate\": [0.05, -0.1, 0.1]}}",
+         4.0 / 3.0 * M_PI * 1.2 * 0.7 * 0.45, 2},
+        {HEAD "\"convention\": \"soft\", \"root\": {\"type\": \"sphere\", \"radius\": 0.9, "
+              "\"kernel\": \"blinn\"}}",
+         4.0 / 3.0 * M_PI * 0.729, 2},
+        {HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"torus\", \"major_radius\": 0.9, "
+              "\"minor_radius\": 0.35, \"axis\": [0, 1, 1]}}",
+         2.0 * M_PI * M_PI * 0.9 * 0.35 * 0.35, 0},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        built B;
+        build_text(cases[i].text, &o, &B);
+        expect_closed_manifold(cases[i].text, B.m);
+        const topo t = topology(B.m);
+        const double rel = fabs(t.volume - cases[i].volume) / cases[i].volume;
+        fprintf(stderr, "  case %zu: %zu triangles, volume %.6f (exact %.6f, %.3f %%), euler %ld\n",
+                i, B.m->ntriangles, t.volume, cases[i].volume, 100.0 * rel, t.euler);
+        assert_true(rel < 0.005);
+        assert_int_equal(t.euler, cases[i].euler);
+        unbuild(&B);
+    }
+}
+
+/* Fields built to be ambiguous for marching cubes: spheres on every other
+ * node of a checkerboard (every cell face has diagonal inside corners),
+ * two spheres touching exactly at a grid node (phi = 0 there), and a thin
+ * torus whose tube is about one cell wide. */
+static void test_ambiguous_fields(void **state) {
+    (void)state;
+    char *text = malloc(65536);
+    assert_non_null(text);
+    size_t len = (size_t)snprintf(text, 65536,
+                                  HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"min\", "
+                                       "\"args\": [");
+    int first = 1;
+    for (int k = 0; k < 6; ++k)
+        for (int j = 0; j < 6; ++j)
+            for (int i = 0; i < 6; ++i) {
+                if ((i + j + k) % 2) continue;
+                len += (size_t)snprintf(text + len, 65536 - len,
+                                        "%s{\"type\": \"sphere\", \"center\": [%d, %d, %d], "
+                                        "\"radius\": 0.74}",
+                                        first ? "" : ", ", i, j, k);
+                first = 0;
+            }
+    snprintf(text + len, 65536 - len, "]}}");
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -1.0;
+        o.bmax[d] = 6.0;
+    }
+    /* cell size 1: the grid nodes are the lattice, every face ambiguous */
+    o.cell_size = 1.0;
+    o.flags = LB_MESH_OPEN_BOUNDARY;
+    built B;
+    build_text(text, &o, &B);
+    expect_closed_manifold("checkerboard at cell size 1", B.m);
+    unbuild(&B);
+    /* and at cell sizes that cut the spheres anywhere */
+    const double sizes[3] = {0.5, 0.37, 0.21};
+    for (int s = 0; s < 3; ++s) {
+        o.cell_size = sizes[s];
+        o.flags = 0;
+        build_text(text, &o, &B);
+        expect_closed_manifold("checkerboard", B.m);
+        unbuild(&B);
+    }
+    free(text);
+    /* touching at a node: min of two unit spheres at (+-1, 0, 0), node at 0 */
+    static const char touch[] =
+        HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"min\", \"args\": [{\"type\": "
+             "\"sphere\", \"center\": [-1, 0, 0], \"radius\": 1}, {\"type\": \"sphere\", "
+             "\"center\": [1, 0, 0], \"radius\": 1}]}}";
+    o.cell_size = 0.25;
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -2.5;
+        o.bmax[d] = 2.5;
+    }
+    build_text(touch, &o, &B);
+    expect_closed_manifold("spheres touching at a node", B.m);
+    unbuild(&B);
+    static const char thin[] =
+        HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"torus\", \"major_radius\": 1, "
+             "\"minor_radius\": 0.06, \"axis\": [0.3, 1, 0.2]}}";
+    o.cell_size = 0.1;
+    build_text(thin, &o, &B);
+    expect_closed_manifold("thin torus", B.m);
+    unbuild(&B);
+}
+
+/* The region cuts a sphere in half: closed on the cut (half the volume),
+ * or open with every boundary edge on the cutting plane. */
+static void test_region_cap_and_open(void **state) {
+    (void)state;
+    static const char text[] =
+        HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"sphere\", \"radius\": 1}}";
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    o.resolution = 96;
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -1.25;
+        o.bmax[d] = 1.25;
+    }
+    o.bmax[2] = 0.0;
+    built B;
+    build_text(text, &o, &B);
+    expect_closed_manifold("capped half sphere", B.m);
+    topo t = topology(B.m);
+    const double half = 2.0 / 3.0 * M_PI;
+    assert_true(fabs(t.volume - half) / half < 0.005);
+    double zmax = -INFINITY;
+    for (size_t i = 0; i < B.m->nvertices; ++i) zmax = fmax(zmax, B.m->positions[3 * i + 2]);
+    assert_true(zmax <= 1e-12);
+    unbuild(&B);
+    o.flags = LB_MESH_OPEN_BOUNDARY;
+    build_text(text, &o, &B);
+    t = topology(B.m);
+    assert_false(t.closed);
+    assert_true(t.oriented);
+    assert_true(t.boundary_edges > 100);
+    /* the open rim lies on the region's top face */
+    for (size_t i = 0; i < B.m->nvertices; ++i) assert_true(B.m->positions[3 * i + 2] <= 1e-12);
+    unbuild(&B);
+}
+
+/* ---- self-intersections: a triangle-triangle test over a grid ---- */
+
+static int seg_tri(const double *p, const double *q, const double *a, const double *b,
+                   const double *c) {
+    /* proper intersection of segment pq with triangle abc (Moller-Trumbore) */
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    const double h[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2],
+                         d[0] * e2[1] - d[1] * e2[0]};
+    const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+    const double scale = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]) *
+                         sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]) *
+                         sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (fabs(det) <= 1e-12 * scale) return 0; /* parallel: not a proper crossing */
+    const double inv = 1.0 / det;
+    const double s[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+    const double u = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) * inv;
+    const double qv[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2],
+                          s[0] * e1[1] - s[1] * e1[0]};
+    const double v = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) * inv;
+    const double t = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) * inv;
+    const double eps = 1e-9;
+    return u > eps && v > eps && u + v < 1.0 - eps && t > eps && t < 1.0 - eps;
+}
+
+static int tri_tri(const lb_mesh *m, size_t i, size_t j) {
+    const uint32_t *A = m->triangles + 3 * i, *B = m->triangles + 3 * j;
+    int shared = 0;
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) shared += A[a] == B[b];
+    if (shared >= 2) return 0; /* neighbours across an edge */
+    const double *P = m->positions;
+    for (int k = 0; k < 3; ++k) {
+        const uint32_t p = A[k], q = A[(k + 1) % 3];
+        if (shared && (p == B[0] || p == B[1] || p == B[2] || q == B[0] || q == B[1] || q == B[2]))
+            continue; /* an edge through the shared vertex touches there */
+        if (seg_tri(P + 3 * p, P + 3 * q, P + 3 * B[0], P + 3 * B[1], P + 3 * B[2])) return 1;
+        const uint32_t r = B[k], s = B[(k + 1) % 3];
+        if (shared && (r == A[0] || r == A[1] || r == A[2] || s == A[0] || s == A[1] || s == A[2]))
+            continue;
+        if (seg_tri(P + 3 * r, P + 3 * s, P + 3 * A[0], P + 3 * A[1], P + 3 * A[2])) return 1;
+    }
+    return 0;
+}
+
+typedef struct entry {
+    uint64_t cell;
+    uint32_t tri;
+} entry;
+
+static int cmp_entry(const void *a, const void *b) {
+    const entry *x = a, *y = b;
+    return x->cell < y->cell ? -1 : x->cell > y->cell ? 1 : (x->tri > y->tri) - (x->tri < y->tri);
+}
+
+static size_t self_intersections(const lb_mesh *m, size_t *pairs) {
+    /* bins of two cells: every triangle lies in one cell, so at most 2^3 bins */
+    const double bin = 2.0 * fmax(m->cell[0], fmax(m->cell[1], m->cell[2]));
+    size_t cap = 8 * m->ntriangles + 1, n = 0;
+    entry *E = malloc(cap * sizeof *E);
+    assert_non_null(E);
+    for (size_t t = 0; t < m->ntriangles; ++t) {
+        long lo[3], hi[3];
+        for (int d = 0; d < 3; ++d) {
+            double a = INFINITY, b = -INFINITY;
+            for (int c = 0; c < 3; ++c) {
+                const double x = m->positions[3 * (size_t)m->triangles[3 * t + c] + d];
+                a = fmin(a, x);
+                b = fmax(b, x);
+            }
+            lo[d] = (long)floor((a - m->origin[d]) / bin);
+            hi[d] = (long)floor((b - m->origin[d]) / bin);
+        }
+        for (long z = lo[2]; z <= hi[2]; ++z)
+            for (long y = lo[1]; y <= hi[1]; ++y)
+                for (long x = lo[0]; x <= hi[0]; ++x) {
+                    assert_true(n < cap);
+                    E[n].cell = ((uint64_t)(z + 2) * 1048576u + (uint64_t)(y + 2)) * 1048576u +
+                                (uint64_t)(x + 2);
+                    E[n].tri = (uint32_t)t;
+                    ++n;
+                }
+    }
+    qsort(E, n, sizeof *E, cmp_entry);
+    size_t hits = 0;
+    *pairs = 0;
+    for (size_t s = 0; s < n;) {
+        size_t e = s;
+        while (e < n && E[e].cell == E[s].cell) ++e;
+        for (size_t i = s; i < e; ++i)
+            for (size_t j = i + 1; j < e; ++j) {
+                ++*pairs;
+                if (tri_tri(m, E[i].tri, E[j].tri)) {
+                    if (hits < 4)
+                        fprintf(stderr, "  triangles %u and %u intersect\n", E[i].tri, E[j].tri);
+                    ++hits;
+                }
+            }
+        s = e;
+    }
+    free(E);
+    return hits;
+}
+
+static void test_no_self_intersections(void **state) {
+    (void)state;
+    const unsigned res[2] = {64, 128};
+    size_t checked = 0;
+    for (size_t s = 0; s < nscenes; ++s) {
+        if (!strstr(scene_paths[s], "/scenes/hsu")) continue; /* the papers' scenes */
+        for (int r = 0; r < 2; ++r) {
+            built B;
+            build_file(scene_paths[s], res[r], 0, 0, &B);
+            size_t pairs = 0;
+            const size_t hits = self_intersections(B.m, &pairs);
+            if (hits)
+                fail_msg("%s at %u: %zu intersecting triangle pairs", scene_paths[s], res[r], hits);
+            checked += pairs;
+            unbuild(&B);
+        }
+    }
+    fprintf(stderr, "  %zu nearby triangle pairs tested\n", checked);
+    assert_true(checked > 1000000);
+}
+
+/* ---- progress, cancel, bad options ---- */
+
+typedef struct prog {
+    int calls;
+    double last;
+    int monotone;
+    int cancel_at;
+} prog;
+
+static int on_progress(double f, void *user) {
+    prog *p = user;
+    if (f < p->last || f < 0.0 || f > 1.0) p->monotone = 0;
+    p->last = f;
+    return ++p->calls == p->cancel_at;
+}
+
+static void test_progress_and_cancel(void **state) {
+    (void)state;
+    char path[1100];
+    snprintf(path, sizeof path, "%s/scenes/bench-s2-64-spheres.json", SOURCE_DIR);
+    lb_error e = {LB_OK, ""};
+    lb_scene *sc = NULL;
+    lb_evaluator *ev = NULL;
+    assert_int_equal(lb_scene_load(path, &sc, &e), LB_OK);
+    assert_int_equal(lb_evaluator_create(sc, &ev, &e), LB_OK);
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    lb_scene_bounds(sc, o.bmin, o.bmax);
+    o.resolution = 64;
+    o.threads = 2;
+    prog p = {0, 0.0, 1, -1};
+    o.progress = on_progress;
+    o.user = &p;
+    lb_mesh *m = NULL;
+    assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_OK);
+    assert_true(p.calls >= 3 && p.monotone && p.last == 1.0);
+    lb_mesh_free(m);
+    /* the callback cancels */
+    prog q = {0, 0.0, 1, 3};
+    o.user = &q;
+    assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_ERR_CANCELLED);
+    assert_null(m);
+    assert_non_null(strstr(e.message, "cancelled"));
+    /* the flag cancels */
+    volatile int flag = 1;
+    o.progress = NULL;
+    o.cancel = &flag;
+    assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_ERR_CANCELLED);
+    assert_null(m);
+    lb_evaluator_free(ev);
+    lb_scene_free(sc);
+}
+
+static void test_bad_options(void **state) {
+    (void)state;
+    static const char text[] =
+        HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"sphere\", \"radius\": 1}}";
+    lb_error e = {LB_OK, ""};
+    lb_scene *sc = NULL;
+    lb_evaluator *ev = NULL;
+    assert_int_equal(lb_scene_parse(text, strlen(text), "t.json", &sc, &e), LB_OK);
+    assert_int_equal(lb_evaluator_create(sc, &ev, &e), LB_OK);
+    lb_mesh_options base;
+    lb_mesh_options_init(&base);
+    for (int d = 0; d < 3; ++d) {
+        base.bmin[d] = -2;
+        base.bmax[d] = 2;
+    }
+    static const struct {
+        int field;
+        double value;
+        lb_status status;
+        const char *msg;
+    } rows[] = {
+        {0, 0, LB_ERR_INVALID_ARGUMENT, "min < max on every axis"},
+        {1, 0, LB_ERR_INVALID_ARGUMENT, "resolution = 0; allowed: 1 to 8192"},
+        {1, 9000, LB_ERR_INVALID_ARGUMENT, "resolution = 9000; allowed: 1 to 8192"},
+        {2, -1, LB_ERR_INVALID_ARGUMENT, "cell_size = -1; allowed: a positive number"},
+        {2, 1e-6, LB_ERR_NO_MEMORY, "allowed: at most 8192 cells per axis"},
+        {3, -2, LB_ERR_INVALID_ARGUMENT, "threads = -2"},
+        {4, 8, LB_ERR_INVALID_ARGUMENT, "flags = 0x8"},
+        {5, 1e9, LB_ERR_INVALID_ARGUMENT, "|value| <= 1e+09"},
+        {6, 1 << 20, LB_ERR_NO_MEMORY, "over the memory cap of 1 MiB"},
+        {7, NAN, LB_ERR_INVALID_ARGUMENT, "allowed: finite"},
+    };
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; ++i) {
+        lb_mesh_options o = base;
+        switch (rows[i].field) {
+        case 0:
+            o.bmax[1] = o.bmin[1];
+            break;
+        case 1:
+            o.resolution = (unsigned)rows[i].value;
+            break;
+        case 2:
+            o.cell_size = rows[i].value;
+            break;
+        case 3:
+            o.threads = (int)rows[i].value;
+            break;
+        case 4:
+            o.flags = (unsigned)rows[i].value;
+            break;
+        case 5:
+            o.bmax[0] = 2e9;
+            break;
+        case 6:
+            o.max_memory = (size_t)rows[i].value;
+            o.resolution = 512;
+            break;
+        case 7:
+            o.bmin[2] = rows[i].value;
+            break;
+        }
+        lb_mesh *m = (lb_mesh *)&o; /* must be reset to NULL */
+        e.message[0] = '\0';
+        const lb_status s = lb_mesh_create(ev, &o, &m, &e);
+        if (s != rows[i].status || !strstr(e.message, rows[i].msg) || m != NULL)
+            fail_msg("row %zu: status %d, message \"%s\"; expected %d and \"%s\"", i, s, e.message,
+                     rows[i].status, rows[i].msg);
+    }
+    assert_int_equal(lb_mesh_create(NULL, &base, NULL, &e), LB_ERR_INVALID_ARGUMENT);
+    /* writing: an unknown extension and an unwritable folder leave nothing */
+    lb_mesh *m = NULL;
+    base.resolution = 16;
+    assert_int_equal(lb_mesh_create(ev, &base, &m, &e), LB_OK);
+    assert_int_equal(lb_mesh_write(m, "out.xyz", LB_MESH_FORMAT_AUTO, &e), LB_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(e.message, ".ply, .obj, .stl or .glb"));
+    assert_int_equal(lb_mesh_write(m, "/nonexistent-dir/out.ply", LB_MESH_FORMAT_AUTO, &e),
+                     LB_ERR_IO);
+    assert_non_null(strstr(e.message, "/nonexistent-dir/out.ply"));
+    lb_mesh_free(m);
+    lb_evaluator_free(ev);
+    lb_scene_free(sc);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_scenes_closed_and_accurate),
+        cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_volumes_and_euler),
+        cmocka_unit_test(test_ambiguous_fields),
+        cmocka_unit_test(test_region_cap_and_open),
+        cmocka_unit_test(test_no_self_intersections),
+        cmocka_unit_test(test_progress_and_cancel),
+        cmocka_unit_test(test_bad_options),
+    };
+    return cmocka_run_group_tests(tests, setup, NULL);
+}
