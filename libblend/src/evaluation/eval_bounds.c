@@ -30,6 +30,20 @@ static double clampd(double v) {
 
 static void prim_bounds(const lb__instr *in, const double bc[3], const double br[3], iv *out) {
     const lb_primitive *P = &in->prim;
+    if (in->code == LB__I_ELLIPSOID) {
+        /* zero-convention ellipsoid in world axes: nearest and farthest
+         * points of the box, inline (the common case: spheres) */
+        double sn = 0.0, sf = 0.0;
+        for (int i = 0; i < 3; ++i) {
+            const double d = fabs(bc[i] - P->c[i]);
+            const double dn = (d > br[i] ? d - br[i] : 0.0) / P->a[i], df = (d + br[i]) / P->a[i];
+            sn += dn * dn;
+            sf += df * df;
+        }
+        out->lo = sqrt(sn) * (1.0 - 1e-12) - 1.0;
+        out->hi = sqrt(sf) * (1.0 + 1e-12) - 1.0;
+        return;
+    }
     double lc[3], lr[3];
     lb__affine_apply(&in->A, bc, lc);
     for (int i = 0; i < 3; ++i)
@@ -179,6 +193,43 @@ static int is_difference_family(lb__family f) {
            f == LB__F_SOFT_HYPER || f == LB__F_SOFT_CONIC || f == LB__F_PERLIN;
 }
 
+/* Displacement and conic (no bulge) on the arguments a box can reach
+ * (cull's list): the culled ones are inactive at both corners, so the
+ * kernel on the rest gives the same values, without re-validation. */
+static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, size_t na, iv *out) {
+    const lb__node *n = &in->op;
+    double lo[LB_MAX_ARITY], hi[LB_MAX_ARITY], r[LB_MAX_ARITY], p[LB_MAX_ARITY], m[LB_MAX_ARITY];
+    for (size_t j = 0; j < na; ++j) {
+        const iv u = dual_iv(n->op, act[j], x[act[j]]);
+        lo[j] = u.lo;
+        hi[j] = u.hi;
+        r[j] = n->r[act[j]];
+        p[j] = n->p ? n->p[act[j]] : 2.0;
+        m[j] = n->m[act[j]];
+    }
+    double v1, v2;
+    if (na == 1) {
+        v1 = lo[0] / m[0];
+        v2 = hi[0] / m[0];
+    } else if (in->fast == LB__FAST_DISPLACEMENT) {
+        v1 = lb__bt_union(na, lo, r, p, m, in->mode, NULL, NULL, NULL);
+        v2 = lb__bt_union(na, hi, r, p, m, in->mode, NULL, NULL, NULL);
+    } else {
+        v1 = lb__conic_union(lo, r, n->shape, m, NULL, NULL, NULL);
+        v2 = lb__conic_union(hi, r, n->shape, m, NULL, NULL, NULL);
+    }
+    /* union form: lo <= root <= hi; the duals negate */
+    if (n->op == LB_UNION) {
+        out->lo = v1;
+        out->hi = v2;
+    } else {
+        out->lo = -v2;
+        out->hi = -v1;
+    }
+    out->lo -= 1e-9 * (1.0 + fabs(out->lo));
+    out->hi += 1e-9 * (1.0 + fabs(out->hi));
+}
+
 static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const iv *c, iv *out) {
     const size_t k = n->k;
     if (n->bulge) {
@@ -270,8 +321,16 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
             for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
             if (in->op.family == LB__F_BOUNDED)
                 for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
-            op_bounds(ev->conv, &in->op, x, c, &o);
-            if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
+            if (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC) {
+                uint16_t local[LB_MAX_ARITY];
+                uint16_t *act = plan ? plan->act + in->aoff : local;
+                const uint16_t na = cull(&in->op, x, act);
+                if (plan) plan->nact[i] = na;
+                fast_bounds(in, x, act, na, &o);
+            } else {
+                op_bounds(ev->conv, &in->op, x, c, &o);
+                if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
+            }
         }
         o.lo = clampd(o.lo);
         o.hi = clampd(o.hi);
@@ -291,6 +350,64 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
         }
         if (in->op.bulge) /* the Hessian terms re-run both arguments' prefixes */
             for (size_t a = 0; a < in->op.k; ++a) plan->need[in->srci[a]] = 1;
+    }
+}
+
+/* The same pass over a box inside the box of `parent` (a plan made by
+ * lb__bounds_pass): instructions the parent does not need are skipped, and
+ * blends consider only the arguments the parent kept, which are the only
+ * ones that can matter inside. Fills R for the needed instructions; the
+ * root's interval is R[ev->out]. */
+void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const double bc[3],
+                         const double br[3], iv *R) {
+    iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
+    for (size_t i = 0; i < ev->n; ++i) {
+        if (!parent->need[i]) continue;
+        const lb__instr *in = &ev->ins[i];
+        iv o;
+        if (in->code != LB__I_OP) {
+            prim_bounds(in, bc, br, &o);
+        } else if (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC ||
+                   in->fast == LB__FAST_MINMAX) {
+            const uint16_t *pa = parent->act + in->aoff;
+            const uint16_t pn = parent->nact[i];
+            for (uint16_t j = 0; j < pn; ++j) x[pa[j]] = R[in->src[pa[j]]];
+            if (in->fast == LB__FAST_MINMAX) {
+                const int mn = in->op.family == LB__F_MIN;
+                o = x[pa[0]];
+                for (uint16_t j = 1; j < pn; ++j) {
+                    const iv a = x[pa[j]];
+                    if (mn ? a.lo < o.lo : a.lo > o.lo) o.lo = a.lo;
+                    if (mn ? a.hi < o.hi : a.hi > o.hi) o.hi = a.hi;
+                }
+            } else {
+                /* cull among the parent's arguments, as cull() does */
+                const lb__node *n = &in->op;
+                double H = INFINITY;
+                for (uint16_t j = 0; j < pn; ++j) {
+                    const iv u = dual_iv(n->op, pa[j], x[pa[j]]);
+                    const double t = u.hi / n->m[pa[j]];
+                    if (t < H) H = t;
+                }
+                uint16_t act[LB_MAX_ARITY], na = 0;
+                for (uint16_t j = 0; j < pn; ++j) {
+                    const uint16_t a = pa[j];
+                    const iv u = dual_iv(n->op, a, x[a]);
+                    const double reach = u.lo - n->m[a] * H;
+                    if (!(reach >= n->r[a] * (1.0 + 1e-9) + 1e-12 * fabs(u.lo))) act[na++] = a;
+                }
+                fast_bounds(in, x, act, na, &o);
+            }
+        } else {
+            const size_t k = in->op.k;
+            for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
+            if (in->op.family == LB__F_BOUNDED)
+                for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
+            op_bounds(ev->conv, &in->op, x, c, &o);
+        }
+        o.lo = clampd(o.lo);
+        o.hi = clampd(o.hi);
+        R[in->dst] = o;
     }
 }
 

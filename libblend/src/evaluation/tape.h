@@ -79,6 +79,11 @@ typedef struct lb__plan {
 LB_INTERNAL void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br[3],
                                  lb__iv *R, lb__plan *plan);
 
+/* The pass over a box inside the box a parent plan was made for: only the
+ * instructions and blend arguments the parent kept (eval_bounds.c). */
+LB_INTERNAL void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent,
+                                     const double bc[3], const double br[3], lb__iv *R);
+
 /* Centre and half-size of a box, the half-size rounded up to cover it. */
 LB_INTERNAL void lb__box_centre(const double bmin[3], const double bmax[3], double bc[3],
                                 double br[3]);
@@ -91,6 +96,14 @@ LB_INTERNAL lb_status lb__tape_run(const lb_evaluator *ev, size_t upto, size_t n
 LB_INTERNAL lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *plan, size_t n,
                                         const double *x, const double *y, const double *z,
                                         double *regs, lb_error *err);
+
+/* Values and gradients of n points that all lie in [bmin, bmax], with the
+ * culling of one interval pass over that box (single-threaded; the
+ * mesher's blocks). */
+LB_INTERNAL lb_status lb__eval_in_box(const lb_evaluator *ev, const double bmin[3],
+                                      const double bmax[3], size_t n, const double *x,
+                                      const double *y, const double *z, double *v, double *gx,
+                                      double *gy, double *gz, lb_error *err);
 
 static inline double *lb__reg(double *regs, uint32_t r, int comp) {
     return regs + ((size_t)r * 4u + (size_t)comp) * LB__CHUNK;

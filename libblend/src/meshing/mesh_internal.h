@@ -11,6 +11,7 @@
 #define LIBBLEND_MESH_INTERNAL_H
 
 #include "../common/internal.h"
+#include "../evaluation/tape.h"
 
 #include <libblend/mesh.h>
 
@@ -34,6 +35,9 @@ typedef struct lb__block {
     uint32_t nc[3]; /* cells per axis in this block */
     uint64_t id;    /* linear block index (sort key) */
     double *vals;   /* (nc+1)^3 node values of phi_c, x fastest */
+    double *grads;  /* their gradients, 3 per node */
+    uint8_t *nmask; /* nodes evaluated (corners of cells that may cross) */
+    uint8_t *cmask; /* cells that may cross the surface, nc[0] * nc[1] * nc[2] */
     /* output: vertices keyed by grid edge, triangles by local vertex index */
     size_t nv, nt;
     uint64_t *vkey;
@@ -52,6 +56,10 @@ static inline void lb__node_pos(const lb__grid *g, uint64_t x, uint64_t y, uint6
     X[2] = g->origin[2] + (double)z * g->h[2];
 }
 
+/* The world box of a block's nodes, widened by a hair for rounding. */
+LB_INTERNAL void lb__block_box(const lb__grid *g, const lb__block *B, double bmin[3],
+                               double bmax[3]);
+
 /* phi_c and its gradient from the field's value and gradient at X. */
 LB_INTERNAL double lb__mesh_phi(const lb__grid *g, const double X[3], double f, const double gf[3],
                                 double gphi[3]);
@@ -63,9 +71,13 @@ LB_INTERNAL lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, 
                                      lb_error *err);
 
 /* Safeguarded, batched root solve of phi_c along n grid edges: a[i] inside
- * (phi < 0), b[i] outside; writes the surface points and unit normals. */
-LB_INTERNAL lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, size_t n,
-                                       const double *a, const double *b, const double *pa,
-                                       const double *pb, double *pos, double *nrm, lb_error *err);
+ * (phi < 0), b[i] outside, pa/pb their values and ga/gb their gradients
+ * (3 per edge), all inside block B; writes the surface points and unit
+ * normals. */
+LB_INTERNAL lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g,
+                                       const lb__block *B, size_t n, const double *a,
+                                       const double *b, const double *pa, const double *pb,
+                                       const double *ga, const double *gb, double *pos, double *nrm,
+                                       lb_error *err);
 
 #endif

@@ -6,10 +6,11 @@
  *    max(phi, box) closes on the region's faces.
  * 2. Blocks of 8^3 cells: an octree over block ranges keeps the blocks whose
  *    interval bound of phi_c (lb_evaluator_bounds) contains 0.
- * 3. In parallel, each kept block evaluates its (8+1)^3 node values.
+ * 3. In parallel, each kept block finds, by intervals again, its sub-boxes
+ *    of 2^3 cells that may cross (mark) and evaluates only their nodes.
  * 4. Nodes on a block's far faces are also nodes of the next block: they
- *    take that block's value, so both sides see the same signs (the
- *    evaluator's per-batch culling may differ in the last bit).
+ *    take that block's value and gradient, so both sides see the same signs
+ *    (the evaluator's per-batch culling may differ in the last bit).
  * 5. In parallel, marching tetrahedra per block (tetra.c, refine.c).
  * 6. One thread merges the blocks in block order, sharing the vertex of an
  *    edge two blocks both cut (the first block's copy), so the output is the
@@ -217,62 +218,179 @@ static lb__block *find_block(run *R, const uint32_t b[3]) {
     return lo < R->nblocks && R->blocks[lo].id == id ? &R->blocks[lo] : NULL;
 }
 
+/* phi_c's interval over nodes [n0, n1] with phi from an interval pass
+ * restricted by the block's plan (lb__bounds_pass_sub). */
+static void sub_phi(const lb_evaluator *ev, const lb__grid *g, const lb__plan *plan, lb__iv *R,
+                    const uint64_t n0[3], const uint64_t n1[3], double *lo, double *hi) {
+    double bl[3], bh[3], bc[3], br[3];
+    lb__node_pos(g, n0[0], n0[1], n0[2], bl);
+    lb__node_pos(g, n1[0], n1[1], n1[2], bh);
+    lb__box_centre(bl, bh, bc, br);
+    lb__bounds_pass_sub(ev, plan, bc, br, R);
+    const lb__iv f = R[ev->out];
+    double plo = g->soft ? 0.5 - f.hi : f.lo, phi = g->soft ? 0.5 - f.lo : f.hi;
+    if (g->closed)
+        for (int d = 0; d < 3; ++d) {
+            const double l1 = g->bmin[d] - bh[d], h1 = g->bmin[d] - bl[d];
+            const double l2 = bl[d] - g->bmax[d], h2 = bh[d] - g->bmax[d];
+            if (l1 > plo) plo = l1;
+            if (l2 > plo) plo = l2;
+            if (h1 > phi) phi = h1;
+            if (h2 > phi) phi = h2;
+        }
+    *lo = plo;
+    *hi = phi;
+}
+
+/* Inside a kept block, the sub-boxes of at most 2^3 cells whose interval
+ * may contain 0: their cells and corner nodes are marked; nothing else of
+ * the block is evaluated (no cell outside them can cross the surface). */
+static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const uint32_t s0[3],
+                 const uint32_t s1[3]) {
+    const lb__grid *g = R->g;
+    uint64_t n0[3], n1[3];
+    for (int d = 0; d < 3; ++d) {
+        n0[d] = (uint64_t)B->b[d] * LB__MB + s0[d];
+        n1[d] = (uint64_t)B->b[d] * LB__MB + s1[d];
+    }
+    double lo, hi;
+    sub_phi(R->ev, g, plan, IV, n0, n1, &lo, &hi);
+    if (lo >= 0.0 || hi < 0.0) return;
+    int axis = -1;
+    uint32_t span = 2;
+    for (int d = 0; d < 3; ++d)
+        if (s1[d] - s0[d] > span) {
+            span = s1[d] - s0[d];
+            axis = d;
+        }
+    if (axis >= 0) {
+        const uint32_t mid = s0[axis] + span / 2;
+        uint32_t a1[3] = {s1[0], s1[1], s1[2]}, b0[3] = {s0[0], s0[1], s0[2]};
+        a1[axis] = mid;
+        b0[axis] = mid;
+        mark(R, B, plan, IV, s0, a1);
+        mark(R, B, plan, IV, b0, s1);
+        return;
+    }
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    for (uint32_t k = s0[2]; k <= s1[2]; ++k)
+        for (uint32_t j = s0[1]; j <= s1[1]; ++j)
+            for (uint32_t i = s0[0]; i <= s1[0]; ++i) {
+                B->nmask[((size_t)k * D1 + j) * D0 + i] = 1;
+                if (i < s1[0] && j < s1[1] && k < s1[2])
+                    B->cmask[((size_t)k * B->nc[1] + j) * B->nc[0] + i] = 1;
+            }
+}
+
+/* The block's plan (its interval pass), then mark(). */
+static lb_status mark_block(run *R, lb__block *B, lb_error *err) {
+    const lb_evaluator *ev = R->ev;
+    lb__iv *IV = malloc(ev->nregs * sizeof *IV);
+    lb__plan plan = {malloc(ev->n), malloc(ev->n * sizeof *plan.nact),
+                     malloc((ev->total_k ? ev->total_k : 1) * sizeof *plan.act)};
+    lb_status s = LB_OK;
+    if (!IV || !plan.need || !plan.nact || !plan.act) {
+        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    } else {
+        double bmin[3], bmax[3], bc[3], br[3];
+        lb__block_box(R->g, B, bmin, bmax);
+        lb__box_centre(bmin, bmax, bc, br);
+        lb__bounds_pass(ev, bc, br, IV, &plan);
+        const uint32_t zero[3] = {0, 0, 0};
+        mark(R, B, &plan, IV, zero, B->nc);
+    }
+    free(IV);
+    free(plan.need);
+    free(plan.nact);
+    free(plan.act);
+    return s;
+}
+
 static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     const lb__grid *g = R->g;
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
     const size_t n = (size_t)D0 * D1 * D2;
-    double *mem = malloc(7 * n * sizeof *mem);
+    B->nmask = calloc(n, 1);
+    B->cmask = calloc((size_t)B->nc[0] * B->nc[1] * B->nc[2], 1);
     B->vals = malloc(n * sizeof *B->vals);
-    if (!mem || !B->vals) {
+    B->grads = malloc(3 * n * sizeof *B->grads);
+    if (!B->nmask || !B->cmask || !B->vals || !B->grads)
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    lb_status s = mark_block(R, B, err);
+    if (s) return s;
+    size_t m = 0;
+    for (size_t q = 0; q < n; ++q) m += B->nmask[q];
+    if (m == 0) return LB_OK;
+    double *mem = malloc(7 * m * sizeof *mem);
+    size_t *idx = malloc(m * sizeof *idx);
+    if (!mem || !idx) {
         free(mem);
+        free(idx);
         return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     }
-    double *x = mem, *y = x + n, *z = y + n, *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
-    size_t q = 0;
+    double *x = mem, *y = x + m, *z = y + m, *v = z + m, *gx = v + m, *gy = gx + m, *gz = gy + m;
+    size_t q = 0, w = 0;
     for (uint32_t k = 0; k < D2; ++k)
         for (uint32_t j = 0; j < D1; ++j)
             for (uint32_t i = 0; i < D0; ++i, ++q) {
+                if (!B->nmask[q]) continue;
                 double X[3];
                 lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + i, (uint64_t)B->b[1] * LB__MB + j,
                              (uint64_t)B->b[2] * LB__MB + k, X);
-                x[q] = X[0];
-                y[q] = X[1];
-                z[q] = X[2];
+                x[w] = X[0];
+                y[w] = X[1];
+                z[w] = X[2];
+                idx[w++] = q;
             }
-    lb_status s = lb_evaluator_eval(R->ev, n, x, y, z, v, gx, gy, gz, 1, err);
-    for (size_t i = 0; i < n && !s; ++i) {
+    double bmin[3], bmax[3];
+    lb__block_box(g, B, bmin, bmax);
+    s = lb__eval_in_box(R->ev, bmin, bmax, m, x, y, z, v, gx, gy, gz, err);
+    for (size_t i = 0; i < m && !s; ++i) {
         const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
-        double gp[3];
-        B->vals[i] = lb__mesh_phi(g, X, v[i], gf, gp);
+        B->vals[idx[i]] = lb__mesh_phi(g, X, v[i], gf, B->grads + 3 * idx[i]);
     }
     free(mem);
+    free(idx);
     return s;
 }
 
-/* Far-face nodes take the value of the block that owns them. */
+/* Far-face nodes take the value and gradient of the block that owns them. */
 static void block_share(run *R, lb__block *B) {
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
+    /* the (up to 7) next blocks, looked up once */
+    const lb__block *next[8] = {NULL};
+    for (int c = 1; c < 8; ++c) {
+        uint32_t ob[3];
+        int ok = 1;
+        for (int d = 0; d < 3; ++d) {
+            ob[d] = B->b[d] + ((c >> d) & 1);
+            if (ob[d] >= R->nb[d]) ok = 0;
+        }
+        next[c] = ok ? find_block(R, ob) : NULL;
+    }
     for (uint32_t k = 0; k < D2; ++k)
         for (uint32_t j = 0; j < D1; ++j)
             for (uint32_t i = 0; i < D0; ++i) {
                 const uint32_t l[3] = {i, j, k};
-                uint32_t ob[3], ol[3];
-                int other = 0;
+                int c = 0;
+                uint32_t ol[3];
                 for (int d = 0; d < 3; ++d) {
-                    ob[d] = B->b[d];
                     ol[d] = l[d];
                     if (l[d] == LB__MB && B->b[d] + 1 < R->nb[d]) {
-                        ob[d] = B->b[d] + 1;
+                        c |= 1 << d;
                         ol[d] = 0;
-                        other = 1;
                     }
                 }
-                if (!other) continue;
-                const lb__block *O = find_block(R, ob);
-                if (!O) continue;
+                if (!c || !next[c]) continue;
+                const lb__block *O = next[c];
                 const uint32_t E0 = O->nc[0] + 1, E1 = O->nc[1] + 1;
-                B->vals[((size_t)k * D1 + j) * D0 + i] =
-                    O->vals[((size_t)ol[2] * E1 + ol[1]) * E0 + ol[0]];
+                const size_t mine = ((size_t)k * D1 + j) * D0 + i,
+                             theirs = ((size_t)ol[2] * E1 + ol[1]) * E0 + ol[0];
+                /* a node only one side evaluated is used only by that side:
+                 * the other side's interval proved its cells there do not cross */
+                if (!B->nmask[mine] || !O->nmask[theirs]) continue;
+                B->vals[mine] = O->vals[theirs];
+                memcpy(B->grads + 3 * mine, O->grads + 3 * theirs, 3 * sizeof(double));
             }
 }
 
@@ -285,8 +403,16 @@ static void do_block(run *R, size_t i) {
         s = block_nodes(R, B, &e);
     else if (R->phase == PH_SHARE)
         block_share(R, B);
-    else
+    else {
         s = lb__mesh_block(R->ev, R->g, B, &e);
+        /* the node data is not needed any more (the share phase is over) */
+        free(B->vals);
+        free(B->grads);
+        free(B->nmask);
+        free(B->cmask);
+        B->vals = B->grads = NULL;
+        B->nmask = B->cmask = NULL;
+    }
     if (s) {
         pthread_mutex_lock(&R->lock);
         if (i < R->err_block) {
@@ -359,7 +485,7 @@ static lb_status phase(run *R, int ph, size_t nt, progress *P) {
 
 /* ---- merge ---- */
 
-static lb_status merge(const run *R, lb_mesh *M, lb_error *err) {
+static lb_status merge(run *R, lb_mesh *M, lb_error *err) {
     size_t tv = 0, tt = 0;
     for (size_t i = 0; i < R->nblocks; ++i) {
         tv += R->blocks[i].nv;
@@ -384,7 +510,7 @@ static lb_status merge(const run *R, lb_mesh *M, lb_error *err) {
     }
     size_t nv = 0, nt = 0;
     for (size_t b = 0; b < R->nblocks; ++b) {
-        const lb__block *B = &R->blocks[b];
+        lb__block *B = &R->blocks[b];
         for (size_t i = 0; i < B->nv; ++i) {
             const uint64_t key = B->vkey[i];
             size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
@@ -400,6 +526,14 @@ static lb_status merge(const run *R, lb_mesh *M, lb_error *err) {
         }
         for (size_t t = 0; t < 3 * B->nt; ++t) M->triangles[3 * nt + t] = local[B->tri[t]];
         nt += B->nt;
+        /* merged: the block's copy goes, so the peak holds one mesh, not two */
+        free(B->vkey);
+        free(B->vpos);
+        free(B->vnrm);
+        free(B->tri);
+        B->vkey = NULL;
+        B->vpos = B->vnrm = NULL;
+        B->tri = NULL;
     }
     M->nvertices = nv;
     M->ntriangles = nt;
@@ -486,6 +620,9 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     for (size_t i = 0; i < R.nblocks; ++i) {
         lb__block *B = &R.blocks[i];
         free(B->vals);
+        free(B->grads);
+        free(B->nmask);
+        free(B->cmask);
         free(B->vkey);
         free(B->vpos);
         free(B->vnrm);

@@ -2,14 +2,16 @@
  * edges, batched so that each iteration is one evaluator call over all the
  * edges still unconverged.
  *
- * Per edge: start at the linear interpolation of the end values; Newton on
+ * Per edge: start at the root of the cubic Hermite interpolant of the end
+ * values and gradients (hermite_root); Newton on
  * t (phi's derivative along the edge is grad phi . (b - a)) while the step
  * stays strictly inside the bracket, bisection otherwise and every eighth
  * step. Stops when
  * |phi| <= 1e-7 h |grad phi| (the vertex is within 1e-7 cell sizes of the
- * surface to first order) or when the bracket is below 1e-12 of the edge.
- * The vertex is the last evaluated point, so its normal is the gradient
- * there. */
+ * surface to first order) or when the bracket is below 1e-12 of the edge;
+ * or takes one last Newton step unevaluated when a curvature bound from the
+ * normals makes its error below 1e-9 h (see the loop). The normal is the
+ * gradient at the last evaluated point. */
 #include "mesh_internal.h"
 
 #include <math.h>
@@ -40,9 +42,45 @@ double lb__mesh_phi(const lb__grid *g, const double X[3], double f, const double
 
 #define MAX_ITER 64
 
-lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, size_t n, const double *a,
-                           const double *b, const double *pa, const double *pb, double *pos,
-                           double *nrm, lb_error *err) {
+/* The root in (0, 1) of the cubic Hermite interpolant of phi along an edge
+ * (end values f0 < 0 <= f1, end slopes d0, d1): a start that is usually
+ * within rounding of the surface, so one evaluation confirms it. Newton on
+ * the cubic inside its bracket, bisection when a step leaves it. */
+static double hermite_root(double f0, double f1, double d0, double d1) {
+    /* H(t) = f0 + d0 t + c2 t^2 + c3 t^3 */
+    const double c2 = 3.0 * (f1 - f0) - 2.0 * d0 - d1, c3 = 2.0 * (f0 - f1) + d0 + d1;
+    double lo = 0.0, hi = 1.0, t = f0 / (f0 - f1);
+    for (int it = 0; it < 16; ++it) {
+        const double H = f0 + t * (d0 + t * (c2 + t * c3));
+        const double dH = d0 + t * (2.0 * c2 + 3.0 * t * c3);
+        if (H < 0.0)
+            lo = t;
+        else
+            hi = t;
+        const double tn = dH > 0.0 ? t - H / dH : NAN;
+        const double next = tn > lo && tn < hi ? tn : 0.5 * (lo + hi);
+        if (fabs(next - t) <= 1e-7) return next; /* far below the cubic's own error */
+        t = next;
+    }
+    return t;
+}
+
+void lb__block_box(const lb__grid *g, const lb__block *B, double bmin[3], double bmax[3]) {
+    const uint64_t n0[3] = {(uint64_t)B->b[0] * LB__MB, (uint64_t)B->b[1] * LB__MB,
+                            (uint64_t)B->b[2] * LB__MB};
+    lb__node_pos(g, n0[0], n0[1], n0[2], bmin);
+    lb__node_pos(g, n0[0] + B->nc[0], n0[1] + B->nc[1], n0[2] + B->nc[2], bmax);
+    for (int d = 0; d < 3; ++d) {
+        const double pad = 1e-9 * g->h[d];
+        bmin[d] -= pad;
+        bmax[d] += pad;
+    }
+}
+
+lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, size_t n,
+                           const double *a, const double *b, const double *pa, const double *pb,
+                           const double *ga, const double *gb, double *pos, double *nrm,
+                           lb_error *err) {
     if (n == 0) return LB_OK;
     double hmin = g->h[0];
     if (g->h[1] < hmin) hmin = g->h[1];
@@ -58,11 +96,17 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, size_t n, 
         act[i] = i;
         lo[i] = 0.0;
         hi[i] = 1.0;
-        double t0 = pa[i] / (pa[i] - pb[i]);
+        const double e[3] = {b[3 * i] - a[3 * i], b[3 * i + 1] - a[3 * i + 1],
+                             b[3 * i + 2] - a[3 * i + 2]};
+        const double d0 = ga[3 * i] * e[0] + ga[3 * i + 1] * e[1] + ga[3 * i + 2] * e[2];
+        const double d1 = gb[3 * i] * e[0] + gb[3 * i + 1] * e[1] + gb[3 * i + 2] * e[2];
+        double t0 = hermite_root(pa[i], pb[i], d0, d1);
         if (!(t0 > 1e-9)) t0 = 1e-9;
         if (!(t0 < 1.0 - 1e-9)) t0 = 1.0 - 1e-9;
         t[i] = t0;
     }
+    double bmin[3], bmax[3];
+    lb__block_box(g, B, bmin, bmax);
     lb_status s = LB_OK;
     for (int it = 0; it < MAX_ITER && na > 0 && !s; ++it) {
         for (size_t j = 0; j < na; ++j) {
@@ -72,7 +116,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, size_t n, 
             y[j] = A[1] + t[i] * (Bp[1] - A[1]);
             z[j] = A[2] + t[i] * (Bp[2] - A[2]);
         }
-        s = lb_evaluator_eval(ev, na, x, y, z, v, gx, gy, gz, 1, err);
+        s = lb__eval_in_box(ev, bmin, bmax, na, x, y, z, v, gx, gy, gz, err);
         if (s) break;
         size_t keep = 0;
         const int last = it == MAX_ITER - 1;
@@ -99,6 +143,40 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, size_t n, 
             }
             const double dt = gp[0] * e[0] + gp[1] * e[1] + gp[2] * e[2];
             const double tn = dt != 0.0 ? t[i] - ph / dt : NAN;
+            if (tn > lo[i] && tn < hi[i] && gl > 0.0) {
+                /* A last Newton step taken without evaluating its point, when
+                 * its error is provably tiny: the unit normals at both ends
+                 * and here bound the curvature along the edge (kappa), and
+                 * Newton's error is kappa step^2 / 2. Accepted only when that
+                 * is below tol / 100 and the normal here is within 1e-6 rad
+                 * of the one at the new point; kinks (normals that jump)
+                 * never qualify. */
+                double kap = 0.0;
+                const double *G[2] = {ga + 3 * i, gb + 3 * i};
+                for (int q = 0; q < 2; ++q) {
+                    const double l =
+                        sqrt(G[q][0] * G[q][0] + G[q][1] * G[q][1] + G[q][2] * G[q][2]);
+                    if (!(l > 0.0)) {
+                        kap = INFINITY;
+                        break;
+                    }
+                    double dn = 0.0;
+                    for (int d = 0; d < 3; ++d) {
+                        const double u = G[q][d] / l - gp[d] / gl;
+                        dn += u * u;
+                    }
+                    if (sqrt(dn) > kap) kap = sqrt(dn);
+                }
+                kap = 4.0 * kap / L;
+                const double step = fabs(tn - t[i]) * L;
+                if (0.5 * kap * step * step <= 0.01 * tol && kap * step <= 1e-6) {
+                    for (int d = 0; d < 3; ++d) {
+                        pos[3 * i + d] = A[d] + tn * e[d];
+                        nrm[3 * i + d] = gp[d] / gl;
+                    }
+                    continue;
+                }
+            }
             /* every eighth step bisects, so slow Newton (a kink) still ends */
             t[i] = tn > lo[i] && tn < hi[i] && it % 8 != 7 ? tn : 0.5 * (lo[i] + hi[i]);
             act[keep++] = i;

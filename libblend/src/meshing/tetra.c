@@ -36,6 +36,7 @@ typedef struct bctx {
     int32_t *emap; /* local edge id -> crossing edge index */
     size_t ne, cap;
     double *ea, *eb, *pa, *pb; /* inside end, outside end, their phi */
+    double *ga, *gb;           /* and their gradients */
     uint64_t *key;
     face *faces;
     size_t nf, fcap;
@@ -79,7 +80,11 @@ static int64_t edge_of(bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, int 
         if (pb) C->pb = pb;
         uint64_t *key = realloc(C->key, nc * sizeof *key);
         if (key) C->key = key;
-        if (!ea || !eb || !pa || !pb || !key) return -1;
+        double *ga = realloc(C->ga, 3 * nc * sizeof *ga);
+        if (ga) C->ga = ga;
+        double *gb = realloc(C->gb, 3 * nc * sizeof *gb);
+        if (gb) C->gb = gb;
+        if (!ea || !eb || !pa || !pb || !key || !ga || !gb) return -1;
         C->cap = nc;
     }
     const lb__grid *g = C->g;
@@ -94,6 +99,12 @@ static int64_t edge_of(bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, int 
     memcpy(C->eb + 3 * e, pin ? Q : P, sizeof P);
     C->pa[e] = pin ? c[op] : c[oq];
     C->pb[e] = pin ? c[oq] : c[op];
+    const uint32_t D0n = B->nc[0] + 1, D1n = B->nc[1] + 1;
+    const size_t np = ((size_t)lk * D1n + lj) * D0n + li;
+    const size_t nq = ((size_t)(lk + ((mask >> 2) & 1)) * D1n + (lj + ((mask >> 1) & 1))) * D0n +
+                      (li + (mask & 1));
+    memcpy(C->ga + 3 * e, B->grads + 3 * (pin ? np : nq), 3 * sizeof(double));
+    memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
     C->key[e] = lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask;
     C->emap[lid] = (int32_t)e;
     return (int64_t)e;
@@ -214,6 +225,7 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
     for (uint32_t k = 0; k < B->nc[2]; ++k)
         for (uint32_t j = 0; j < B->nc[1]; ++j)
             for (uint32_t i = 0; i < B->nc[0]; ++i) {
+                if (!B->cmask[((size_t)k * B->nc[1] + j) * B->nc[0] + i]) continue;
                 double c[8];
                 int nin = 0;
                 for (int o = 0; o < 8; ++o) {
@@ -242,7 +254,8 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
             s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
             goto done;
         }
-        s = lb__refine_edges(ev, g, C.ne, C.ea, C.eb, C.pa, C.pb, B->vpos, B->vnrm, err);
+        s = lb__refine_edges(ev, g, B, C.ne, C.ea, C.eb, C.pa, C.pb, C.ga, C.gb, B->vpos, B->vnrm,
+                             err);
         if (s) goto done;
         uint32_t *T = B->tri;
         for (size_t f = 0; f < C.nf; ++f) {
@@ -269,6 +282,8 @@ done:
     free(C.eb);
     free(C.pa);
     free(C.pb);
+    free(C.ga);
+    free(C.gb);
     free(C.key);
     free(C.faces);
     return s;
