@@ -12,6 +12,11 @@ PACKAGES=(
   python3-numpy              # tests: independent mesh readers and checks (tests/mesh/)
 )
 
+# `install-deps.sh bench`: also what the benchmarks compare against
+if [ "${1:-}" = "bench" ]; then
+  PACKAGES+=(blender python3-skimage)
+fi
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

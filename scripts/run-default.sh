@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job on the built-in default scene (scenes/default.json): install
 # what is missing, build, then validate every shipped scene, describe the
-# default one and evaluate its field and gradient along a line through it.
+# default one, evaluate its field and gradient along a line through it, and
+# mesh it (build-release/default.ply).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -13,3 +14,4 @@ blendtool=./build-release/tools/blendtool
 echo "# value gx gy gz along the y axis, through the cube and the blended super-ellipsoid"
 for y in -1.2 -0.9 0 0.9 1.0 1.1 1.35 1.9 2.1; do echo "0 $y 0"; done |
   "$blendtool" eval scenes/default.json
+"$blendtool" mesh scenes/default.json -o build-release/default.ply --resolution 256
