@@ -230,6 +230,12 @@ static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, s
     out->hi += 1e-9 * (1.0 + fabs(out->hi));
 }
 
+static int any_above_one(const iv *x, size_t k) {
+    for (size_t i = 0; i < k; ++i)
+        if (x[i].hi > 1.0) return 1;
+    return 0;
+}
+
 static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const iv *c, iv *out) {
     const size_t k = n->k;
     if (n->bulge) {
@@ -245,6 +251,12 @@ static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const 
             out->hi = 1.0 - x[0].lo > 0.0 ? 1.0 - x[0].lo : 0.0;
         }
         return; /* exact */
+    } else if (n->family == LB__F_PERLIN && any_above_one(x, k)) {
+        /* Perlin's products are monotone only on [0, 1]: an argument a soft
+         * union took above 1 flips a factor's sign. No information then. */
+        out->lo = 0.0;
+        out->hi = BIG;
+        return;
     } else {
         double xl[LB_MAX_ARITY], xh[LB_MAX_ARITY], v1 = 0.0, v2 = 0.0;
         for (size_t i = 0; i < k; ++i) {
