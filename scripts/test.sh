@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole test suite: install what is missing, then a Release build and a
-# sanitizer (ASan + UBSan) build, each run by ctest, then the scene parser
-# under libFuzzer (clang, ASan + UBSan) for LIBBLEND_FUZZ_SECONDS (60).
+# sanitizer (ASan + UBSan) build, each run by ctest; the threaded tests under
+# ThreadSanitizer; then the scene parser under libFuzzer (clang, ASan +
+# UBSan) for LIBBLEND_FUZZ_SECONDS (60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -17,6 +18,13 @@ for cfg in "build-release:-DCMAKE_BUILD_TYPE=Release" \
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir "$dir" --output-on-failure -j "$JOBS"
 done
+
+echo "== build-tsan (ThreadSanitizer: the tests that run threads)"
+cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_TSAN=ON \
+  -DLIBBLEND_BENCH=OFF
+cmake --build build-tsan -j "$JOBS" --target test_threads test_scene_eval test_mesh
+TSAN_OPTIONS=halt_on_error=1 \
+  ctest --test-dir build-tsan --output-on-failure -R '^(test_threads|test_scene_eval|test_mesh)$'
 
 echo "== build-fuzz (clang, libFuzzer, ASan + UBSan)"
 CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_FUZZ=ON \
