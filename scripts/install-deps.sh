@@ -10,6 +10,7 @@ PACKAGES=(
   libcjson-dev               # JSON parser for scene files
   python3-jsonschema         # tests: scene files against docs/libblend-scene.schema.json
   python3-numpy              # tests: independent mesh readers and checks (tests/mesh/)
+  povray                     # tests: the generated POV-Ray include, run by POV-Ray itself
 )
 
 # `install-deps.sh bench`: also what the benchmarks compare against

@@ -1,0 +1,286 @@
+/* POV-Ray agrees with the C library: for every operator family and
+ * primitive in povray_include/libblend.inc, a scene that evaluates the
+ * generated functions at >= 1000 random points (random parameters, ties,
+ * single active terms, non-blending regions) is run by the real povray, and
+ * every value must match the C library within 1e-9 (absolute or relative,
+ * whichever is larger).
+ *
+ * Usage: test_pov_agreement SOURCE_DIR WORK_DIR */
+#define _POSIX_C_SOURCE 200809L
+#include <libblend/libblend.h>
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    uint64_t s;
+} rng;
+static double unit(rng *r) {
+    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+}
+static double range(rng *r, double a, double b) {
+    return a + (b - a) * unit(r);
+}
+static double logu(rng *r, double a, double b) {
+    return exp(range(r, log(a), log(b)));
+}
+
+#define MAXCASES 20000
+static double expect[MAXCASES];
+static const char *family[MAXCASES];
+static size_t ncases;
+static FILE *pov;
+
+/* one evaluation: the .pov writes F(x, y, z); we remember the C value */
+static void record(const char *fam, const char *fn, double x, double y, double z, double value) {
+    if (ncases >= MAXCASES) abort();
+    fprintf(pov, "#write (FO, str(%s(%.17g, %.17g, %.17g), 0, 17), \"\\n\")\n", fn, x, y, z);
+    family[ncases] = fam;
+    expect[ncases++] = value;
+}
+
+/* k argument functions F_i(x, y, z) = a_i x + b_i, declared as an array */
+static void args_array(const char *name, size_t k, const double *a, const double *b) {
+    fprintf(pov, "#declare %s = array[%zu] {", name, k);
+    for (size_t i = 0; i < k; ++i)
+        fprintf(pov, "%s function(x, y, z) { x * %.17g + %.17g }", i ? "," : "", a[i], b[i]);
+    fprintf(pov, " };\n");
+}
+
+static void farray(const char *name, size_t k, const double *v) {
+    fprintf(pov, "#declare %s = array[%zu] {", name, k);
+    for (size_t i = 0; i < k; ++i) fprintf(pov, "%s%.17g", i ? ", " : "", v[i]);
+    fprintf(pov, "};\n");
+}
+
+static void displacement_cases(rng *g) {
+    static const char *const fams[3] = {"displacement union", "displacement intersection",
+                                        "displacement difference"};
+    for (int set = 0; set < 600; ++set) {
+        const int op = set % 3;
+        const size_t k = 1 + (size_t)(unit(g) * 16);
+        double a[16], b[16], r[16], p[16], m[16];
+        const double scale = logu(g, 0.01, 10.0);
+        const int tie = set % 7 == 0, alone = set % 11 == 0;
+        for (size_t i = 0; i < k; ++i) {
+            a[i] = tie ? 1.0 : range(g, 0.5, 1.5);
+            b[i] = tie ? 0.0 : scale * range(g, -1.0, 1.0);
+            if (alone && i > 0) b[i] += 50.0 * scale * (op == 1 ? -1 : 1); /* one active term */
+            r[i] = scale * logu(g, 0.05, 1.0);
+            const double u = unit(g);
+            p[i] = u < 0.3 ? 2.0 : u < 0.6 ? (double)(1 + (int)(unit(g) * 16)) : logu(g, 1.05, 16);
+            if (p[i] < 1.05) p[i] = 2.0;
+            m[i] = logu(g, 0.05, 20.0);
+        }
+        args_array("A", k, a, b);
+        farray("R", k, r);
+        farray("P", k, p);
+        farray("M", k, m);
+        fprintf(pov, "#declare G = LB_Displacement(%d, A, R, P, M)\n", op);
+        for (int q = 0; q < 5; ++q) {
+            const double x = scale * range(g, -1.0, 1.0);
+            double d[16], v;
+            for (size_t i = 0; i < k; ++i) d[i] = x * a[i] + b[i];
+            lb_error e;
+            if (lb_displacement((lb_setop)op, k, d, r, p, m, &v, NULL, &e)) {
+                fprintf(stderr, "%s\n", e.message);
+                exit(1);
+            }
+            record(fams[op], "G", x, 0, 0, v);
+        }
+        fprintf(pov, "#undef G\n#undef A\n");
+    }
+}
+
+static void classic_cases(rng *g) {
+    static const struct {
+        const char *fam, *macro;
+        lb_classic_kind kind;
+        int soft, binary;
+    } K[] = {
+        {"R-function union", "LB_RUnion", LB_RFUNC_UNION, 0, 1},
+        {"R-function intersection", "LB_RIntersection", LB_RFUNC_INTERSECTION, 0, 1},
+        {"soft sum", "LB_SoftSum", LB_SOFT_SUM, 1, 0},
+        {"Ricci union", "LB_Ricci", LB_RICCI_UNION, 1, 0},
+        {"Perlin union", "LB_PerlinUnion", LB_PERLIN_UNION, 1, 0},
+        {"Perlin intersection", "LB_PerlinIntersection", LB_PERLIN_INTERSECTION, 1, 0},
+        {"Perlin difference", "LB_PerlinDifference", LB_PERLIN_DIFFERENCE, 1, 0},
+    };
+    for (size_t f = 0; f < sizeof K / sizeof K[0]; ++f)
+        for (int set = 0; set < 200; ++set) {
+            const size_t k = K[f].binary ? 2 : 1 + (size_t)(unit(g) * 8);
+            double a[16], b[16];
+            for (size_t i = 0; i < k; ++i) {
+                a[i] = K[f].soft ? range(g, 0.0, 0.5) : range(g, -1.0, 1.0);
+                b[i] = K[f].soft ? range(g, 0.0, 0.5) : range(g, -2.0, 2.0);
+            }
+            const double n = logu(g, 1.0, 8.0);
+            args_array("A", k, a, b);
+            if (K[f].binary)
+                fprintf(pov, "#declare G = %s(A[0], A[1])\n", K[f].macro);
+            else if (K[f].kind == LB_RICCI_UNION)
+                fprintf(pov, "#declare G = %s(A, %.17g)\n", K[f].macro, n);
+            else
+                fprintf(pov, "#declare G = %s(A)\n", K[f].macro);
+            for (int q = 0; q < 5; ++q) {
+                const double x = K[f].soft ? unit(g) : range(g, -2.0, 2.0);
+                double d[16], v;
+                for (size_t i = 0; i < k; ++i) d[i] = x * a[i] + b[i];
+                lb_error e;
+                if (lb_classic(K[f].kind, k, d, n, &v, NULL, &e)) {
+                    fprintf(stderr, "%s: %s\n", K[f].fam, e.message);
+                    exit(1);
+                }
+                record(K[f].fam, "G", x, 0, 0, v);
+            }
+            fprintf(pov, "#undef G\n#undef A\n");
+        }
+}
+
+static void primitive_cases(rng *g) {
+    for (int set = 0; set < 6000; ++set) {
+        const int kind = set % 6;
+        double c[3], q[3], ax[3], R = logu(g, 0.1, 3.0), R2 = R * range(g, 0.1, 0.5);
+        for (int d = 0; d < 3; ++d) {
+            c[d] = range(g, -2, 2);
+            q[d] = range(g, -2, 2);
+            ax[d] = range(g, -1, 1);
+        }
+        lb_primitive P;
+        lb_error e;
+        const char *fam = NULL;
+        lb_status s = LB_OK;
+        switch (kind) {
+        case 0:
+            fam = "sphere";
+            s = lb_primitive_sphere(&P, c, R, &e);
+            fprintf(pov, "#declare G = LB_Sphere(<%.17g, %.17g, %.17g>, %.17g)\n", c[0], c[1], c[2],
+                    R);
+            break;
+        case 1: {
+            fam = "ellipsoid";
+            const double A[3] = {R, R * range(g, 0.3, 2), R * range(g, 0.3, 2)};
+            s = lb_primitive_ellipsoid(&P, c, A, &e);
+            fprintf(pov,
+                    "#declare G = LB_Ellipsoid(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>)\n",
+                    c[0], c[1], c[2], A[0], A[1], A[2]);
+            break;
+        }
+        case 2:
+            fam = "slab";
+            s = lb_primitive_slab(&P, c, ax, R, &e);
+            fprintf(pov,
+                    "#declare G = LB_Slab(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n",
+                    c[0], c[1], c[2], ax[0], ax[1], ax[2], R);
+            break;
+        case 3:
+            fam = "cylinder";
+            s = lb_primitive_cylinder(&P, c, ax, R, &e);
+            fprintf(
+                pov,
+                "#declare G = LB_Cylinder(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n",
+                c[0], c[1], c[2], ax[0], ax[1], ax[2], R);
+            break;
+        case 4:
+            fam = "capsule";
+            s = lb_primitive_capsule(&P, c, q, R, &e);
+            fprintf(
+                pov,
+                "#declare G = LB_Capsule(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n",
+                c[0], c[1], c[2], q[0], q[1], q[2], R);
+            break;
+        default:
+            fam = "torus";
+            s = lb_primitive_torus(&P, c, ax, R, R2, &e);
+            fprintf(pov,
+                    "#declare G = LB_Torus(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g, "
+                    "%.17g)\n",
+                    c[0], c[1], c[2], ax[0], ax[1], ax[2], R, R2);
+            break;
+        }
+        if (s) {
+            fprintf(stderr, "%s: %s\n", fam, e.message);
+            exit(1);
+        }
+        for (int k = 0; k < 1; ++k) {
+            const double X[3] = {range(g, -4, 4), range(g, -4, 4), range(g, -4, 4)};
+            record(fam, "G", X[0], X[1], X[2], lb_primitive_eval(&P, X, NULL));
+        }
+        fprintf(pov, "#undef G\n");
+    }
+}
+
+int main(int argc, char **argv) {
+    if (argc != 3) {
+        fprintf(stderr, "usage: test_pov_agreement SOURCE_DIR WORK_DIR\n");
+        return 2;
+    }
+    char path[4096], outp[4096], cmd[16384];
+    snprintf(path, sizeof path, "%s/agree.pov", argv[2]);
+    snprintf(outp, sizeof outp, "%s/agree.txt", argv[2]);
+    pov = fopen(path, "w");
+    if (!pov) {
+        perror(path);
+        return 1;
+    }
+    fprintf(pov, "#version 3.7;\n#include \"%s/povray_include/libblend.inc\"\n", argv[1]);
+    fprintf(pov, "#fopen FO \"%s\" write\n", outp);
+    rng g = {77};
+    displacement_cases(&g);
+    classic_cases(&g);
+    primitive_cases(&g);
+    fprintf(pov, "#fclose FO\n");
+    fclose(pov);
+    remove(outp);
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && povray +I'%s' -D -F +W1 +H1 -V -GR -GS -GW +L'%s/povray_include' "
+             "> povray.log 2>&1",
+             argv[2], path, argv[1]);
+    if (system(cmd) != 0) {
+        fprintf(stderr, "povray failed; see %s/povray.log\n", argv[2]);
+        return 1;
+    }
+    FILE *in = fopen(outp, "r");
+    if (!in) {
+        perror(outp);
+        return 1;
+    }
+    size_t n = 0, bad = 0;
+    double worst = 0.0;
+    double v;
+    while (n < ncases && fscanf(in, "%lf", &v) == 1) {
+        const double tol = 1e-9 * fmax(1.0, fabs(expect[n]));
+        const double err = fabs(v - expect[n]);
+        if (!(err <= tol)) {
+            if (bad < 10)
+                fprintf(stderr, "  %s case %zu: povray %.17g, C %.17g\n", family[n], n, v,
+                        expect[n]);
+            ++bad;
+        }
+        if (err / fmax(1.0, fabs(expect[n])) > worst) worst = err / fmax(1.0, fabs(expect[n]));
+        ++n;
+    }
+    fclose(in);
+    /* per family counts */
+    const char *seen[64];
+    size_t counts[64], ns = 0;
+    for (size_t i = 0; i < ncases; ++i) {
+        size_t j = 0;
+        while (j < ns && strcmp(seen[j], family[i])) ++j;
+        if (j == ns) {
+            seen[ns] = family[i];
+            counts[ns++] = 0;
+        }
+        counts[j]++;
+    }
+    for (size_t j = 0; j < ns; ++j) fprintf(stderr, "  %-28s %zu points\n", seen[j], counts[j]);
+    fprintf(stderr, "%zu of %zu values read, %zu outside 1e-9, worst %.3g\n", n, ncases, bad,
+            worst);
+    return n == ncases && bad == 0 ? 0 : 1;
+}
