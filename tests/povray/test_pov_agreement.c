@@ -98,6 +98,43 @@ static void displacement_cases(rng *g) {
     }
 }
 
+static void conic_cases(rng *g) {
+    static const char *const fams[3] = {"conic union", "conic intersection", "conic difference"};
+    for (int set = 0; set < 600; ++set) {
+        const int op = set % 3;
+        const double scale = logu(g, 0.01, 10.0);
+        double a[2], b[2], r[2], m[2];
+        for (int i = 0; i < 2; ++i) {
+            a[i] = range(g, 0.5, 1.5);
+            b[i] = scale * range(g, -1.0, 1.0);
+            r[i] = scale * logu(g, 0.05, 1.0);
+            m[i] = logu(g, 0.05, 20.0);
+        }
+        if (set % 9 == 0) { /* ties */
+            a[1] = a[0];
+            b[1] = b[0];
+        }
+        const double shape = r[0] * r[1] * (set % 5 == 0 ? 0.0 : range(g, -3.0, 0.95));
+        args_array("A", 2, a, b);
+        fprintf(pov, "#declare F1 = A[0];\n#declare F2 = A[1];\n");
+        farray("R", 2, r);
+        farray("M", 2, m);
+        fprintf(pov, "#declare G = LB_Conic(%d, F1, F2, R, %.17g, M)\n", op, shape);
+        for (int q = 0; q < 5; ++q) {
+            const double x = scale * range(g, -1.0, 1.0);
+            const double d[2] = {x * a[0] + b[0], x * a[1] + b[1]};
+            double v;
+            lb_error e;
+            if (lb_conic((lb_setop)op, d, r, shape, m, &v, NULL, &e)) {
+                fprintf(stderr, "%s\n", e.message);
+                exit(1);
+            }
+            record(fams[op], "G", x, 0, 0, v);
+        }
+        fprintf(pov, "#undef G\n#undef A\n#undef F1\n#undef F2\n");
+    }
+}
+
 static void classic_cases(rng *g) {
     static const struct {
         const char *fam, *macro;
@@ -233,6 +270,7 @@ int main(int argc, char **argv) {
     fprintf(pov, "#fopen FO \"%s\" write\n", outp);
     rng g = {77};
     displacement_cases(&g);
+    conic_cases(&g);
     classic_cases(&g);
     primitive_cases(&g);
     fprintf(pov, "#fclose FO\n");

@@ -207,6 +207,46 @@ static void classic(void) {
       "#end) }\n#end\n\n");
 }
 
+/* LB_Conic(Op, F1, F2, R, P, M): the binary conic BT_2 in closed form,
+ * mirroring lb__conic_union step for step (shifted variable s = h - h1). */
+static void conic(void) {
+    w("// ---- binary conic blend BT_2 (hsu2006 Eq. 4), closed form ----\n"
+      "// LB_Conic(Op, F1, F2, R, Shape, M): Op 0 union, 1 intersection, 2 difference;\n"
+      "// R, M arrays of 2 (r > 0, m > 0); Shape (the paper's p) below R[0] R[1]; 0 is\n"
+      "// the quarter ellipse, the same as LB_Displacement with p = 2.\n");
+    w("#macro LB_Conic(Op, F1, F2, R, Shape, M)\n"
+      "  #if (Shape >= R[0] * R[1]) #error \"LB_Conic: Shape must be below R[0] R[1]\" #end\n"
+      "  #local lbr1 = R[0]; #local lbr2 = R[1]; #local lbm1 = M[0]; #local lbm2 = M[1];\n"
+      "  #local lbp = Shape;\n"
+      "  #local lba = lbr2 * lbr2 * lbm1 * lbm1 + lbr1 * lbr1 * lbm2 * lbm2 + 2 * lbp * lbm1 * "
+      "lbm2;\n"
+      "  #local lbw = lbr1 * lbm2 + lbr2 * lbm1;\n");
+    /* distance of a candidate from [s2, 0] */
+    w("  #local lbdist = function(lbc, lbs2) { select(-lbc, lbc, select(lbc - lbs2, lbs2 - lbc, "
+      "0)) }\n");
+    /* s from v1, v2 via b, chord, cc, q */
+    w("  #local lbpick = function(lbsa, lbsb, lbs2) { min(0, max(lbs2, select(lbdist(lbsb, lbs2) "
+      "- lbdist(lbsa, lbs2), lbsb, lbsa))) }\n");
+    w("  #local lbs4 = function(lbq, lbcc, lbch) { select((lbcc / lbq <= 0) * (lbcc / lbq * lbw "
+      ">= lbch) - 0.5, lbpick(lbcc / lbq, lbq / lba, lbch / lbw), lbcc / lbq) }\n");
+    w("  #local lbs3 = function(lbb, lbcc, lbch) { lbs4(-0.5 * (lbb + select(lbb, -sqrt(max(0, "
+      "lbb * lbb - 4 * lba * lbcc)), sqrt(max(0, lbb * lbb - 4 * lba * lbcc)))), lbcc, lbch) }\n");
+    w("  #local lbs2 = function(lbv1, lbv2, lbch) { lbs3(2 * ((lbr1 - lbv1) * lbr2 * lbr2 * lbm1 "
+      "+ (lbr2 - lbv2) * lbr1 * lbr1 * lbm2 - lbp * (lbv1 * lbm2 + lbv2 * lbm1)), lbch * lbch + "
+      "2 * (lbp - lbr1 * lbr2) * lbv1 * lbv2, lbch) }\n");
+    w("  #local lbin = function(lbh1, lbv1, lbv2) { lbh1 + lbs2(lbv1, lbv2, lbr1 * lbv2 + lbr2 * "
+      "lbv1 - lbr1 * lbr2) }\n");
+    /* region II and h1 */
+    w("  #local lbu = function(lbx1, lbx2, lbh1, lbc) { select(lbc, select(lbx1 - lbm1 * lbh1 - "
+      "lbr1, lbin(lbh1, lbx1 - lbm1 * lbh1, 0), lbh1), select(lbx2 - lbm2 * lbh1 - lbr2, "
+      "lbin(lbh1, 0, lbx2 - lbm2 * lbh1), lbh1)) }\n");
+    w("  #local lbU = function(lbx1, lbx2) { lbu(lbx1, lbx2, select(lbx2 * lbm1 - lbx1 * lbm2, "
+      "lbx2 / lbm2, lbx1 / lbm1), lbx2 * lbm1 - lbx1 * lbm2) }\n");
+    w("  #local lbSG = select(Op - 1, 1, -1, -1);\n"
+      "  #local lbSO = select(abs(Op - 1), -1, -1, 1);\n"
+      "  function(x, y, z) { lbSG * lbU(lbSG * F1(x, y, z), lbSO * F2(x, y, z)) }\n#end\n\n");
+}
+
 /* LB_Displacement(Op, F, R, P, M): BT_k by unrolled CPS Newton. */
 static void displacement(int steps) {
     w("// ---- displacement blends BT_k (hsu2006; m = 1 everywhere is Rockwood's) ----\n"
@@ -299,6 +339,7 @@ int main(int argc, char **argv) {
     primitives();
     classic();
     displacement(steps);
+    conic();
     w("#version LB_INC_TEMP;\n#end\n");
     if (fclose(out) != 0 || rename(tmp, argv[1]) != 0) {
         perror(argv[1]);
