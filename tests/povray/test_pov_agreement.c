@@ -31,7 +31,7 @@ static double logu(rng *r, double a, double b) {
     return exp(range(r, log(a), log(b)));
 }
 
-#define MAXCASES 20000
+#define MAXCASES 100000
 static double expect[MAXCASES];
 static const char *family[MAXCASES];
 static size_t ncases;
@@ -132,6 +132,39 @@ static void conic_cases(rng *g) {
             record(fams[op], "G", x, 0, 0, v);
         }
         fprintf(pov, "#undef G\n#undef A\n#undef F1\n#undef F2\n");
+    }
+}
+
+static void scale_cases(rng *g) {
+    static const char *const fams[3] = {"scale union", "scale intersection", "scale difference"};
+    for (int set = 0; set < 600; ++set) {
+        const int op = set % 3;
+        const size_t k = 1 + (size_t)(unit(g) * 16);
+        double a[16], b[16], r[16], p[16];
+        for (size_t i = 0; i < k; ++i) {
+            a[i] = range(g, 0.5, 1.5);
+            b[i] = range(g, -1.0, 2.0);
+            r[i] = op == 0 ? logu(g, 0.05, 3.0) : logu(g, 0.05, 1.0);
+            const double u = unit(g);
+            p[i] = u < 0.3 ? 2.0 : u < 0.6 ? (double)(1 + (int)(unit(g) * 16)) : logu(g, 1.05, 16);
+            if (p[i] < 1.05) p[i] = 2.0;
+        }
+        args_array("A", k, a, b);
+        farray("R", k, r);
+        farray("P", k, p);
+        fprintf(pov, "#declare G = LB_Scale(%d, A, R, P)\n", op);
+        for (int q = 0; q < 5; ++q) {
+            const double x = range(g, -1.0, 1.0);
+            double d[16], v;
+            for (size_t i = 0; i < k; ++i) d[i] = x * a[i] + b[i];
+            lb_error e;
+            if (lb_scale((lb_setop)op, k, d, r, p, &v, NULL, &e)) {
+                fprintf(stderr, "%s\n", e.message);
+                exit(1);
+            }
+            record(fams[op], "G", x, 0, 0, v);
+        }
+        fprintf(pov, "#undef G\n#undef A\n");
     }
 }
 
@@ -271,6 +304,7 @@ int main(int argc, char **argv) {
     rng g = {77};
     displacement_cases(&g);
     conic_cases(&g);
+    scale_cases(&g);
     classic_cases(&g);
     primitive_cases(&g);
     fprintf(pov, "#fclose FO\n");

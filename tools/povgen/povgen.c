@@ -99,6 +99,37 @@ static int choose_steps(void) {
         if (used > worst) worst = used;
         if (err > maxerr) maxerr = err;
     }
+    /* the scale method's use: d = -1 (B_A, m = y/min y >= 1) or d = 1 (B_S, m = y/max y
+     * in (1 - r, 1]) */
+    for (int c = 0; c < 200000; ++c) {
+        const int k = 1 + (int)(unit(&g) * KMAX);
+        const int bs = c & 1;
+        double d[KMAX], r[KMAX], p[KMAX], m[KMAX];
+        for (int i = 0; i < k; ++i) {
+            r[i] = logu(&g, 0.01, bs ? 1.0 : 100.0);
+            d[i] = bs ? 1.0 : -1.0;
+            m[i] = i == 0 ? 1.0
+                   : bs   ? 1.0 - r[i] * unit(&g)
+                          : 1.0 + logu(&g, 1e-6, 1.0) * (1.0 + r[i]);
+            if (!(m[i] > 0.0)) m[i] = 1e-3;
+            const double u = unit(&g);
+            p[i] = u < 0.3   ? 2.0
+                   : u < 0.6 ? (double)(1 + (int)(unit(&g) * P_MAX))
+                             : logu(&g, P_MIN, P_MAX);
+            if (p[i] < P_MIN) p[i] = 2.0;
+        }
+        int used = 0;
+        const double v = step_sim(k, d, r, p, m, 400, &used);
+        double ref;
+        lb_error e;
+        if (lb_displacement(LB_UNION, (size_t)k, d, r, p, m, &ref, NULL, &e)) {
+            fprintf(stderr, "povgen: %s\n", e.message);
+            exit(1);
+        }
+        const double err = fabs(v - ref) / (1.0 + fabs(ref));
+        if (used > worst) worst = used;
+        if (err > maxerr) maxerr = err;
+    }
     if (worst > 400 || maxerr > 1e-10) {
         fprintf(stderr, "povgen: the SDL recurrence misses the C library (%d steps, error %g)\n",
                 worst, maxerr);
@@ -247,6 +278,151 @@ static void conic(void) {
       "  function(x, y, z) { lbSG * lbU(lbSG * F1(x, y, z), lbSO * F2(x, y, z)) }\n#end\n\n");
 }
 
+/* "lbd0, ..., lbd15, lbm0, ..., lbm15, lbr0, ..., lbr15" */
+static void vlist(void) {
+    for (int i = 0; i < KMAX; ++i) w("lbd%d, ", i);
+    for (int i = 0; i < KMAX; ++i) w("lbm%d, ", i);
+    for (int i = 0; i < KMAX; ++i) w("%slbr%d", i ? ", " : "", i);
+}
+
+/* The displacement root with every d, m and r a parameter (p baked from the
+ * array lbP): lbVB(d..., m..., r...) inside the current macro. Used where m
+ * or r vary with the point (scale method, bounded primitives). */
+static void vsolver(int steps) {
+    w("  #local lbVS = function(lbh, ");
+    vlist();
+    w(") {\n    (-1");
+    for (int i = 0; i < KMAX; ++i)
+        w(" + pow(max(0, (lbr%d - lbd%d + lbm%d * lbh) / lbr%d), lbP[%d])", i, i, i, i, i);
+    w(")\n    / (0");
+    for (int i = 0; i < KMAX; ++i)
+        w(" + (lbP[%d] * lbm%d / lbr%d) * ((lbr%d - lbd%d + lbm%d * lbh) / lbr%d > 0) * "
+          "pow(max(0, (lbr%d - lbd%d + lbm%d * lbh) / lbr%d), lbP[%d] - 1)",
+          i, i, i, i, i, i, i, i, i, i, i, i);
+    w(") }\n");
+    w("  #local lbVN%d = function(lbh, lbl, ", steps);
+    vlist();
+    w(") { lbh }\n");
+    for (int n = steps - 1; n >= 0; --n) {
+        w("  #local lbVE%d = function(lbh, lbs, lbl, ", n);
+        vlist();
+        w(") { select(abs(lbs) - %.17g * (1 + abs(lbh)), lbh - lbs, lbh - lbs, "
+          "lbVN%d(max(lbl, lbh - lbs), lbl, ",
+          TOL, n + 1);
+        vlist();
+        w(")) }\n");
+        w("  #local lbVN%d = function(lbh, lbl, ", n);
+        vlist();
+        w(") { lbVE%d(lbh, lbVS(lbh, ", n);
+        vlist();
+        w("), lbl, ");
+        vlist();
+        w(") }\n");
+    }
+    w("  #local lbVB = function(");
+    vlist();
+    w(") { lbVN0(min(");
+    for (int i = 0; i < KMAX; ++i) w("%slbd%d / lbm%d", i ? ", " : "", i, i);
+    w("), min(");
+    for (int i = 0; i < KMAX; ++i) w("%s(lbd%d - lbr%d) / lbm%d", i ? ", " : "", i, i, i);
+    w("), ");
+    vlist();
+    w(") }\n");
+}
+
+/* "lby0, ..., lby15" with an optional sign */
+static void ylist(const char *sign) {
+    for (int i = 0; i < KMAX; ++i) w("%s%slby%d", i ? ", " : "", sign, i);
+}
+
+/* LB_Scale(Op, F, R, P): the scale method, mirroring lb__scale_setop. */
+static void scale(int steps) {
+    w("// ---- scale method (Hsu-Lee) ----\n"
+      "// LB_Scale(Op, F, R, P): Op 0 union, 1 intersection, 2 difference; F 1 to %d\n"
+      "// functions (ray-linear primitives: f >= -1); R (> 0; <= 1 for intersection and\n"
+      "// difference) and P (%g to %g) one per function. Solved like LB_Displacement\n"
+      "// (the scale method is the displacement equation in 1/h).\n",
+      KMAX, P_MIN, P_MAX);
+    w("#macro LB_Scale(Op, F, R, P)\n"
+      "  #local K = dimension_size(F, 1);\n"
+      "  #if (K < 1 | K > %d) #error \"LB_Scale: 1 to %d functions\" #end\n"
+      "  #if (dimension_size(R, 1) != K | dimension_size(P, 1) != K)\n"
+      "    #error \"LB_Scale: R and P need one value per function\"\n  #end\n",
+      KMAX, KMAX);
+    w("  #local lbR = array[%d]; #local lbRc = array[%d]; #local lbP = array[%d];\n", KMAX, KMAX,
+      KMAX);
+    w("  #for (I, 0, %d) #if (I < K) #local lbR[I] = R[I]; #local lbRc[I] = min(R[I], 1); "
+      "#local lbP[I] = P[I]; #else #local lbR[I] = 1; #local lbRc[I] = 1; #local lbP[I] = 2; "
+      "#end #end\n",
+      KMAX - 1);
+    vsolver(steps);
+    /* B_A(y), min y > 0: sc * (-1 / BT(-1; m = y / sc)) */
+    w("  #local lbBA2 = function(lbsc, ");
+    ylist("");
+    w(") { lbsc * (-1 / lbVB(");
+    for (int i = 0; i < KMAX; ++i) w("-1, ");
+    for (int i = 0; i < KMAX; ++i) w("lby%d / lbsc, ", i);
+    for (int i = 0; i < KMAX; ++i) w("%slbR[%d]", i ? ", " : "", i);
+    w(")) }\n  #local lbBA = function(");
+    ylist("");
+    w(") { lbBA2(min(");
+    ylist("");
+    w("), ");
+    ylist("");
+    w(") }\n");
+    /* B_S(y), max y > 0, r clamped to 1: terms that cannot be active are masked */
+    w("  #local lbBS2 = function(lbsc, ");
+    ylist("");
+    w(") { lbsc * (1 / lbVB(");
+    for (int i = 0; i < KMAX; ++i)
+        w("select((lby%d / lbsc > 1 - lbRc[%d]) * (lby%d / lbsc >= 1e-100) - 0.5, 1e30, 1), ", i, i,
+          i);
+    for (int i = 0; i < KMAX; ++i)
+        w("select((lby%d / lbsc > 1 - lbRc[%d]) * (lby%d / lbsc >= 1e-100) - 0.5, 1, lby%d / "
+          "lbsc), ",
+          i, i, i, i);
+    for (int i = 0; i < KMAX; ++i) w("%slbRc[%d]", i ? ", " : "", i);
+    w(")) }\n  #local lbBS = function(");
+    ylist("");
+    w(") { lbBS2(max(");
+    ylist("");
+    w("), ");
+    ylist("");
+    w(") }\n");
+    /* union: B_AS(y) - 1; intersection, difference: B_SA(y) - 1 */
+    w("  #local lbZU = function(");
+    ylist("");
+    w(") { select(-min(");
+    ylist("");
+    w("), lbBA(");
+    ylist("");
+    w("), -lbBS(");
+    ylist("-");
+    w("), -lbBS(");
+    ylist("-");
+    w(")) - 1 }\n  #local lbZI = function(");
+    ylist("");
+    w(") { select(-max(");
+    ylist("");
+    w("), lbBS(");
+    ylist("");
+    w("), -lbBA(");
+    ylist("-");
+    w("), -lbBA(");
+    ylist("-");
+    w(")) - 1 }\n");
+    w("  #local lbFill = select(Op - 0.5, 1e30, -1e30);\n"
+      "  #local lbSO = select(Op - 1.5, 1, -1);\n");
+    w("  #if (Op = 0)\n  function(x, y, z) { lbZU(");
+    for (int i = 0; i < KMAX; ++i)
+        w("%s#if (K > %d) F[%d](x, y, z) + 1 #else lbFill #end", i ? ", " : "", i, i);
+    w(") }\n  #else\n  function(x, y, z) { lbZI(");
+    for (int i = 0; i < KMAX; ++i)
+        w("%s#if (K > %d) %sF[%d](x, y, z) + 1 #else lbFill #end", i ? ", " : "", i,
+          i ? "lbSO * " : "", i);
+    w(") }\n  #end\n#end\n\n");
+}
+
 /* LB_Displacement(Op, F, R, P, M): BT_k by unrolled CPS Newton. */
 static void displacement(int steps) {
     w("// ---- displacement blends BT_k (hsu2006; m = 1 everywhere is Rockwood's) ----\n"
@@ -340,6 +516,7 @@ int main(int argc, char **argv) {
     classic();
     displacement(steps);
     conic();
+    scale(steps);
     w("#version LB_INC_TEMP;\n#end\n");
     if (fclose(out) != 0 || rename(tmp, argv[1]) != 0) {
         perror(argv[1]);
