@@ -168,6 +168,50 @@ static void scale_cases(rng *g) {
     }
 }
 
+/* bounded: spheres (f = |X - c|/a - 1 along x: here a_i x + b_i) with
+ * bounding values c_i = (f_i + 1) / s_i - 1, s_i > 1 (union: a larger solid)
+ * or < 1 (intersection), sometimes not containing (R floored at omega) */
+static void bounded_cases(rng *g) {
+    static const char *const fams[3] = {"bounded union", "bounded intersection",
+                                        "bounded difference"};
+    for (int set = 0; set < 600; ++set) {
+        const int op = set % 3;
+        const size_t k = 1 + (size_t)(unit(g) * 16);
+        double a[16], b[16], ca[16], cb[16], p[16];
+        for (size_t i = 0; i < k; ++i) {
+            a[i] = range(g, 0.5, 1.5);
+            b[i] = range(g, -1.0, 2.0);
+            const int union_like = op == 0 || (op == 2 && i > 0);
+            const double sc = union_like ? range(g, 1.05, 3.0) : range(g, 0.3, 0.95);
+            const double s2 = set % 13 == 0 ? 1.0 / sc : sc; /* a wrong-sized bounding solid */
+            ca[i] = a[i] / s2;
+            cb[i] = (b[i] + 1.0) / s2 - 1.0;
+            const double u = unit(g);
+            p[i] = u < 0.3 ? 2.0 : u < 0.6 ? (double)(1 + (int)(unit(g) * 16)) : logu(g, 1.05, 16);
+            if (p[i] < 1.05) p[i] = 2.0;
+        }
+        args_array("A", k, a, b);
+        args_array("C", k, ca, cb);
+        farray("P", k, p);
+        fprintf(pov, "#declare G = LB_Bounded(%d, A, C, P)\n", op);
+        for (int q = 0; q < 5; ++q) {
+            const double x = range(g, -1.0, 1.0);
+            double d[16], c[16], v;
+            for (size_t i = 0; i < k; ++i) {
+                d[i] = x * a[i] + b[i];
+                c[i] = x * ca[i] + cb[i];
+            }
+            lb_error e;
+            if (lb_bounded((lb_setop)op, k, d, c, p, &v, NULL, NULL, &e)) {
+                fprintf(stderr, "%s\n", e.message);
+                exit(1);
+            }
+            record(fams[op], "G", x, 0, 0, v);
+        }
+        fprintf(pov, "#undef G\n#undef A\n#undef C\n");
+    }
+}
+
 static void classic_cases(rng *g) {
     static const struct {
         const char *fam, *macro;
@@ -305,6 +349,7 @@ int main(int argc, char **argv) {
     displacement_cases(&g);
     conic_cases(&g);
     scale_cases(&g);
+    bounded_cases(&g);
     classic_cases(&g);
     primitive_cases(&g);
     fprintf(pov, "#fclose FO\n");

@@ -335,6 +335,104 @@ static void ylist(const char *sign) {
     for (int i = 0; i < KMAX; ++i) w("%s%slby%d", i ? ", " : "", sign, i);
 }
 
+/* "lbq0, ..., lbq15": per-point ranges */
+static void qlist(const char *fmt) {
+    for (int i = 0; i < KMAX; ++i) {
+        if (i) w(", ");
+        w(fmt, i);
+    }
+}
+
+/* The scale method's zero-convention set operations with the ranges as
+ * parameters (lbq0..15), mirroring scale_zero: lbZU(y..., q...) (union) and
+ * lbZI(y..., q...) (intersection; difference negates its tail first). */
+static void scale_body(int steps) {
+    vsolver(steps);
+    /* B_A(y), min y > 0: sc * (-1 / BT(-1; m = y / sc, r = q)) */
+    w("  #local lbBA2 = function(lbsc, ");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w(") { lbsc * (-1 / lbVB(");
+    for (int i = 0; i < KMAX; ++i) w("-1, ");
+    for (int i = 0; i < KMAX; ++i) w("lby%d / lbsc, ", i);
+    qlist("lbq%d");
+    w(")) }\n  #local lbBA = function(");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w(") { lbBA2(min(");
+    ylist("");
+    w("), ");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w(") }\n");
+    /* B_S(y), max y > 0, r clamped to 1: terms that cannot be active masked */
+    w("  #local lbBS2 = function(lbsc, ");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w(") { lbsc * (1 / lbVB(");
+    for (int i = 0; i < KMAX; ++i)
+        w("select((lby%d / lbsc > 1 - min(lbq%d, 1)) * (lby%d / lbsc >= 1e-100) - 0.5, 1e30, 1), ",
+          i, i, i);
+    for (int i = 0; i < KMAX; ++i)
+        w("select((lby%d / lbsc > 1 - min(lbq%d, 1)) * (lby%d / lbsc >= 1e-100) - 0.5, 1, lby%d / "
+          "lbsc), ",
+          i, i, i, i);
+    qlist("min(lbq%d, 1)");
+    w(")) }\n  #local lbBS = function(");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w(") { lbBS2(max(");
+    ylist("");
+    w("), ");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w(") }\n");
+    /* union: B_AS(y) - 1; intersection, difference: B_SA(y) - 1 */
+    w("  #local lbZU = function(");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w(") { select(-min(");
+    ylist("");
+    w("), lbBA(");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w("), -lbBS(");
+    ylist("-");
+    w(", ");
+    qlist("lbq%d");
+    w("), -lbBS(");
+    ylist("-");
+    w(", ");
+    qlist("lbq%d");
+    w(")) - 1 }\n  #local lbZI = function(");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w(") { select(-max(");
+    ylist("");
+    w("), lbBS(");
+    ylist("");
+    w(", ");
+    qlist("lbq%d");
+    w("), -lbBA(");
+    ylist("-");
+    w(", ");
+    qlist("lbq%d");
+    w("), -lbBA(");
+    ylist("-");
+    w(", ");
+    qlist("lbq%d");
+    w(")) - 1 }\n");
+}
+
 /* LB_Scale(Op, F, R, P): the scale method, mirroring lb__scale_setop. */
 static void scale(int steps) {
     w("// ---- scale method (Hsu-Lee) ----\n"
@@ -343,84 +441,83 @@ static void scale(int steps) {
       "// difference) and P (%g to %g) one per function. Solved like LB_Displacement\n"
       "// (the scale method is the displacement equation in 1/h).\n",
       KMAX, P_MIN, P_MAX);
-    w("#macro LB_Scale(Op, F, R, P)\n"
-      "  #local K = dimension_size(F, 1);\n"
+    w("#macro LB_Scale(Op, F, R, P)\n");
+    w("  #local K = dimension_size(F, 1);\n"
       "  #if (K < 1 | K > %d) #error \"LB_Scale: 1 to %d functions\" #end\n"
       "  #if (dimension_size(R, 1) != K | dimension_size(P, 1) != K)\n"
       "    #error \"LB_Scale: R and P need one value per function\"\n  #end\n",
       KMAX, KMAX);
-    w("  #local lbR = array[%d]; #local lbRc = array[%d]; #local lbP = array[%d];\n", KMAX, KMAX,
-      KMAX);
-    w("  #for (I, 0, %d) #if (I < K) #local lbR[I] = R[I]; #local lbRc[I] = min(R[I], 1); "
-      "#local lbP[I] = P[I]; #else #local lbR[I] = 1; #local lbRc[I] = 1; #local lbP[I] = 2; "
-      "#end #end\n",
+    w("  #local lbR = array[%d]; #local lbP = array[%d];\n", KMAX, KMAX);
+    w("  #for (I, 0, %d) #if (I < K) #local lbR[I] = R[I]; #local lbP[I] = P[I]; #else #local "
+      "lbR[I] = 1; #local lbP[I] = 2; #end #end\n",
       KMAX - 1);
-    vsolver(steps);
-    /* B_A(y), min y > 0: sc * (-1 / BT(-1; m = y / sc)) */
-    w("  #local lbBA2 = function(lbsc, ");
-    ylist("");
-    w(") { lbsc * (-1 / lbVB(");
-    for (int i = 0; i < KMAX; ++i) w("-1, ");
-    for (int i = 0; i < KMAX; ++i) w("lby%d / lbsc, ", i);
-    for (int i = 0; i < KMAX; ++i) w("%slbR[%d]", i ? ", " : "", i);
-    w(")) }\n  #local lbBA = function(");
-    ylist("");
-    w(") { lbBA2(min(");
-    ylist("");
-    w("), ");
-    ylist("");
-    w(") }\n");
-    /* B_S(y), max y > 0, r clamped to 1: terms that cannot be active are masked */
-    w("  #local lbBS2 = function(lbsc, ");
-    ylist("");
-    w(") { lbsc * (1 / lbVB(");
-    for (int i = 0; i < KMAX; ++i)
-        w("select((lby%d / lbsc > 1 - lbRc[%d]) * (lby%d / lbsc >= 1e-100) - 0.5, 1e30, 1), ", i, i,
-          i);
-    for (int i = 0; i < KMAX; ++i)
-        w("select((lby%d / lbsc > 1 - lbRc[%d]) * (lby%d / lbsc >= 1e-100) - 0.5, 1, lby%d / "
-          "lbsc), ",
-          i, i, i, i);
-    for (int i = 0; i < KMAX; ++i) w("%slbRc[%d]", i ? ", " : "", i);
-    w(")) }\n  #local lbBS = function(");
-    ylist("");
-    w(") { lbBS2(max(");
-    ylist("");
-    w("), ");
-    ylist("");
-    w(") }\n");
-    /* union: B_AS(y) - 1; intersection, difference: B_SA(y) - 1 */
-    w("  #local lbZU = function(");
-    ylist("");
-    w(") { select(-min(");
-    ylist("");
-    w("), lbBA(");
-    ylist("");
-    w("), -lbBS(");
-    ylist("-");
-    w("), -lbBS(");
-    ylist("-");
-    w(")) - 1 }\n  #local lbZI = function(");
-    ylist("");
-    w(") { select(-max(");
-    ylist("");
-    w("), lbBS(");
-    ylist("");
-    w("), -lbBA(");
-    ylist("-");
-    w("), -lbBA(");
-    ylist("-");
-    w(")) - 1 }\n");
+    scale_body(steps);
     w("  #local lbFill = select(Op - 0.5, 1e30, -1e30);\n"
       "  #local lbSO = select(Op - 1.5, 1, -1);\n");
     w("  #if (Op = 0)\n  function(x, y, z) { lbZU(");
     for (int i = 0; i < KMAX; ++i)
         w("%s#if (K > %d) F[%d](x, y, z) + 1 #else lbFill #end", i ? ", " : "", i, i);
+    w(", ");
+    qlist("lbR[%d]");
     w(") }\n  #else\n  function(x, y, z) { lbZI(");
     for (int i = 0; i < KMAX; ++i)
         w("%s#if (K > %d) %sF[%d](x, y, z) + 1 #else lbFill #end", i ? ", " : "", i,
           i ? "lbSO * " : "", i);
+    w(", ");
+    qlist("lbR[%d]");
     w(") }\n  #end\n#end\n\n");
+}
+
+/* LB_Bounded(Op, F, C, P): bounded primitives, mirroring lb_bounded: the
+ * scale method with per-point ranges from the bounding solids. */
+static void bounded(int steps) {
+    w("// ---- bounded primitives (hsu-bounded 3) ----\n"
+      "// LB_Bounded(Op, F, C, P): Op 0 union, 1 intersection, 2 difference; F 1 to %d\n"
+      "// ray-linear primitives and C their bounding solids (the same kind, containing F[i]\n"
+      "// for union, inside it for intersection); P one per function (%g to %g). Outside its\n"
+      "// bounding solid a primitive does not blend.\n",
+      KMAX, P_MIN, P_MAX);
+    w("#macro LB_Bounded(Op, F, C, P)\n"
+      "  #local K = dimension_size(F, 1);\n"
+      "  #if (K < 1 | K > %d) #error \"LB_Bounded: 1 to %d functions\" #end\n"
+      "  #if (dimension_size(C, 1) != K | dimension_size(P, 1) != K)\n"
+      "    #error \"LB_Bounded: C and P need one entry per function\"\n  #end\n",
+      KMAX, KMAX);
+    w("  #local lbP = array[%d];\n", KMAX);
+    w("  #for (I, 0, %d) #if (I < K) #local lbP[I] = P[I]; #else #local lbP[I] = 2; #end #end\n",
+      KMAX - 1);
+    scale_body(steps);
+    /* R_i = omega where c_i + 1 <= 0, else max(omega, min(cap, sgn ((x+1)/(c+1) - 1))) */
+    w("  #local lbCap = select(Op - 0.5, 1e300, 1);\n"
+      "  #local lbRU = function(lbx, lbc) { select(lbc + 1, %.17g, %.17g, max(%.17g, min(lbCap, "
+      "(lbx + 1) / (lbc + 1) - 1))) }\n"
+      "  #local lbRI = function(lbx, lbc) { select(lbc + 1, %.17g, %.17g, max(%.17g, min(lbCap, "
+      "1 - (lbx + 1) / (lbc + 1)))) }\n",
+      LB_BOUNDED_OMEGA, LB_BOUNDED_OMEGA, LB_BOUNDED_OMEGA, LB_BOUNDED_OMEGA, LB_BOUNDED_OMEGA,
+      LB_BOUNDED_OMEGA);
+    /* unused slots: neutral after the difference's negation */
+    w("  #local lbFillF = select(abs(Op - 1) - 0.5, -1e30, 1e30);\n"
+      "  #local lbSO = select(Op - 1.5, 1, -1);\n");
+    /* the values, then y = (signed) x + 1 and the ranges */
+    w("  #local lbT = function(");
+    for (int i = 0; i < KMAX; ++i) w("lbf%d, ", i);
+    for (int i = 0; i < KMAX; ++i) w("%slbc%d", i ? ", " : "", i);
+    w(") {\n    #if (Op = 0) lbZU(");
+    for (int i = 0; i < KMAX; ++i) w("%slbf%d + 1", i ? ", " : "", i);
+    w(", ");
+    for (int i = 0; i < KMAX; ++i) w("%slbRU(lbf%d, lbc%d)", i ? ", " : "", i, i);
+    w(")\n    #else lbZI(");
+    for (int i = 0; i < KMAX; ++i) w("%s%slbf%d + 1", i ? ", " : "", i ? "lbSO * " : "", i);
+    w(", lbRI(lbf0, lbc0)");
+    for (int i = 1; i < KMAX; ++i)
+        w(", select(Op - 1.5, lbRI(lbf%d, lbc%d), lbRU(lbf%d, lbc%d))", i, i, i, i);
+    w(")\n    #end }\n");
+    w("  function(x, y, z) { lbT(");
+    for (int i = 0; i < KMAX; ++i)
+        w("%s#if (K > %d) F[%d](x, y, z) #else lbFillF #end", i ? ", " : "", i, i);
+    /* an unused slot gets c = f: range omega, never active */
+    for (int i = 0; i < KMAX; ++i) w(", #if (K > %d) C[%d](x, y, z) #else lbFillF #end", i, i);
+    w(") }\n#end\n\n");
 }
 
 /* LB_Displacement(Op, F, R, P, M): BT_k by unrolled CPS Newton. */
@@ -517,6 +614,7 @@ int main(int argc, char **argv) {
     displacement(steps);
     conic();
     scale(steps);
+    bounded(steps);
     w("#version LB_INC_TEMP;\n#end\n");
     if (fclose(out) != 0 || rename(tmp, argv[1]) != 0) {
         perror(argv[1]);
