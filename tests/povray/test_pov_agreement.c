@@ -212,6 +212,44 @@ static void bounded_cases(rng *g) {
     }
 }
 
+static void soft_hyper_cases(rng *g) {
+    static const char *const fams[3] = {"soft hyper union", "soft hyper intersection",
+                                        "soft hyper difference"};
+    for (int set = 0; set < 600; ++set) {
+        const int op = set % 3;
+        const size_t k = 1 + (size_t)(unit(g) * 16);
+        double a[16], b[16], r[16], p[16], m[16];
+        for (size_t i = 0; i < k; ++i) {
+            a[i] = range(g, 0.0, 0.5);
+            b[i] = range(g, 0.0, 0.5);
+            if (set % 10 == 0 && i == k - 1) a[i] = b[i] = 0.0; /* a zero field */
+            r[i] = op == 0 ? logu(g, 0.02, 1.0) : logu(g, 0.02, 3.0);
+            if (op == 0 && unit(g) < 0.1) r[i] = 1.0;
+            const double u = unit(g);
+            p[i] = u < 0.3 ? 2.0 : u < 0.6 ? (double)(1 + (int)(unit(g) * 16)) : logu(g, 1.05, 16);
+            if (p[i] < 1.05) p[i] = 2.0;
+            m[i] = logu(g, 0.05, 20.0);
+        }
+        args_array("A", k, a, b);
+        farray("R", k, r);
+        farray("P", k, p);
+        farray("M", k, m);
+        fprintf(pov, "#declare G = LB_SoftHyper(%d, A, R, P, M)\n", op);
+        for (int q = 0; q < 5; ++q) {
+            const double x = unit(g);
+            double d[16], v;
+            for (size_t i = 0; i < k; ++i) d[i] = x * a[i] + b[i];
+            lb_error e;
+            if (lb_soft_hyper((lb_setop)op, k, d, r, p, m, &v, NULL, &e)) {
+                fprintf(stderr, "%s\n", e.message);
+                exit(1);
+            }
+            record(fams[op], "G", x, 0, 0, v);
+        }
+        fprintf(pov, "#undef G\n#undef A\n");
+    }
+}
+
 static void classic_cases(rng *g) {
     static const struct {
         const char *fam, *macro;
@@ -350,6 +388,7 @@ int main(int argc, char **argv) {
     conic_cases(&g);
     scale_cases(&g);
     bounded_cases(&g);
+    soft_hyper_cases(&g);
     classic_cases(&g);
     primitive_cases(&g);
     fprintf(pov, "#fclose FO\n");

@@ -140,6 +140,106 @@ static int choose_steps(void) {
     return worst + 2;
 }
 
+/* ---- soft non-uniform blends: bracketed Newton in lambda = ln h ---- */
+
+#define LTOL 1e-13 /* |Newton step| in lambda (= relative in h) */
+#define LN2 0.69314718055994530942
+
+/* T and T' of the soft k-ary blend in lambda, as the SDL computes them */
+static void soft_TD(int u, int k, const double *a, const double *r, const double *p,
+                    const double *m, double lam, double *T, double *D) {
+    double s = 0.0, d = 0.0;
+    for (int i = 0; i < k; ++i) {
+        const double z = exp(a[i] - m[i] * lam);
+        const double t = u ? (r[i] - 1.0 + z) / r[i] : (1.0 + r[i] - z) / r[i];
+        if (t > 0.0) {
+            s += pow(t, p[i]);
+            d += p[i] / r[i] * pow(t, p[i] - 1.0) * m[i] * z;
+        }
+    }
+    *T = u ? 1.0 - s : s - 1.0;
+    *D = d;
+}
+
+/* the SDL recurrence: start at the non-blending end, Newton inside the
+ * bracket, bisection otherwise; exit when |T/D| < LTOL */
+static double soft_sim(int u, int k, const double *a, const double *r, const double *p,
+                       const double *m, double lo, double hi, double lam, int steps, int *used) {
+    for (int n = 0; n < steps; ++n) {
+        double T, D;
+        soft_TD(u, k, a, r, p, m, lam, &T, &D);
+        *used = n + 1;
+        const double st = T / D;
+        if (fabs(st) - LTOL <= 0.0) return fmin(hi, fmax(lo, lam - st));
+        if (T > 0.0)
+            hi = lam;
+        else
+            lo = lam;
+        const double nx = lam - st;
+        lam = nx > lo && nx < hi ? nx : 0.5 * (lo + hi);
+    }
+    *used = steps + 1;
+    return lam;
+}
+
+static int choose_soft_steps(void) {
+    rng g = {424242};
+    int worst = 0;
+    double maxerr = 0.0;
+    for (int c = 0; c < 200000; ++c) {
+        const int u = c & 1;
+        const int k = 1 + (int)(unit(&g) * KMAX);
+        double x[KMAX], r[KMAX], p[KMAX], m[KMAX], a[KMAX];
+        for (int i = 0; i < k; ++i) {
+            x[i] = unit(&g) < 0.1 ? 1e-9 * unit(&g) : unit(&g);
+            r[i] = u ? logu(&g, 0.02, 1.0) : logu(&g, 0.02, 3.0);
+            if (u && unit(&g) < 0.1) r[i] = 1.0;
+            const double q = unit(&g);
+            p[i] = q < 0.3   ? 2.0
+                   : q < 0.6 ? (double)(1 + (int)(unit(&g) * P_MAX))
+                             : logu(&g, P_MIN, P_MAX);
+            if (p[i] < P_MIN) p[i] = 2.0;
+            m[i] = logu(&g, 0.05, 20.0);
+        }
+        double ref;
+        lb_error e;
+        if (lb_soft_hyper(u ? LB_UNION : LB_INTERSECTION, (size_t)k, x, r, p, m, &ref, NULL, &e)) {
+            fprintf(stderr, "povgen: %s\n", e.message);
+            exit(1);
+        }
+        /* the SDL's brackets */
+        int npos = 0;
+        double nb = u ? -INFINITY : INFINITY, other = u ? -INFINITY : INFINITY;
+        for (int i = 0; i < k; ++i) {
+            a[i] = log(x[i]) + (1.0 - m[i]) * LN2;
+            npos += x[i] > 0.0;
+        }
+        for (int i = 0; i < k; ++i) {
+            nb = u ? fmax(nb, a[i] / m[i]) : fmin(nb, a[i] / m[i]);
+            const double l = u ? (r[i] < 1.0 ? (a[i] - log1p(-r[i])) / m[i]
+                                             : (a[i] + log((double)npos) / p[i]) / m[i])
+                               : (a[i] - log1p(r[i])) / m[i];
+            other = u ? fmax(other, l) : fmin(other, l);
+        }
+        int used = 0;
+        const double lam = u ? soft_sim(u, k, a, r, p, m, nb, other, nb, 400, &used)
+                             : soft_sim(u, k, a, r, p, m, other, nb, nb, 400, &used);
+        const double v = exp(lam);
+        const double err = fabs(v - ref) / fmax(1.0, fabs(ref));
+        if (used > worst) worst = used;
+        if (err > maxerr) maxerr = err;
+    }
+    if (worst > 400 || maxerr > 1e-10) {
+        fprintf(stderr,
+                "povgen: the soft SDL recurrence misses the C library (%d steps, error %g)\n",
+                worst, maxerr);
+        exit(1);
+    }
+    fprintf(stderr, "povgen: soft blends: %d steps cover every case (error <= %.2g)\n", worst,
+            maxerr);
+    return worst + 2;
+}
+
 /* ---- writing ---- */
 
 static FILE *out;
@@ -520,6 +620,139 @@ static void bounded(int steps) {
     w(") }\n#end\n\n");
 }
 
+/* "lba0, ..., lba15" */
+static void alist(void) {
+    for (int i = 0; i < KMAX; ++i) w("%slba%d", i ? ", " : "", i);
+}
+
+/* LB_SoftHyper(Op, F, R, P, M): mirroring lb_soft_hyper. */
+static void soft_hyper(int steps) {
+    w("// ---- soft objects: super-ellipsoidal blends with non-uniform scaling ----\n"
+      "// LB_SoftHyper(Op, F, R, P, M) (soft convention): Op 0 union, 1 intersection,\n"
+      "// 2 difference; F 1 to %d soft fields; R (> 0; <= 1 for union), P (%g to %g), M\n"
+      "// (0.05 to 20) one per field. Solved in ln h by Newton inside the bracket of\n"
+      "// spec section 7 (bisection when a step leaves it), %d unrolled steps.\n",
+      KMAX, P_MIN, P_MAX, steps);
+    w("#macro LB_SoftHyper(Op, F, R, P, M)\n"
+      "  #local K = dimension_size(F, 1);\n"
+      "  #if (K < 1 | K > %d) #error \"LB_SoftHyper: 1 to %d functions\" #end\n"
+      "  #if (dimension_size(R, 1) != K | dimension_size(P, 1) != K | dimension_size(M, 1) != K)\n"
+      "    #error \"LB_SoftHyper: R, P and M need one value per function\"\n  #end\n",
+      KMAX, KMAX);
+    w("  #local lbR = array[%d]; #local lbP = array[%d]; #local lbM = array[%d];\n", KMAX, KMAX,
+      KMAX);
+    w("  #for (I, 0, %d) #if (I < K) #local lbR[I] = R[I]; #local lbP[I] = P[I]; #local lbM[I] = "
+      "M[I]; #else #local lbR[I] = 1; #local lbP[I] = 2; #local lbM[I] = 1; #end #end\n",
+      KMAX - 1);
+    w("  #local lbU = (Op = 0);\n");
+    /* T and D in lambda */
+    w("  #local lbT = function(lbl, ");
+    alist();
+    w(") { select(lbU - 0.5, 1, -1) * (0");
+    for (int i = 0; i < KMAX; ++i)
+        w(" + pow(max(0, select(lbU - 0.5, (1 + lbR[%d] - exp(lba%d - lbM[%d] * lbl)) / lbR[%d], "
+          "(lbR[%d] - 1 + exp(lba%d - lbM[%d] * lbl)) / lbR[%d])), lbP[%d])",
+          i, i, i, i, i, i, i, i, i);
+    w(") + select(lbU - 0.5, 1, -1) * -1 }\n");
+    w("  #local lbD = function(lbl, ");
+    alist();
+    w(") { 0");
+    for (int i = 0; i < KMAX; ++i)
+        w(" + select(-select(lbU - 0.5, (1 + lbR[%d] - exp(lba%d - lbM[%d] * lbl)) / lbR[%d], "
+          "(lbR[%d] - 1 + exp(lba%d - lbM[%d] * lbl)) / lbR[%d]), lbP[%d] / lbR[%d] * "
+          "pow(select(lbU - 0.5, (1 + lbR[%d] - exp(lba%d - lbM[%d] * lbl)) / lbR[%d], "
+          "(lbR[%d] - 1 + exp(lba%d - lbM[%d] * lbl)) / lbR[%d]), lbP[%d] - 1) * lbM[%d] * "
+          "exp(lba%d - lbM[%d] * lbl), 0, 0)",
+          i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i);
+    w(" }\n");
+    /* CPS bracketed Newton */
+    w("  #local lbN%d = function(lbl, lblo, lbhi, ", steps);
+    alist();
+    w(") { lbl }\n");
+    for (int n = steps - 1; n >= 0; --n) {
+        /* F_n(next, lo, hi): Newton if inside, else bisection */
+        w("  #local lbF%d = function(lbx, lblo, lbhi, ", n);
+        alist();
+        w(") { lbN%d(select((lbx > lblo) * (lbx < lbhi) - 0.5, 0.5 * (lblo + lbhi), lbx), lblo, "
+          "lbhi, ",
+          n + 1);
+        alist();
+        w(") }\n");
+        /* E_n(lambda, T, D, lo, hi): exit, or the next step with the bracket updated */
+        w("  #local lbE%d = function(lbl, lbt, lbd, lblo, lbhi, ", n);
+        alist();
+        w(") { select(abs(lbt / lbd) - %.17g, min(lbhi, max(lblo, lbl - lbt / lbd)), min(lbhi, "
+          "max(lblo, lbl - lbt / lbd)), lbF%d(lbl - lbt / lbd, select(-lbt, lblo, lbl), "
+          "select(-lbt, lbl, lbhi), ",
+          LTOL, n);
+        alist();
+        w(")) }\n");
+        w("  #local lbN%d = function(lbl, lblo, lbhi, ", n);
+        alist();
+        w(") { lbE%d(lbl, lbT(lbl, ", n);
+        alist();
+        w("), lbD(lbl, ");
+        alist();
+        w("), lblo, lbhi, ");
+        alist();
+        w(") }\n");
+    }
+    /* from the (adjusted) values: a_i, the bracket, then h = exp(lambda) */
+    w("  #local lbNpos = function(");
+    ylist("");
+    w(") { 0");
+    for (int i = 0; i < KMAX; ++i) w(" + (lby%d > 0)", i);
+    w(" }\n");
+    w("  #local lbS2 = function(lbnb, lbot, ");
+    alist();
+    w(") { exp(select(lbU - 0.5, lbN0(lbnb, lbot, lbnb, ");
+    alist();
+    w("), lbN0(lbnb, lbnb, lbot, ");
+    alist();
+    w("))) }\n");
+    /* a_i = ln y_i + (1 - m_i) ln 2, or -1e30 for y_i <= 0 (only in unions) */
+    w("  #local lbS1 = function(lbn, ");
+    alist();
+    w(") { lbS2(select(lbU - 0.5, min(");
+    for (int i = 0; i < KMAX; ++i) w("%slba%d / lbM[%d]", i ? ", " : "", i, i);
+    w("), max(");
+    for (int i = 0; i < KMAX; ++i) w("%slba%d / lbM[%d]", i ? ", " : "", i, i);
+    w(")), select(lbU - 0.5, min(");
+    for (int i = 0; i < KMAX; ++i)
+        w("%s(lba%d - ln(1 + lbR[%d])) / lbM[%d]", i ? ", " : "", i, i, i);
+    w("), max(");
+    for (int i = 0; i < KMAX; ++i)
+        w("%sselect(lbR[%d] - 1, (lba%d - ln(1 - lbR[%d])) / lbM[%d], (lba%d + ln(lbn) / lbP[%d]) "
+          "/ lbM[%d])",
+          i ? ", " : "", i, i, i, i, i, i, i);
+    w(")), ");
+    alist();
+    w(") }\n");
+    w("  #local lbS0 = function(");
+    ylist("");
+    w(") { select(select(lbU - 0.5, min(");
+    ylist("");
+    w("), max(");
+    ylist("");
+    w(")), 0, 0, lbS1(lbNpos(");
+    ylist("");
+    w(")");
+    for (int i = 0; i < KMAX; ++i)
+        w(", select(lby%d, -1e30, -1e30, ln(lby%d) + (1 - lbM[%d]) * %.17g)", i, i, i, LN2);
+    w(")) }\n");
+    /* the soft values, complemented in a difference's tail, below 1e-300 as 0 */
+    w("  #local lbFill = select(lbU - 0.5, 1e300, 0);\n"
+      "  #local lbV = function(lbv) { select(lbv - 1e-300, 0, lbv, lbv) }\n"
+      "  function(x, y, z) { lbS0(");
+    for (int i = 0; i < KMAX; ++i) {
+        if (i == 0)
+            w("lbV(F[0](x, y, z))");
+        else
+            w(", #if (K > %d) lbV(#if (Op = 2) 1 - #end F[%d](x, y, z)) #else lbFill #end", i, i);
+    }
+    w(") }\n#end\n\n");
+}
+
 /* LB_Displacement(Op, F, R, P, M): BT_k by unrolled CPS Newton. */
 static void displacement(int steps) {
     w("// ---- displacement blends BT_k (hsu2006; m = 1 everywhere is Rockwood's) ----\n"
@@ -601,6 +834,7 @@ int main(int argc, char **argv) {
         return 2;
     }
     const int steps = choose_steps();
+    const int ssteps = choose_soft_steps();
     char tmp[4096];
     snprintf(tmp, sizeof tmp, "%s.tmp", argv[1]);
     out = fopen(tmp, "w");
@@ -615,6 +849,7 @@ int main(int argc, char **argv) {
     conic();
     scale(steps);
     bounded(steps);
+    soft_hyper(ssteps);
     w("#version LB_INC_TEMP;\n#end\n");
     if (fclose(out) != 0 || rename(tmp, argv[1]) != 0) {
         perror(argv[1]);
