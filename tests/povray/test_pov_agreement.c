@@ -250,6 +250,40 @@ static void soft_hyper_cases(rng *g) {
     }
 }
 
+static void soft_conic_cases(rng *g) {
+    static const char *const fams[3] = {"soft conic union", "soft conic intersection",
+                                        "soft conic difference"};
+    for (int set = 0; set < 600; ++set) {
+        const int op = set % 3;
+        double a[2], b[2], r[2], m[2];
+        for (int i = 0; i < 2; ++i) {
+            a[i] = range(g, 0.0, 0.5);
+            b[i] = range(g, 0.0, 0.5);
+            r[i] = op == 0 ? logu(g, 0.02, 1.0) : logu(g, 0.02, 3.0);
+            m[i] = logu(g, 0.05, 20.0);
+        }
+        if (set % 10 == 0) a[1] = b[1] = 0.0;
+        const double shape = r[0] * r[1] * (set % 5 == 0 ? 0.0 : range(g, -3.0, 0.95));
+        args_array("A", 2, a, b);
+        fprintf(pov, "#declare F1 = A[0];\n#declare F2 = A[1];\n");
+        farray("R", 2, r);
+        farray("M", 2, m);
+        fprintf(pov, "#declare G = LB_SoftConic(%d, F1, F2, R, %.17g, M)\n", op, shape);
+        for (int q = 0; q < 5; ++q) {
+            const double x = unit(g);
+            const double d[2] = {x * a[0] + b[0], x * a[1] + b[1]};
+            double v;
+            lb_error e;
+            if (lb_soft_conic((lb_setop)op, d, r, shape, m, &v, NULL, &e)) {
+                fprintf(stderr, "%s\n", e.message);
+                exit(1);
+            }
+            record(fams[op], "G", x, 0, 0, v);
+        }
+        fprintf(pov, "#undef G\n#undef A\n#undef F1\n#undef F2\n");
+    }
+}
+
 static void classic_cases(rng *g) {
     static const struct {
         const char *fam, *macro;
@@ -389,6 +423,7 @@ int main(int argc, char **argv) {
     scale_cases(&g);
     bounded_cases(&g);
     soft_hyper_cases(&g);
+    soft_conic_cases(&g);
     classic_cases(&g);
     primitive_cases(&g);
     fprintf(pov, "#fclose FO\n");

@@ -240,6 +240,110 @@ static int choose_soft_steps(void) {
     return worst + 2;
 }
 
+/* The soft conic's two solves (chord, then H) in lambda, as the SDL does them. */
+typedef struct sc {
+    double a[2], r[2], m[2], p;
+    int u, chord;
+} sc;
+
+static void sc_TD(const sc *c, double lam, double *T, double *D) {
+    double uu[2], du[2];
+    for (int i = 0; i < 2; ++i) {
+        const double z = exp(c->a[i] - c->m[i] * lam);
+        uu[i] = c->u ? 1.0 - z : z - 1.0;
+        du[i] = c->u ? c->m[i] * z : -c->m[i] * z;
+    }
+    const double sg = c->u ? 1.0 : -1.0;
+    if (c->chord) {
+        *T = sg * (uu[0] / c->r[0] + uu[1] / c->r[1] - 1.0);
+        *D = sg * (du[0] / c->r[0] + du[1] / c->r[1]);
+        return;
+    }
+    const double r1 = c->r[0], r2 = c->r[1], n = 1.0 / (r1 * r1 * r2 * r2);
+    const double H = r2 * r2 * uu[0] * uu[0] + r1 * r1 * uu[1] * uu[1] + r1 * r1 * r2 * r2 -
+                     2.0 * r2 * r2 * r1 * uu[0] - 2.0 * r1 * r1 * r2 * uu[1] +
+                     2.0 * c->p * uu[0] * uu[1];
+    const double H1 = 2.0 * (r2 * r2 * (uu[0] - r1) + c->p * uu[1]);
+    const double H2 = 2.0 * (r1 * r1 * (uu[1] - r2) + c->p * uu[0]);
+    *T = -sg * n * H;
+    *D = -sg * n * (H1 * du[0] + H2 * du[1]);
+}
+
+static double sc_sim(const sc *c, double lo, double hi, double lam, int steps, int *used) {
+    for (int n = 0; n < steps; ++n) {
+        double T, D;
+        sc_TD(c, lam, &T, &D);
+        if (n + 1 > *used) *used = n + 1;
+        const double st = T / D;
+        if (fabs(st) - LTOL <= 0.0) return fmin(hi, fmax(lo, lam - st));
+        if (T > 0.0)
+            hi = lam;
+        else
+            lo = lam;
+        const double nx = lam - st;
+        lam = nx > lo && nx < hi ? nx : 0.5 * (lo + hi);
+    }
+    *used = steps + 1;
+    return lam;
+}
+
+static int choose_sconic_steps(void) {
+    rng g = {99};
+    int worst = 0;
+    double maxerr = 0.0;
+    for (int c = 0; c < 200000; ++c) {
+        sc C;
+        C.u = c & 1;
+        double x[2];
+        for (int i = 0; i < 2; ++i) {
+            x[i] = unit(&g);
+            C.r[i] = C.u ? logu(&g, 0.02, 1.0) : logu(&g, 0.02, 3.0);
+            C.m[i] = logu(&g, 0.05, 20.0);
+            C.a[i] = log(x[i]) + (1.0 - C.m[i]) * LN2;
+        }
+        C.p = C.r[0] * C.r[1] * (c % 5 == 0 ? 0.0 : -3.0 + 3.95 * unit(&g));
+        double ref;
+        lb_error e;
+        if (lb_soft_conic(C.u ? LB_UNION : LB_INTERSECTION, x, C.r, C.p, C.m, &ref, NULL, &e)) {
+            fprintf(stderr, "povgen: %s\n", e.message);
+            exit(1);
+        }
+        const double l0 = C.a[0] / C.m[0], l1 = C.a[1] / C.m[1];
+        const int j = C.u ? l1 > l0 : l1 < l0, o = 1 - j;
+        const double nb = j ? l1 : l0;
+        const double zo = exp(C.a[o] - C.m[o] * nb), uo = C.u ? 1.0 - zo : zo - 1.0;
+        double v;
+        int used = 0;
+        if (uo >= C.r[o]) {
+            v = exp(nb);
+        } else {
+            double far = C.u ? -INFINITY : INFINITY;
+            for (int i = 0; i < 2; ++i) {
+                const double l = (C.a[i] - log1p(C.u ? -0.5 * C.r[i] : 0.5 * C.r[i])) / C.m[i];
+                far = C.u ? fmax(far, l) : fmin(far, l);
+            }
+            C.chord = 1;
+            const double lc =
+                C.u ? sc_sim(&C, nb, far, nb, 400, &used) : sc_sim(&C, far, nb, nb, 400, &used);
+            C.chord = 0;
+            const double lam =
+                C.u ? sc_sim(&C, nb, lc, nb, 400, &used) : sc_sim(&C, lc, nb, nb, 400, &used);
+            v = exp(lam);
+        }
+        const double err = fabs(v - ref) / fmax(1.0, fabs(ref));
+        if (used > worst) worst = used;
+        if (err > maxerr) maxerr = err;
+    }
+    if (worst > 400 || maxerr > 1e-10) {
+        fprintf(stderr, "povgen: the soft conic recurrence misses the C library (%d, %g)\n", worst,
+                maxerr);
+        exit(1);
+    }
+    fprintf(stderr, "povgen: soft conic: %d steps per solve cover every case (error <= %.2g)\n",
+            worst, maxerr);
+    return worst + 2;
+}
+
 /* ---- writing ---- */
 
 static FILE *out;
@@ -753,6 +857,81 @@ static void soft_hyper(int steps) {
     w(") }\n#end\n\n");
 }
 
+/* A bracketed Newton chain in lambda over (lba0, lba1): functions
+ * <pre>N0(lambda, lo, hi, lba0, lba1) returning the root, from SDL bodies
+ * for T and T' (in lbl, lba0, lba1). */
+static void bchain2(const char *pre, int steps, const char *T, const char *D) {
+    w("  #local %sT = function(lbl, lba0, lba1) { %s }\n", pre, T);
+    w("  #local %sD = function(lbl, lba0, lba1) { %s }\n", pre, D);
+    w("  #local %sN%d = function(lbl, lblo, lbhi, lba0, lba1) { lbl }\n", pre, steps);
+    for (int n = steps - 1; n >= 0; --n) {
+        w("  #local %sF%d = function(lbx, lblo, lbhi, lba0, lba1) { %sN%d(select((lbx > lblo) * "
+          "(lbx < lbhi) - 0.5, 0.5 * (lblo + lbhi), lbx), lblo, lbhi, lba0, lba1) }\n",
+          pre, n, pre, n + 1);
+        w("  #local %sE%d = function(lbl, lbt, lbd, lblo, lbhi, lba0, lba1) { select(abs(lbt / "
+          "lbd) - %.17g, min(lbhi, max(lblo, lbl - lbt / lbd)), min(lbhi, max(lblo, lbl - lbt / "
+          "lbd)), %sF%d(lbl - lbt / lbd, select(-lbt, lblo, lbl), select(-lbt, lbl, lbhi), lba0, "
+          "lba1)) }\n",
+          pre, n, LTOL, pre, n);
+        w("  #local %sN%d = function(lbl, lblo, lbhi, lba0, lba1) { %sE%d(lbl, %sT(lbl, lba0, "
+          "lba1), %sD(lbl, lba0, lba1), lblo, lbhi, lba0, lba1) }\n",
+          pre, n, pre, n, pre, pre);
+    }
+}
+
+/* LB_SoftConic(Op, F1, F2, R, Shape, M): mirroring lb_soft_conic. */
+static void soft_conic(int steps) {
+    w("// LB_SoftConic(Op, F1, F2, R, Shape, M) (soft convention): the binary conic\n"
+      "// with non-uniform scaling; R, M arrays of 2 (R <= 1 for union), Shape below\n"
+      "// R[0] R[1]. Two bracketed Newton solves in ln h (the chord, then the conic).\n");
+    w("#macro LB_SoftConic(Op, F1, F2, R, Shape, M)\n"
+      "  #if (Shape >= R[0] * R[1]) #error \"LB_SoftConic: Shape must be below R[0] R[1]\" "
+      "#end\n"
+      "  #local lbr1 = R[0]; #local lbr2 = R[1]; #local lbm1 = M[0]; #local lbm2 = M[1];\n"
+      "  #local lbp = Shape; #local lbU = (Op = 0); #local lbsg = select(lbU - 0.5, -1, 1);\n"
+      "  #local lbn = 1 / (lbr1 * lbr1 * lbr2 * lbr2);\n"
+      "  #local lbz1 = function(lbl, lba0) { exp(lba0 - lbm1 * lbl) }\n"
+      "  #local lbz2 = function(lbl, lba1) { exp(lba1 - lbm2 * lbl) }\n"
+      "  #local lbu1 = function(lbl, lba0) { lbsg * (lbz1(lbl, lba0) - 1) * -1 }\n"
+      "  #local lbu2 = function(lbl, lba1) { lbsg * (lbz2(lbl, lba1) - 1) * -1 }\n"
+      "  #local lbd1 = function(lbl, lba0) { lbsg * lbm1 * lbz1(lbl, lba0) }\n"
+      "  #local lbd2 = function(lbl, lba1) { lbsg * lbm2 * lbz2(lbl, lba1) }\n"
+      "  #local lbH = function(lbv1, lbv2) { lbr2 * lbr2 * lbv1 * lbv1 + lbr1 * lbr1 * lbv2 * "
+      "lbv2 + lbr1 * lbr1 * lbr2 * lbr2 - 2 * lbr2 * lbr2 * lbr1 * lbv1 - 2 * lbr1 * lbr1 * lbr2 "
+      "* lbv2 + 2 * lbp * lbv1 * lbv2 }\n"
+      "  #local lbH1 = function(lbv1, lbv2) { 2 * (lbr2 * lbr2 * (lbv1 - lbr1) + lbp * lbv2) }\n"
+      "  #local lbH2 = function(lbv1, lbv2) { 2 * (lbr1 * lbr1 * (lbv2 - lbr2) + lbp * lbv1) }\n");
+    bchain2("lbC", steps, "lbsg * (lbu1(lbl, lba0) / lbr1 + lbu2(lbl, lba1) / lbr2 - 1)",
+            "lbsg * (lbd1(lbl, lba0) / lbr1 + lbd2(lbl, lba1) / lbr2)");
+    bchain2("lbK", steps, "-lbsg * lbn * lbH(lbu1(lbl, lba0), lbu2(lbl, lba1))",
+            "-lbsg * lbn * (lbH1(lbu1(lbl, lba0), lbu2(lbl, lba1)) * lbd1(lbl, lba0) + "
+            "lbH2(lbu1(lbl, lba0), lbu2(lbl, lba1)) * lbd2(lbl, lba1))");
+    /* after the chord: the H solve between the non-blending end and it */
+    w("  #local lbS3 = function(lbnb, lbc, lba0, lba1) { exp(select(lbU - 0.5, lbKN0(lbnb, lbc, "
+      "lbnb, lba0, lba1), lbKN0(lbnb, lbnb, lbc, lba0, lba1))) }\n");
+    w("  #local lbS2 = function(lbnb, lbfar, lba0, lba1) { lbS3(lbnb, select(lbU - 0.5, "
+      "lbCN0(lbnb, lbfar, lbnb, lba0, lba1), lbCN0(lbnb, lbnb, lbfar, lba0, lba1)), lba0, lba1) "
+      "}\n");
+    /* region II: the other argument within its range at lam_nb */
+    w("  #local lbS1 = function(lbnb, lbo, lbro, lbx0, lbx1, lba0, lba1) { select(select(lbU - "
+      "0.5, lbo - 1, 1 - lbo) - lbro, lbS2(lbnb, select(lbU - 0.5, min((lba0 - ln(1 + 0.5 * lbr1)) "
+      "/ lbm1, (lba1 - ln(1 + 0.5 * lbr2)) / lbm2), max((lba0 - ln(1 - 0.5 * lbr1)) / lbm1, "
+      "(lba1 - ln(1 - 0.5 * lbr2)) / lbm2)), lba0, lba1), exp(lbnb), exp(lbnb)) }\n");
+    /* j: the argument of the non-blending end; o the other; the other's z at lam_nb */
+    w("  #local lbS0 = function(lbx0, lbx1, lba0, lba1) { select(select(lbU - 0.5, lba1 / lbm2 "
+      "- lba0 / lbm1, lba0 / lbm1 - lba1 / lbm2), lbS1(lba1 / lbm2, exp(lba0 - lbm1 * (lba1 / "
+      "lbm2)), lbr1, lbx0, lbx1, lba0, lba1), lbS1(lba0 / lbm1, exp(lba1 - lbm2 * (lba0 / "
+      "lbm1)), lbr2, lbx0, lbx1, lba0, lba1)) }\n");
+    w("  #local lbA = function(lbx, lbm) { select(-lbx, ln(lbx) + (1 - lbm) * %.17g, -1e30) }\n",
+      LN2);
+    /* zero cases: intersection with a zero, union with both zero; x_o <= 0 outside region II */
+    w("  #local lbS = function(lbx0, lbx1) { select(select(lbU - 0.5, min(lbx0, lbx1), max(lbx0, "
+      "lbx1)), 0, 0, lbS0(lbx0, lbx1, lbA(lbx0, lbm1), lbA(lbx1, lbm2))) }\n");
+    w("  #local lbV = function(lbv) { select(lbv - 1e-300, 0, lbv, lbv) }\n"
+      "  function(x, y, z) { lbS(lbV(F1(x, y, z)), lbV(#if (Op = 2) 1 - #end F2(x, y, z))) }\n"
+      "#end\n\n");
+}
+
 /* LB_Displacement(Op, F, R, P, M): BT_k by unrolled CPS Newton. */
 static void displacement(int steps) {
     w("// ---- displacement blends BT_k (hsu2006; m = 1 everywhere is Rockwood's) ----\n"
@@ -835,6 +1014,7 @@ int main(int argc, char **argv) {
     }
     const int steps = choose_steps();
     const int ssteps = choose_soft_steps();
+    const int csteps = choose_sconic_steps();
     char tmp[4096];
     snprintf(tmp, sizeof tmp, "%s.tmp", argv[1]);
     out = fopen(tmp, "w");
@@ -850,6 +1030,7 @@ int main(int argc, char **argv) {
     scale(steps);
     bounded(steps);
     soft_hyper(ssteps);
+    soft_conic(csteps);
     w("#version LB_INC_TEMP;\n#end\n");
     if (fclose(out) != 0 || rename(tmp, argv[1]) != 0) {
         perror(argv[1]);
