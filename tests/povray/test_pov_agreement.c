@@ -27,6 +27,9 @@ static double unit(rng *r) {
 static double range(rng *r, double a, double b) {
     return a + (b - a) * unit(r);
 }
+static double range_neg(rng *r) { /* a conic shape factor: 0, or in [-3, 0.95) */
+    return unit(r) < 0.2 ? 0.0 : -3.0 + 3.95 * unit(r);
+}
 static double logu(rng *r, double a, double b) {
     return exp(range(r, log(a), log(b)));
 }
@@ -284,6 +287,66 @@ static void soft_conic_cases(rng *g) {
     }
 }
 
+/* bulge elimination: the core function of values and gradients */
+static void bulge_cases(rng *g) {
+    static const char *const fams[3][3] = {
+        {"bulge displacement union", "bulge displacement intersection",
+         "bulge displacement difference"},
+        {"bulge conic union", "bulge conic intersection", "bulge conic difference"},
+        {"bulge scale union", "bulge scale intersection", "bulge scale difference"}};
+    for (int set = 0; set < 1800; ++set) {
+        const int fam = set % 3, op = (set / 3) % 3;
+        lb_bulge_params bp;
+        memset(&bp, 0, sizeof bp);
+        bp.omega = set % 4 == 0 ? 0.001 : logu(g, 1e-3, 0.5);
+        bp.flags = fam == 2 ? 1u : (unsigned)(1 + (set / 9) % 3);
+        const int ranged = bp.flags & 1u;
+        for (int i = 0; i < 2; ++i) {
+            bp.r[i] = logu(g, 0.05, 1.0);
+            if (fam == 2 && op != 0) bp.r[i] = logu(g, 0.02, 1.0 / (2.0 + bp.omega));
+            const double u = unit(g);
+            bp.p[i] = u < 0.4   ? 2.0
+                      : u < 0.7 ? (double)(1 + (int)(unit(g) * 16))
+                                : logu(g, 1.05, 16);
+            if (bp.p[i] < 1.05) bp.p[i] = 2.0;
+            bp.m[i] = logu(g, 0.1, 10.0);
+        }
+        bp.conic_p = bp.r[0] * bp.r[1] * (ranged ? bp.omega * bp.omega : 1.0) * range_neg(g);
+        fprintf(pov,
+                "#declare G = LB_BulgeCore(%d, %d, array[2] {%.17g, %.17g}, array[2] {%.17g, "
+                "%.17g}, %.17g, array[2] {%.17g, %.17g}, %u, %.17g)\n",
+                fam, op, bp.r[0], bp.r[1], bp.p[0], bp.p[1], bp.conic_p, bp.m[0], bp.m[1], bp.flags,
+                bp.omega);
+        for (int q = 0; q < 5; ++q) {
+            double x[2], g1[3], g2[3], v;
+            for (int i = 0; i < 2; ++i) x[i] = range(g, -0.6, 0.6);
+            for (int d = 0; d < 3; ++d) {
+                g1[d] = range(g, -2, 2);
+                g2[d] = range(g, -2, 2);
+            }
+            if (q == 1)
+                for (int d = 0; d < 3; ++d) g2[d] = 0.7 * g1[d]; /* parallel */
+            if (q == 2)
+                for (int d = 0; d < 3; ++d) g2[d] = -1.3 * g1[d];    /* opposite */
+            if (q == 3 && set % 5 == 0) g1[0] = g1[1] = g1[2] = 0.0; /* no angle */
+            lb_error e;
+            if (lb_bulge((lb_bulge_family)fam, (lb_setop)op, &bp, x, g1, g2, &v, NULL, NULL, NULL,
+                         &e)) {
+                fprintf(stderr, "%s\n", e.message);
+                exit(1);
+            }
+            if (ncases >= MAXCASES) abort();
+            fprintf(pov,
+                    "#write (FO, str(G(%.17g, %.17g, %.17g, %.17g, %.17g, %.17g, %.17g, %.17g), 0, "
+                    "17), \"\\n\")\n",
+                    x[0], x[1], g1[0], g1[1], g1[2], g2[0], g2[1], g2[2]);
+            family[ncases] = fams[fam][op];
+            expect[ncases++] = v;
+        }
+        fprintf(pov, "#undef G\n");
+    }
+}
+
 static void classic_cases(rng *g) {
     static const struct {
         const char *fam, *macro;
@@ -424,6 +487,7 @@ int main(int argc, char **argv) {
     bounded_cases(&g);
     soft_hyper_cases(&g);
     soft_conic_cases(&g);
+    bulge_cases(&g);
     classic_cases(&g);
     primitive_cases(&g);
     fprintf(pov, "#fclose FO\n");

@@ -444,6 +444,65 @@ static void classic(void) {
 
 /* LB_Conic(Op, F1, F2, R, P, M): the binary conic BT_2 in closed form,
  * mirroring lb__conic_union step for step (shifted variable s = h - h1). */
+/* Write a template: $X = the extra parameters of the variable form, $A and
+ * $W = the quadratic's leading coefficient and the chord weight (constants,
+ * or expressions in the parameters), $P = the function-name prefix. */
+static void wt(const char *t, int var, const char *pre) {
+    for (; *t; ++t) {
+        if (t[0] != '$') {
+            fputc(*t, out);
+            continue;
+        }
+        ++t;
+        if (*t == 'X')
+            w("%s", var ? ", lbr1, lbr2, lbm1, lbm2" : "");
+        else if (*t == 'A')
+            w("%s", var ? "(lbr2 * lbr2 * lbm1 * lbm1 + lbr1 * lbr1 * lbm2 * lbm2 + 2 * lbp * "
+                          "lbm1 * lbm2)"
+                        : "lba");
+        else if (*t == 'W')
+            w("%s", var ? "(lbr1 * lbm2 + lbr2 * lbm1)" : "lbw");
+        else if (*t == 'P')
+            w("%s", pre);
+    }
+}
+
+/* The conic union of lb__conic_union as a chain of functions ending in
+ * <pre>U(x1, x2 [, r1, r2, m1, m2]): with var, the ranges and slopes are
+ * parameters (bulge elimination), else the constants lbr1.. of the macro. */
+static void conic_chain(int var, const char *pre) {
+    /* distance of a candidate from [s2, 0] */
+    wt("  #local $Pdist = function(lbc, lbs2) { select(-lbc, lbc, select(lbc - lbs2, lbs2 - lbc, "
+       "0)) }\n",
+       var, pre);
+    wt("  #local $Ppick = function(lbsa, lbsb, lbs2) { min(0, max(lbs2, select($Pdist(lbsb, lbs2) "
+       "- $Pdist(lbsa, lbs2), lbsb, lbsa))) }\n",
+       var, pre);
+    wt("  #local $Ps4 = function(lbq, lbcc, lbch$X) { select((lbcc / lbq <= 0) * (lbcc / lbq * $W "
+       ">= lbch) - 0.5, $Ppick(lbcc / lbq, lbq / $A, lbch / $W), lbcc / lbq) }\n",
+       var, pre);
+    wt("  #local $Ps3 = function(lbb, lbcc, lbch$X) { $Ps4(-0.5 * (lbb + select(lbb, -sqrt(max(0, "
+       "lbb * lbb - 4 * $A * lbcc)), sqrt(max(0, lbb * lbb - 4 * $A * lbcc)))), lbcc, lbch$X) }\n",
+       var, pre);
+    wt("  #local $Ps2 = function(lbv1, lbv2, lbch$X) { $Ps3(2 * ((lbr1 - lbv1) * lbr2 * lbr2 * "
+       "lbm1 + (lbr2 - lbv2) * lbr1 * lbr1 * lbm2 - lbp * (lbv1 * lbm2 + lbv2 * lbm1)), lbch * "
+       "lbch + 2 * (lbp - lbr1 * lbr2) * lbv1 * lbv2, lbch$X) }\n",
+       var, pre);
+    wt("  #local $Pin = function(lbh1, lbv1, lbv2$X) { lbh1 + $Ps2(lbv1, lbv2, lbr1 * lbv2 + lbr2 "
+       "* lbv1 - lbr1 * lbr2$X) }\n",
+       var, pre);
+    /* region II and h1 */
+    wt("  #local $Pu = function(lbx1, lbx2, lbh1, lbc$X) { select(lbc, select(lbx1 - lbm1 * lbh1 "
+       "- lbr1, $Pin(lbh1, lbx1 - lbm1 * lbh1, 0$X), lbh1), select(lbx2 - lbm2 * lbh1 - lbr2, "
+       "$Pin(lbh1, 0, lbx2 - lbm2 * lbh1$X), lbh1)) }\n",
+       var, pre);
+    wt("  #local $PU = function(lbx1, lbx2$X) { $Pu(lbx1, lbx2, select(lbx2 * lbm1 - lbx1 * lbm2, "
+       "lbx2 / lbm2, lbx1 / lbm1), lbx2 * lbm1 - lbx1 * lbm2$X) }\n",
+       var, pre);
+}
+
+/* LB_Conic(Op, F1, F2, R, P, M): the binary conic BT_2 in closed form,
+ * mirroring lb__conic_union step for step (shifted variable s = h - h1). */
 static void conic(void) {
     w("// ---- binary conic blend BT_2 (hsu2006 Eq. 4), closed form ----\n"
       "// LB_Conic(Op, F1, F2, R, Shape, M): Op 0 union, 1 intersection, 2 difference;\n"
@@ -456,27 +515,7 @@ static void conic(void) {
       "  #local lba = lbr2 * lbr2 * lbm1 * lbm1 + lbr1 * lbr1 * lbm2 * lbm2 + 2 * lbp * lbm1 * "
       "lbm2;\n"
       "  #local lbw = lbr1 * lbm2 + lbr2 * lbm1;\n");
-    /* distance of a candidate from [s2, 0] */
-    w("  #local lbdist = function(lbc, lbs2) { select(-lbc, lbc, select(lbc - lbs2, lbs2 - lbc, "
-      "0)) }\n");
-    /* s from v1, v2 via b, chord, cc, q */
-    w("  #local lbpick = function(lbsa, lbsb, lbs2) { min(0, max(lbs2, select(lbdist(lbsb, lbs2) "
-      "- lbdist(lbsa, lbs2), lbsb, lbsa))) }\n");
-    w("  #local lbs4 = function(lbq, lbcc, lbch) { select((lbcc / lbq <= 0) * (lbcc / lbq * lbw "
-      ">= lbch) - 0.5, lbpick(lbcc / lbq, lbq / lba, lbch / lbw), lbcc / lbq) }\n");
-    w("  #local lbs3 = function(lbb, lbcc, lbch) { lbs4(-0.5 * (lbb + select(lbb, -sqrt(max(0, "
-      "lbb * lbb - 4 * lba * lbcc)), sqrt(max(0, lbb * lbb - 4 * lba * lbcc)))), lbcc, lbch) }\n");
-    w("  #local lbs2 = function(lbv1, lbv2, lbch) { lbs3(2 * ((lbr1 - lbv1) * lbr2 * lbr2 * lbm1 "
-      "+ (lbr2 - lbv2) * lbr1 * lbr1 * lbm2 - lbp * (lbv1 * lbm2 + lbv2 * lbm1)), lbch * lbch + "
-      "2 * (lbp - lbr1 * lbr2) * lbv1 * lbv2, lbch) }\n");
-    w("  #local lbin = function(lbh1, lbv1, lbv2) { lbh1 + lbs2(lbv1, lbv2, lbr1 * lbv2 + lbr2 * "
-      "lbv1 - lbr1 * lbr2) }\n");
-    /* region II and h1 */
-    w("  #local lbu = function(lbx1, lbx2, lbh1, lbc) { select(lbc, select(lbx1 - lbm1 * lbh1 - "
-      "lbr1, lbin(lbh1, lbx1 - lbm1 * lbh1, 0), lbh1), select(lbx2 - lbm2 * lbh1 - lbr2, "
-      "lbin(lbh1, 0, lbx2 - lbm2 * lbh1), lbh1)) }\n");
-    w("  #local lbU = function(lbx1, lbx2) { lbu(lbx1, lbx2, select(lbx2 * lbm1 - lbx1 * lbm2, "
-      "lbx2 / lbm2, lbx1 / lbm1), lbx2 * lbm1 - lbx1 * lbm2) }\n");
+    conic_chain(0, "lb");
     w("  #local lbSG = select(Op - 1, 1, -1, -1);\n"
       "  #local lbSO = select(abs(Op - 1), -1, -1, 1);\n"
       "  function(x, y, z) { lbSG * lbU(lbSG * F1(x, y, z), lbSO * F2(x, y, z)) }\n#end\n\n");
@@ -932,6 +971,87 @@ static void soft_conic(int steps) {
       "#end\n\n");
 }
 
+/* LB_BulgeCore / LB_Bulge: bulge elimination for binary blends, mirroring
+ * lb_bulge (ranges R_i = r_i (1 - cos theta + omega), optionally slopes
+ * M_i(cos theta, |g1|/|g2|)). */
+static void bulge(int steps) {
+    w("// ---- bulge elimination for binary blends (hsu2006 5; hsu-bounded 2.5) ----\n"
+      "// LB_BulgeCore(Family, Op, R, P, Shape, M, Flags, Omega) returns\n"
+      "// function(x1, x2, g1x, g1y, g1z, g2x, g2y, g2z): the blend of two values given their\n"
+      "// gradients. Family 0 displacement, 1 conic, 2 scale; Op 0 union, 1 intersection,\n"
+      "// 2 difference; R, P, M arrays of 2 (P unused by the conic, M by the scale method);\n"
+      "// Shape the conic's p; Flags 1 = ranges, 2 = slopes (not for scale), 3 = both;\n"
+      "// Omega the range floor (0.001 in the papers).\n"
+      "// LB_Bulge(Family, Op, F1, F2, R, P, Shape, M, Flags, Omega, Eps) applies it to two\n"
+      "// functions, their gradients by central differences of step Eps.\n");
+    w("#macro LB_BulgeCore(Family, Op, R, P, Shape, M, Flags, Omega)\n"
+      "  #local lbFam = Family; #local lbop = Op;\n"
+      "  #local lbrng = (Flags = 1 | Flags = 3); #local lbslp = (Flags = 2 | Flags = 3);\n"
+      "  #local lbom = Omega; #local lbp = Shape;\n"
+      "  #local lbb1 = R[0]; #local lbb2 = R[1]; #local lbn1 = M[0]; #local lbn2 = M[1];\n"
+      "  #local lbP = array[%d];\n"
+      "  #for (I, 0, %d) #if (I < 2) #local lbP[I] = P[I]; #else #local lbP[I] = 2; #end #end\n",
+      KMAX, KMAX - 1);
+    /* the three base operators with ranges and slopes as parameters */
+    w("  #if (lbFam = 0)\n");
+    vsolver(steps);
+    w("  #local lbBase = function(lbx1, lbx2, lbr1, lbr2, lbm1, lbm2) { lbVB(lbx1, lbx2");
+    for (int i = 2; i < KMAX; ++i) w(", 1e30");
+    w(", lbm1, lbm2");
+    for (int i = 2; i < KMAX; ++i) w(", 1");
+    w(", lbr1, lbr2");
+    for (int i = 2; i < KMAX; ++i) w(", 1");
+    w(") }\n  #elseif (lbFam = 1)\n");
+    conic_chain(1, "lbc");
+    w("  #local lbBase = function(lbx1, lbx2, lbr1, lbr2, lbm1, lbm2) { lbcU(lbx1, lbx2, lbr1, "
+      "lbr2, lbm1, lbm2) }\n  #else\n");
+    scale_body(steps);
+    w("  #local lbBase = function(lbx1, lbx2, lbr1, lbr2, lbm1, lbm2) { #if (lbop = 0) "
+      "lbZU(lbx1 + 1, lbx2 + 1");
+    for (int i = 2; i < KMAX; ++i) w(", 1e30");
+    w(", lbr1, lbr2");
+    for (int i = 2; i < KMAX; ++i) w(", 1");
+    w(") #else lbZI(lbx1 + 1, lbx2 + 1");
+    for (int i = 2; i < KMAX; ++i) w(", -1e30");
+    w(", lbr1, lbr2");
+    for (int i = 2; i < KMAX; ++i) w(", 1");
+    w(") #end }\n  #end\n");
+    /* the duals of the displacement and conic families; the scale method
+     * takes x as is and negates a difference's second argument itself */
+    w("  #local lbSG = select(lbop - 1, 1, -1, -1);\n"
+      "  #local lbSO = select(abs(lbop - 1), -1, -1, 1);\n"
+      "  #local lbSig = select(lbop - 1.5, 1, -1);\n");
+    w("  #local lbQ3 = function(lbx1, lbx2, lbr1, lbr2, lbm1, lbm2) {\n"
+      "    #if (lbFam = 2) lbBase(lbx1, lbSig * lbx2, lbr1, lbr2, lbm1, lbm2)\n"
+      "    #else lbSG * lbBase(lbSG * lbx1, lbSO * lbx2, lbr1, lbr2, lbm1, lbm2) #end }\n");
+    /* slopes: M from cos+ = max(cs, 0) and G = |g1|/|g2|, kept in [1e-6, 1e6] */
+    w("  #local lbQ2 = function(lbx1, lbx2, lbcs, lbG, lbboth) { lbQ3(lbx1, lbx2, "
+      "select(lbrng - 0.5, lbb1, lbb1 * (1 - lbcs + lbom)), select(lbrng - 0.5, lbb2, lbb2 * (1 - "
+      "lbcs + lbom)), select(lbslp * lbboth - 0.5, lbn1, select(lbn1 - lbn2 * lbG, min(%.17g, "
+      "max(%.17g, lbn1 + (lbn2 * lbG - lbn1) * max(lbcs, 0))), lbn1, lbn1)), select(lbslp * "
+      "lbboth - 0.5, lbn2, select(lbn1 - lbn2 * lbG, lbn2, lbn2, min(%.17g, max(%.17g, lbn2 + "
+      "(lbn1 / lbG - lbn2) * max(lbcs, 0)))))) }\n",
+      LB_MAX_SLOPE, LB_MIN_SLOPE, LB_MAX_SLOPE, LB_MIN_SLOPE);
+    /* cos theta from unit vectors; a gradient below 1e-30 counts as zero */
+    w("  #local lbQ1 = function(lbx1, lbx2, lbg1x, lbg1y, lbg1z, lbg2x, lbg2y, lbg2z, lbl1, lbl2) "
+      "{ lbQ2(lbx1, lbx2, select((lbl1 >= %.17g) * (lbl2 >= %.17g) - 0.5, 0, min(1, max(-1, "
+      "lbSig * ((lbg1x / lbl1) * (lbg2x / lbl2) + (lbg1y / lbl1) * (lbg2y / lbl2) + (lbg1z / "
+      "lbl1) * (lbg2z / lbl2))))), select(lbl2, 1, 1, lbl1 / lbl2), (lbl1 >= %.17g) * (lbl2 >= "
+      "%.17g)) }\n",
+      LB_BULGE_MIN_GRAD, LB_BULGE_MIN_GRAD, LB_BULGE_MIN_GRAD, LB_BULGE_MIN_GRAD);
+    w("  function(lbx1, lbx2, lbg1x, lbg1y, lbg1z, lbg2x, lbg2y, lbg2z) { lbQ1(lbx1, lbx2, lbg1x, "
+      "lbg1y, lbg1z, lbg2x, lbg2y, lbg2z, sqrt(lbg1x * lbg1x + lbg1y * lbg1y + lbg1z * lbg1z), "
+      "sqrt(lbg2x * lbg2x + lbg2y * lbg2y + lbg2z * lbg2z)) }\n#end\n\n");
+    w("#macro LB_Bulge(Family, Op, F1, F2, R, P, Shape, M, Flags, Omega, Eps)\n"
+      "  #local lbCore = LB_BulgeCore(Family, Op, R, P, Shape, M, Flags, Omega)\n"
+      "  #local lbe = Eps;\n"
+      "  function(x, y, z) { lbCore(F1(x, y, z), F2(x, y, z), (F1(x + lbe, y, z) - F1(x - lbe, "
+      "y, z)) / (2 * lbe), (F1(x, y + lbe, z) - F1(x, y - lbe, z)) / (2 * lbe), (F1(x, y, z + "
+      "lbe) - F1(x, y, z - lbe)) / (2 * lbe), (F2(x + lbe, y, z) - F2(x - lbe, y, z)) / (2 * "
+      "lbe), (F2(x, y + lbe, z) - F2(x, y - lbe, z)) / (2 * lbe), (F2(x, y, z + lbe) - F2(x, y, "
+      "z - lbe)) / (2 * lbe)) }\n#end\n\n");
+}
+
 /* LB_Displacement(Op, F, R, P, M): BT_k by unrolled CPS Newton. */
 static void displacement(int steps) {
     w("// ---- displacement blends BT_k (hsu2006; m = 1 everywhere is Rockwood's) ----\n"
@@ -1031,6 +1151,7 @@ int main(int argc, char **argv) {
     bounded(steps);
     soft_hyper(ssteps);
     soft_conic(csteps);
+    bulge(steps);
     w("#version LB_INC_TEMP;\n#end\n");
     if (fclose(out) != 0 || rename(tmp, argv[1]) != 0) {
         perror(argv[1]);
