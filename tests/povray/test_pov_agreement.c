@@ -393,8 +393,8 @@ static void classic_cases(rng *g) {
 }
 
 static void primitive_cases(rng *g) {
-    for (int set = 0; set < 6000; ++set) {
-        const int kind = set % 6;
+    for (int set = 0; set < 12000; ++set) {
+        const int kind = set % 12;
         double c[3], q[3], ax[3], R = logu(g, 0.1, 3.0), R2 = R * range(g, 0.1, 0.5);
         for (int d = 0; d < 3; ++d) {
             c[d] = range(g, -2, 2);
@@ -444,6 +444,48 @@ static void primitive_cases(rng *g) {
                 "#declare G = LB_Capsule(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n",
                 c[0], c[1], c[2], q[0], q[1], q[2], R);
             break;
+        case 6: {
+            fam = "LP metric";
+            const double A[3] = {R, R * range(g, 0.3, 2), R * range(g, 0.3, 2)};
+            const double n = logu(g, 1.0, 12.0);
+            s = lb_primitive_lp(&P, c, A, n, &e);
+            fprintf(pov,
+                    "#declare G = LB_LP(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n",
+                    c[0], c[1], c[2], A[0], A[1], A[2], n);
+            break;
+        }
+        case 7: {
+            fam = "superquadric";
+            const double A[3] = {R, R * range(g, 0.3, 2), R * range(g, 0.3, 2)};
+            const double e1 = logu(g, 0.1, 3.0), e2 = logu(g, 0.1, 3.0);
+            s = lb_primitive_superquadric(&P, c, A, e1, e2, &e);
+            fprintf(pov,
+                    "#declare G = LB_Superquadric(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, "
+                    "%.17g, %.17g)\n",
+                    c[0], c[1], c[2], A[0], A[1], A[2], e1, e2);
+            break;
+        }
+        case 8:
+            fam = "halfspace";
+            s = lb_primitive_halfspace(&P, c, ax, R, &e);
+            fprintf(pov,
+                    "#declare G = LB_Halfspace(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, "
+                    "%.17g)\n",
+                    c[0], c[1], c[2], ax[0], ax[1], ax[2], R);
+            break;
+        case 9:
+        case 10: {
+            /* soft kernels over a sphere: K(rho) with rho = f + 1 */
+            fam = kind == 9 ? "Wyvill kernel" : "Blinn kernel";
+            s = lb_primitive_sphere(&P, c, R, &e);
+            if (!s) s = lb_primitive_soften(&P, kind == 9 ? LB_KERNEL_WYVILL : LB_KERNEL_BLINN, &e);
+            fprintf(pov,
+                    "#declare G0 = LB_Sphere(<%.17g, %.17g, %.17g>, %.17g)\n"
+                    "#declare G = function(x, y, z) { %s(G0(x, y, z) + 1) }\n#undef G0\n",
+                    c[0], c[1], c[2], R, kind == 9 ? "LB_Wyvill" : "LB_Blinn");
+            break;
+        }
+        case 11:
         default:
             fam = "torus";
             s = lb_primitive_torus(&P, c, ax, R, R2, &e);
@@ -458,7 +500,9 @@ static void primitive_cases(rng *g) {
             exit(1);
         }
         for (int k = 0; k < 1; ++k) {
-            const double X[3] = {range(g, -4, 4), range(g, -4, 4), range(g, -4, 4)};
+            const double sp = kind >= 9 && kind <= 10 ? 0.6 * R : 4.0;
+            const double X[3] = {c[0] + range(g, -sp, sp), c[1] + range(g, -sp, sp),
+                                 c[2] + range(g, -sp, sp)};
             record(fam, "G", X[0], X[1], X[2], lb_primitive_eval(&P, X, NULL));
         }
         fprintf(pov, "#undef G\n");

@@ -419,6 +419,35 @@ static void primitives(void) {
       "- 1 }\n#end\n\n");
 }
 
+/* the other primitives and the soft kernels */
+static void primitives2(void) {
+    w("// LP metric: (sum |x_i / a_i|^N)^(1/N), N >= 1\n#macro LB_LP(C, A, N)\n");
+    unpack("C", "lbc");
+    unpack("A", "lba");
+    w("  #local lbn = N;\n"
+      "  function(x, y, z) { pow(pow(abs(x - lbcx) / lbax, lbn) + pow(abs(y - lbcy) / lbay, lbn) "
+      "+ pow(abs(z - lbcz) / lbaz, lbn), 1 / lbn) - 1 }\n#end\n\n");
+    w("// Barr's superquadric: ((|x/a1|^(2/E2) + |y/a2|^(2/E2))^(E2/E1) + |z/a3|^(2/E1))^(E1/2)\n"
+      "#macro LB_Superquadric(C, A, E1, E2)\n");
+    unpack("C", "lbc");
+    unpack("A", "lba");
+    w("  #local lbe1 = E1; #local lbe2 = E2;\n"
+      "  function(x, y, z) { pow(pow(pow(abs(x - lbcx) / lbax, 2 / lbe2) + pow(abs(y - lbcy) / "
+      "lbay, 2 / lbe2), lbe2 / lbe1) + pow(abs(z - lbcz) / lbaz, 2 / lbe1), lbe1 / 2) - 1 }\n"
+      "#end\n\n");
+    w("// one-branch plane: max(N.(X - C), 0) / W - 1 (only C0 on the plane)\n"
+      "#macro LB_Halfspace(C, N, W)\n");
+    unpack("C", "lbc");
+    unpack("vnormalize(N)", "lbu");
+    w("  function(x, y, z) { max(0, lbux * (x - lbcx) + lbuy * (y - lbcy) + lbuz * (z - lbcz)) / "
+      "W - 1 }\n#end\n\n");
+    w("// soft kernels of rho (rho = f + 1 of a zero-convention primitive): 0.5 on the surface\n"
+      "#declare LB_Wyvill = function(lbrho) { select(lbrho - 2, pow(1 - lbrho * lbrho / 4, 2) * "
+      "(1 - lbrho * lbrho / 9), 0, 0) }\n"
+      "#declare LB_Blinn = function(lbrho) { exp(-%.17g * lbrho * lbrho) }\n\n",
+      LN2);
+}
+
 static void classic(void) {
     w("// ---- classic operators ----\n\n");
     w("// Rvachev R-functions (binary, zero convention)\n"
@@ -1144,6 +1173,7 @@ int main(int argc, char **argv) {
     }
     header();
     primitives();
+    primitives2();
     classic();
     displacement(steps);
     conic();
