@@ -52,6 +52,7 @@ int bt_write_file(const char *cmd, const char *path, const char *data, size_t le
 /* Is help requested anywhere in argv? */
 int bt_wants_help(int argc, char **argv);
 
-extern const bt_command bt_cmd_validate, bt_cmd_info, bt_cmd_eval, bt_cmd_mesh;
+extern const bt_command bt_cmd_validate, bt_cmd_info, bt_cmd_eval, bt_cmd_mesh, bt_cmd_pov,
+    bt_cmd_render;
 
 #endif

@@ -9,7 +9,7 @@
 #include <unistd.h>
 
 static const bt_command *const COMMANDS[] = {&bt_cmd_validate, &bt_cmd_info, &bt_cmd_eval,
-                                             &bt_cmd_mesh};
+                                             &bt_cmd_mesh,     &bt_cmd_pov,  &bt_cmd_render};
 #define NCOMMANDS (sizeof COMMANDS / sizeof COMMANDS[0])
 
 int bt_exit_for(lb_status s) {

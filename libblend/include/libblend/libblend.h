@@ -7,5 +7,6 @@
 #include "primitives.h"
 #include "scene.h"
 #include "mesh.h"
+#include "pov.h"
 
 #endif

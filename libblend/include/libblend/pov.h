@@ -1,0 +1,47 @@
+/* libblend -> POV-Ray: a scene as a renderable .pov file.
+ *
+ * The field is built from the macros of povray_include/libblend.inc (one
+ * declaration per distinct node: shared defs stay shared; transforms become
+ * argument substitutions), rendered as one isosurface whose contained_by box
+ * is the scene's bounds and whose max_gradient libblend computes: the
+ * largest |grad f| on a dense grid over the box (LB_POV_GRADIENT_SAMPLES per
+ * axis) times LB_POV_GRADIENT_SAFETY. Camera, lights and material come from
+ * the scene's render section, or frame the bounds by default. Nothing the
+ * scene's author typed reaches an identifier: names are generated (LBn0,
+ * LBn1, ...) and user text appears only in comments, stripped of anything
+ * but printable ASCII.
+ *
+ * Limits of the include: a k-ary blend takes at most 16 arguments; a scene
+ * with a larger one is refused with a message naming the node. */
+#ifndef LIBBLEND_POV_H
+#define LIBBLEND_POV_H
+
+#include "scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LB_POV_MAX_ARITY 16
+#define LB_POV_GRADIENT_SAMPLES 48
+#define LB_POV_GRADIENT_SAFETY 1.25
+
+typedef struct lb_pov_options {
+    int include_only;    /* 1: only the #declare'd functions (the root is LB_Field) */
+    double aspect;       /* image width / height for the camera (0: 4/3) */
+    double max_gradient; /* > 0: use this instead of computing it */
+    int threads;         /* for the gradient sampling: 0 = all CPUs, 1 = caller only */
+} lb_pov_options;
+
+/* Write the scene to path (atomically). ev must be compiled from scene. The
+ * file includes "libblend.inc": render with povray +L<dir of libblend.inc>.
+ * *max_gradient (may be NULL) receives the value written. */
+LB_API lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
+                                    const lb_pov_options *opt, const char *path,
+                                    double *max_gradient, lb_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,391 @@
+/* A scene as a POV-Ray 3.7 file (pov.h): the node DAG as #declare'd
+ * functions built with povray_include/libblend.inc, one isosurface, camera,
+ * lights and material. */
+#define _POSIX_C_SOURCE 200809L
+#include "../scene/scene_internal.h"
+
+#include <libblend/pov.h>
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static const char FN[] = "lb_scene_write_pov";
+
+typedef struct sbuf {
+    char *s;
+    size_t n, cap;
+    int oom;
+} sbuf;
+
+static void sb(sbuf *b, const char *fmt, ...) {
+    if (b->oom) return;
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        const int w = vsnprintf(b->s ? b->s + b->n : NULL, b->s ? b->cap - b->n : 0, fmt, ap);
+        va_end(ap);
+        if (w < 0) {
+            b->oom = 1;
+            return;
+        }
+        if (b->s && b->n + (size_t)w < b->cap) {
+            b->n += (size_t)w;
+            return;
+        }
+        size_t nc = b->cap ? 2 * b->cap : 65536;
+        while (nc < b->n + (size_t)w + 1) nc *= 2;
+        char *q = realloc(b->s, nc);
+        if (!q) {
+            b->oom = 1;
+            return;
+        }
+        b->s = q;
+        b->cap = nc;
+    }
+}
+
+/* user text in a comment: printable ASCII only */
+static void sb_comment(sbuf *b, const char *label, const char *text) {
+    if (!text || !*text) return;
+    sb(b, "// %s: ", label);
+    for (const char *c = text; *c && b->n < ((size_t)1 << 30); ++c)
+        sb(b, "%c", *c >= 32 && *c < 127 ? *c : ' ');
+    sb(b, "\n");
+}
+
+typedef struct pctx {
+    sbuf *b;
+    const lb_scene *sc;
+    const lb__node **done;
+    int *ids;
+    size_t ndone, cap;
+    int next;
+    double eps; /* central-difference step of the bulge macros */
+    lb_error *err;
+} pctx;
+
+static void arr(sbuf *b, size_t k, const double *v, double fallback) {
+    sb(b, "array[%zu] {", k);
+    for (size_t i = 0; i < k; ++i) sb(b, "%s%.17g", i ? ", " : "", v ? v[i] : fallback);
+    sb(b, "}");
+}
+
+static lb_status emit(pctx *c, const lb__node *n, int *out);
+
+static lb_status emit_args(pctx *c, const lb__node *n, lb__node *const *args, int aid) {
+    int ids[LB_MAX_ARITY];
+    for (size_t i = 0; i < n->k; ++i) {
+        lb_status s = emit(c, args[i], &ids[i]);
+        if (s) return s;
+    }
+    sb(c->b, "#declare LBa%d = array[%zu] {", aid, n->k);
+    for (size_t i = 0; i < n->k; ++i) sb(c->b, "%sLBn%d", i ? ", " : "", ids[i]);
+    sb(c->b, "};\n");
+    return LB_OK;
+}
+
+static lb_status emit(pctx *c, const lb__node *n, int *out) {
+    for (size_t i = 0; i < c->ndone; ++i)
+        if (c->done[i] == n) {
+            *out = c->ids[i];
+            return LB_OK;
+        }
+    sbuf *b = c->b;
+    const int id = c->next++;
+    const char *name = n->has_transform ? "LBl" : "LBn";
+    const int k16 = n->family == LB__F_DISPLACEMENT || n->family == LB__F_SCALE ||
+                    n->family == LB__F_BOUNDED || n->family == LB__F_SOFT_HYPER;
+    if (k16 && n->k > LB_POV_MAX_ARITY)
+        return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: %s: a %s blend of %zu arguments; allowed in POV-Ray: at most %d "
+                        "(the include's limit; POV-Ray functions take at most 56 parameters)",
+                        FN, n->path, n->type, n->k, LB_POV_MAX_ARITY);
+    lb_status s = LB_OK;
+    if (n->family == LB__F_PRIMITIVE) {
+        const lb_primitive *P = &n->prim;
+        const char *base = P->kernel == LB_KERNEL_NONE ? name : "LBr";
+        sb(b, "#declare %s%d = ", base, id);
+        switch (P->kind) {
+        case LB_PRIM_ELLIPSOID:
+            sb(b, "LB_Ellipsoid(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>)\n", P->c[0], P->c[1],
+               P->c[2], P->a[0], P->a[1], P->a[2]);
+            break;
+        case LB_PRIM_LP:
+            sb(b, "LB_LP(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0], P->c[1],
+               P->c[2], P->a[0], P->a[1], P->a[2], P->s0);
+            break;
+        case LB_PRIM_SUPERQUADRIC:
+            sb(b, "LB_Superquadric(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g, %.17g)\n",
+               P->c[0], P->c[1], P->c[2], P->a[0], P->a[1], P->a[2], P->s0, P->s1);
+            break;
+        case LB_PRIM_SLAB:
+        case LB_PRIM_HALFSPACE:
+            sb(b, "%s(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n",
+               P->kind == LB_PRIM_SLAB ? "LB_Slab" : "LB_Halfspace", P->c[0], P->c[1], P->c[2],
+               P->n[0], P->n[1], P->n[2], P->s0);
+            break;
+        case LB_PRIM_CYLINDER:
+            sb(b, "LB_Cylinder(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0],
+               P->c[1], P->c[2], P->n[0], P->n[1], P->n[2], P->s0);
+            break;
+        case LB_PRIM_CAPSULE:
+            sb(b, "LB_Capsule(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0],
+               P->c[1], P->c[2], P->q[0], P->q[1], P->q[2], P->s0);
+            break;
+        case LB_PRIM_TORUS:
+            sb(b, "LB_Torus(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g, %.17g)\n", P->c[0],
+               P->c[1], P->c[2], P->n[0], P->n[1], P->n[2], P->s0, P->s1);
+            break;
+        }
+        if (P->kernel != LB_KERNEL_NONE)
+            sb(b, "#declare %s%d = function(x, y, z) { %s(LBr%d(x, y, z) + 1) }\n", name, id,
+               P->kernel == LB_KERNEL_WYVILL ? "LB_Wyvill" : "LB_Blinn", id);
+    } else if (n->family == LB__F_GROUP) {
+        int a;
+        if ((s = emit(c, n->args[0], &a))) return s;
+        sb(b, "#declare %s%d = LBn%d;\n", name, id, a);
+    } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
+        int ids[LB_MAX_ARITY];
+        for (size_t i = 0; i < n->k; ++i)
+            if ((s = emit(c, n->args[i], &ids[i]))) return s;
+        sb(b, "#declare %s%d = function(x, y, z) { %s(", name, id,
+           n->family == LB__F_MIN ? "min" : "max");
+        for (size_t i = 0; i < n->k; ++i) sb(b, "%sLBn%d(x, y, z)", i ? ", " : "", ids[i]);
+        sb(b, "%s) }\n", n->k > 1 ? "" : n->family == LB__F_MIN ? ", 1e300" : ", -1e300");
+    } else if (n->family == LB__F_COMPLEMENT) {
+        int a;
+        if ((s = emit(c, n->args[0], &a))) return s;
+        if (c->sc->convention == LB_CONVENTION_ZERO)
+            sb(b, "#declare %s%d = function(x, y, z) { -LBn%d(x, y, z) }\n", name, id, a);
+        else
+            sb(b, "#declare %s%d = function(x, y, z) { max(0, 1 - LBn%d(x, y, z)) }\n", name, id,
+               a);
+    } else if (n->family == LB__F_RFUNCTION) {
+        int a, d;
+        if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
+        sb(b, "#declare %s%d = %s(LBn%d, LBn%d)\n", name, id,
+           n->op == LB_UNION ? "LB_RUnion" : "LB_RIntersection", a, d);
+    } else if (n->bulge) {
+        int a, d;
+        if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
+        const lb_bulge_params *bp = &n->bp;
+        const int fam = n->family == LB__F_DISPLACEMENT ? 0 : n->family == LB__F_CONIC ? 1 : 2;
+        sb(b,
+           "#declare %s%d = LB_Bulge(%d, %d, LBn%d, LBn%d, array[2] {%.17g, %.17g}, array[2] "
+           "{%.17g, %.17g}, %.17g, array[2] {%.17g, %.17g}, %u, %.17g, %.17g)\n",
+           name, id, fam, (int)n->op, a, d, bp->r[0], bp->r[1], bp->p[0], bp->p[1], bp->conic_p,
+           bp->m[0], bp->m[1], bp->flags, bp->omega, c->eps);
+    } else if (n->family == LB__F_CONIC || n->family == LB__F_SOFT_CONIC) {
+        int a, d;
+        if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
+        sb(b, "#declare %s%d = %s(%d, LBn%d, LBn%d, ", name, id,
+           n->family == LB__F_CONIC ? "LB_Conic" : "LB_SoftConic", (int)n->op, a, d);
+        arr(b, 2, n->r, 1.0);
+        sb(b, ", %.17g, ", n->shape);
+        arr(b, 2, n->m, 1.0);
+        sb(b, ")\n");
+    } else {
+        if ((s = emit_args(c, n, n->args, id))) return s;
+        if (n->family == LB__F_BOUNDED) {
+            int ids[LB_MAX_ARITY];
+            for (size_t i = 0; i < n->k; ++i)
+                if ((s = emit(c, n->bounds[i], &ids[i]))) return s;
+            sb(b, "#declare LBc%d = array[%zu] {", id, n->k);
+            for (size_t i = 0; i < n->k; ++i) sb(b, "%sLBn%d", i ? ", " : "", ids[i]);
+            sb(b, "};\n#declare %s%d = LB_Bounded(%d, LBa%d, LBc%d, ", name, id, (int)n->op, id,
+               id);
+            arr(b, n->k, n->p, 2.0);
+            sb(b, ")\n");
+        } else if (n->family == LB__F_DISPLACEMENT || n->family == LB__F_SOFT_HYPER) {
+            sb(b, "#declare %s%d = %s(%d, LBa%d, ", name, id,
+               n->family == LB__F_DISPLACEMENT ? "LB_Displacement" : "LB_SoftHyper", (int)n->op,
+               id);
+            arr(b, n->k, n->r, 1.0);
+            sb(b, ", ");
+            arr(b, n->k, n->p, 2.0);
+            sb(b, ", ");
+            arr(b, n->k, n->m, 1.0);
+            sb(b, ")\n");
+        } else if (n->family == LB__F_SCALE) {
+            sb(b, "#declare %s%d = LB_Scale(%d, LBa%d, ", name, id, (int)n->op, id);
+            arr(b, n->k, n->r, 1.0);
+            sb(b, ", ");
+            arr(b, n->k, n->p, 2.0);
+            sb(b, ")\n");
+        } else if (n->family == LB__F_SOFT_SUM) {
+            sb(b, "#declare %s%d = LB_SoftSum(LBa%d)\n", name, id, id);
+        } else if (n->family == LB__F_RICCI) {
+            sb(b, "#declare %s%d = LB_Ricci(LBa%d, %.17g)\n", name, id, id, n->shape);
+        } else if (n->family == LB__F_PERLIN) {
+            sb(b, "#declare %s%d = %s(LBa%d)\n", name, id,
+               n->op == LB_UNION          ? "LB_PerlinUnion"
+               : n->op == LB_INTERSECTION ? "LB_PerlinIntersection"
+                                          : "LB_PerlinDifference",
+               id);
+        } else {
+            return lb__fail(c->err, LB_ERR_INTERNAL, "%s: %s: no POV-Ray form for %s", FN, n->path,
+                            n->type);
+        }
+    }
+    if (n->has_transform) {
+        const double *M = n->to_local.M, *t = n->to_local.t;
+        sb(b, "#declare LBn%d = function(x, y, z) { LBl%d(", id, id);
+        for (int r = 0; r < 3; ++r)
+            sb(b, "%s%.17g * x + %.17g * y + %.17g * z + %.17g", r ? ", " : "", M[3 * r],
+               M[3 * r + 1], M[3 * r + 2], t[r]);
+        sb(b, ") }\n");
+    }
+    if (c->ndone == c->cap) {
+        const size_t nc = c->cap ? 2 * c->cap : 64;
+        const lb__node **d = realloc(c->done, nc * sizeof *d);
+        int *q = realloc(c->ids, nc * sizeof *q);
+        if (d) c->done = d;
+        if (q) c->ids = q;
+        if (!d || !q) return lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        c->cap = nc;
+    }
+    c->done[c->ndone] = n;
+    c->ids[c->ndone++] = id;
+    *out = id;
+    return b->oom ? lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN) : LB_OK;
+}
+
+/* the largest |grad f| on a grid over the box */
+static lb_status max_gradient(const lb_evaluator *ev, const double lo[3], const double hi[3],
+                              int threads, double *g, lb_error *err) {
+    const size_t N = LB_POV_GRADIENT_SAMPLES, n = N * N * N;
+    double *mem = malloc(7 * n * sizeof *mem);
+    if (!mem) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    double *x = mem, *y = x + n, *z = y + n, *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
+    for (size_t i = 0; i < n; ++i) {
+        const size_t a = i % N, bq = i / N % N, cq = i / N / N;
+        x[i] = lo[0] + (hi[0] - lo[0]) * (double)a / (double)(N - 1);
+        y[i] = lo[1] + (hi[1] - lo[1]) * (double)bq / (double)(N - 1);
+        z[i] = lo[2] + (hi[2] - lo[2]) * (double)cq / (double)(N - 1);
+    }
+    lb_status s = lb_evaluator_eval(ev, n, x, y, z, v, gx, gy, gz, threads, err);
+    double m = 0.0;
+    for (size_t i = 0; i < n && !s; ++i) {
+        const double l = sqrt(gx[i] * gx[i] + gy[i] * gy[i] + gz[i] * gz[i]);
+        if (l > m) m = l;
+    }
+    free(mem);
+    *g = m * LB_POV_GRADIENT_SAFETY;
+    if (!(*g > 0.0)) *g = 1.0;
+    return s;
+}
+
+lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
+                             const lb_pov_options *opt, const char *path, double *out_gradient,
+                             lb_error *err) {
+    if (!scene || !ev || !path || !*path)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: scene, ev and path must be given", FN);
+    lb_pov_options o = {0, 0.0, 0.0, 0};
+    if (opt) o = *opt;
+    if (!scene->has_bounds)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: the scene has no bounds; allowed: a scene with \"bounds\" (the "
+                        "isosurface's contained_by box)",
+                        FN);
+    const double *lo = scene->bmin, *hi = scene->bmax;
+    double diag = 0.0, ctr[3];
+    for (int d = 0; d < 3; ++d) {
+        diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+        ctr[d] = 0.5 * (lo[d] + hi[d]);
+    }
+    diag = sqrt(diag);
+    sbuf b = {NULL, 0, 0, 0};
+    pctx c = {&b, scene, NULL, NULL, 0, 0, 0, 1e-5 * diag, err};
+    sb(&b, "// written by libblend %d.%d.%d (blendtool pov)\n", LB_VERSION_MAJOR, LB_VERSION_MINOR,
+       LB_VERSION_PATCH);
+    sb_comment(&b, "scene", scene->name);
+    sb(&b, "#version 3.7;\n#include \"libblend.inc\"\n\n");
+    int root = 0;
+    lb_status s = emit(&c, scene->root, &root);
+    double g = o.max_gradient;
+    if (!s) {
+        sb(&b, "#declare LB_Field = LBn%d;\n", root);
+        if (!(g > 0.0)) s = max_gradient(ev, lo, hi, o.threads, &g, err);
+    }
+    if (!s && !o.include_only) {
+        const lb_render *R = &scene->render;
+        const double aspect = o.aspect > 0.0 ? o.aspect : 4.0 / 3.0;
+        double loc[3], at[3], angle = R->has_camera ? R->angle : 40.0;
+        if (R->has_camera) {
+            memcpy(loc, R->location, sizeof loc);
+            memcpy(at, R->look_at, sizeof at);
+        } else {
+            /* frame the bounding sphere from the front, a little above and to the right */
+            const double dir[3] = {0.45, 0.5, -1.0}, dl = sqrt(0.45 * 0.45 + 0.25 + 1.0);
+            const double dist = 0.5 * diag / sin(0.5 * angle * M_PI / 180.0) * 1.05;
+            for (int d = 0; d < 3; ++d) {
+                at[d] = ctr[d];
+                loc[d] = ctr[d] + dir[d] / dl * dist;
+            }
+        }
+        sb(&b,
+           "\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb <1, 1, 1> }\n"
+           "camera { perspective location <%.17g, %.17g, %.17g> look_at <%.17g, %.17g, %.17g> "
+           "right x * %.17g up y angle %.17g }\n",
+           loc[0], loc[1], loc[2], at[0], at[1], at[2], aspect, angle);
+        if (R->light_count)
+            for (size_t i = 0; i < R->light_count; ++i)
+                sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb <%.17g, %.17g, %.17g> }\n",
+                   R->lights[i].location[0], R->lights[i].location[1], R->lights[i].location[2],
+                   R->lights[i].color[0], R->lights[i].color[1], R->lights[i].color[2]);
+        else
+            sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb 1 }\n", loc[0] + diag,
+               loc[1] + 2.0 * diag, loc[2]);
+        const int soft = scene->convention == LB_CONVENTION_SOFT;
+        sb(&b,
+           "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
+           "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
+           "  max_gradient %.17g\n  accuracy %.17g\n"
+           "  texture { pigment { rgb <%.17g, %.17g, %.17g> } finish { ambient %.17g diffuse "
+           "%.17g specular %.17g } }\n}\n",
+           soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
+           1e-4 * diag, R->color[0], R->color[1], R->color[2], R->ambient, R->diffuse, R->specular);
+    }
+    free(c.done);
+    free(c.ids);
+    if (!s && b.oom) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    if (s) {
+        free(b.s);
+        return s;
+    }
+    /* atomically: a temporary file in the same folder, renamed when complete */
+    const size_t pl = strlen(path);
+    char *tmp = malloc(pl + 16);
+    if (!tmp) {
+        free(b.s);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    }
+    snprintf(tmp, pl + 16, "%s.tmp.XXXXXX", path);
+    const int fd = mkstemp(tmp);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    int ok = f && fwrite(b.s, 1, b.n, f) == b.n;
+    if (f)
+        ok = (fclose(f) == 0) && ok;
+    else if (fd >= 0)
+        close(fd);
+    const int e = errno;
+    if (ok && rename(tmp, path) != 0) ok = 0;
+    if (!ok) {
+        if (fd >= 0) unlink(tmp);
+        s = lb__fail(err, LB_ERR_IO, "%s: %s: writing failed (%s); nothing was written", FN, path,
+                     strerror(errno ? errno : e));
+    }
+    free(tmp);
+    free(b.s);
+    if (!s && out_gradient) *out_gradient = g;
+    return s;
+}
