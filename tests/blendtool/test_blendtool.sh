@@ -24,7 +24,7 @@ out_has() { grep -qF -- "$1" "$T/out"; }
 run --help
 check "--help exits 0 and lists the commands" rc 0
 check "--help lists eval" out_has "eval"
-for c in validate info eval; do
+for c in validate info eval mesh pov render; do
   run "$c" --help
   check "$c --help exits 0" rc 0
   check "$c --help prints its usage" out_has "usage: blendtool $c"
@@ -126,6 +126,27 @@ check "eval of a bad scene exits 2 with the scene message" rc 2
 check "eval passes the scene message through" err_has "\$.root.radius"
 run eval "$T/sphere.json" --points
 check "an option without its value exits 2" rc 2
+
+# pov and render
+run pov "$SRC/scenes/bench-s2-64-spheres.json" -o "$T/s2.pov"
+check "a 64-argument blend is refused for POV-Ray with exit 2" rc 2
+check "the refusal names the node and the limit" err_has "\$.root: a displacement blend of 64 arguments; allowed in POV-Ray: at most 16"
+check "no .pov written for a refused scene" test ! -e "$T/s2.pov"
+run pov "$T/bad.json" -o "$T/bad.pov"
+check "pov of a bad scene exits 2 with the scene message" rc 2
+check "no .pov for a bad scene" test ! -e "$T/bad.pov"
+run pov "$SRC/scenes/bench-s1-three-spheres.json" -o "$T/s1.pov"
+check "pov exits 0" rc 0
+check "the .pov has the isosurface and max_gradient" grep -q "max_gradient" "$T/s1.pov"
+run render "$SRC/scenes/bench-s1-three-spheres.json" -o "$T/s1.jpg"
+check "render wants a .png" rc 2
+run render "$SRC/scenes/bench-s1-three-spheres.json" -o "$T/s1.png" --width 64 --height 48 --threads 1
+check "render exits 0" rc 0
+check "render writes a PNG" bash -c "head -c 8 '$T/s1.png' | od -An -c | grep -q 'P   N   G'"
+check "POV-Ray finds no gradient above max_gradient" bash -c "! grep -q 'may contain holes' '$T/err'"
+LIBBLEND_POVRAY_INCLUDE=/nonexistent run render "$SRC/scenes/bench-s1-three-spheres.json" -o "$T/s1b.png" --width 32 --height 24
+check "render with a missing include exits 1" rc 1
+check "no PNG when povray fails" test ! -e "$T/s1b.png"
 
 echo "$fails failure(s)"
 [ "$fails" -eq 0 ]
