@@ -11,6 +11,7 @@ PACKAGES=(
   python3-jsonschema         # tests: scene files against docs/libblend-scene.schema.json
   python3-numpy              # tests: independent mesh readers and checks (tests/mesh/)
   povray                     # tests: the generated POV-Ray include, run by POV-Ray itself
+  openimageio-tools          # tests: idiff compares POV-Ray renders with libblend silhouettes
 )
 
 # `install-deps.sh bench`: also what the benchmarks compare against

@@ -35,7 +35,7 @@ static int parse_int(const char *cmd, const char *opt, const char *v, long lo, l
 
 typedef struct povargs {
     const char *scene, *out;
-    int include_only, width, height, threads, quality;
+    int include_only, width, height, threads, quality, silhouette;
 } povargs;
 
 static int parse(const char *cmd, int argc, char **argv, povargs *a, int render) {
@@ -56,6 +56,8 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
             if (r < 0 || parse_int(cmd, "--quality", v, 0, 11, &a->quality)) return -1;
         } else if (!render && strcmp(argv[i], "--include-only") == 0) {
             a->include_only = 1;
+        } else if (strcmp(argv[i], "--silhouette") == 0) {
+            a->silhouette = 1;
         } else if (argv[i][0] == '-' && argv[i][1]) {
             bt_error(cmd, "unknown option %s; see blendtool %s --help", argv[i], cmd);
             return -1;
@@ -83,7 +85,8 @@ static int export(const char *cmd, const povargs *a, const char *path) {
     lb_evaluator *ev = NULL;
     lb_status s = lb_evaluator_create(sc, &ev, &e);
     if (!s) {
-        lb_pov_options o = {a->include_only, (double)a->width / (double)a->height, 0.0, a->threads};
+        lb_pov_options o = {a->include_only, a->silhouette, (double)a->width / (double)a->height,
+                            0.0, a->threads};
         s = lb_scene_write_pov(sc, ev, &o, path, NULL, &e);
     }
     if (s) {
@@ -96,13 +99,13 @@ static int export(const char *cmd, const povargs *a, const char *path) {
 }
 
 static int run_pov(int argc, char **argv) {
-    povargs a = {NULL, NULL, 0, 640, 480, 0, 9};
+    povargs a = {NULL, NULL, 0, 640, 480, 0, 9, 0};
     if (parse("pov", argc, argv, &a, 0)) return BT_EXIT_BAD_INPUT;
     return export("pov", &a, a.out);
 }
 
 static int run_render(int argc, char **argv) {
-    povargs a = {NULL, NULL, 0, 640, 480, 0, 9};
+    povargs a = {NULL, NULL, 0, 640, 480, 0, 9, 0};
     if (parse("render", argc, argv, &a, 1)) return BT_EXIT_BAD_INPUT;
     const size_t ol = strlen(a.out);
     if (ol < 5 || strcmp(a.out + ol - 4, ".png") != 0) {
@@ -174,13 +177,15 @@ static int run_render(int argc, char **argv) {
 
 const bt_command bt_cmd_pov = {
     "pov", "the scene as a POV-Ray 3.7 file (isosurface with a computed max_gradient)",
-    "usage: blendtool pov SCENE -o OUT.pov [--include-only] [--width W --height H]\n\n"
+    "usage: blendtool pov SCENE -o OUT.pov [--include-only] [--silhouette] [--width W --height "
+    "H]\n\n"
     "Writes a complete POV-Ray 3.7 scene: the field as functions built with\n"
     "libblend.inc, one isosurface over the scene's bounds with a max_gradient\n"
     "computed by libblend, camera, lights and material from the scene's render\n"
     "section (or framing the bounds). Render it with\n"
     "  povray +IOUT.pov +L" LIBBLEND_POVRAY_DIR "\n"
     "  --include-only  only the function declarations (the field is LB_Field)\n"
+    "  --silhouette    a white object on black, unshaded (for comparisons)\n"
     "  --width, --height  the image's aspect ratio for the camera (640 x 480)\n"
     "Exit status: 0 success, 2 bad scene (or one POV-Ray cannot express), 1 internal\n"
     "failure.\n",
@@ -189,12 +194,13 @@ const bt_command bt_cmd_pov = {
 const bt_command bt_cmd_render = {
     "render", "render the scene with POV-Ray into a PNG",
     "usage: blendtool render SCENE -o OUT.png [--width W] [--height H] [--threads N]\n"
-    "                        [--quality Q]\n\n"
+    "                        [--quality Q] [--silhouette]\n\n"
     "Exports the scene (as blendtool pov) and runs povray on it; povray's progress\n"
     "streams to standard error. OUT.png appears only when the render succeeded.\n"
     "libblend.inc is taken from $LIBBLEND_POVRAY_INCLUDE or " LIBBLEND_POVRAY_DIR ".\n"
     "  --width, --height  image size (640 x 480)\n"
     "  --threads N        render threads (0 = one per CPU)\n"
     "  --quality Q        POV-Ray quality 0..11 (9)\n"
+    "  --silhouette       a white object on black, unshaded\n"
     "Exit status: 0 success, 2 bad scene or options, 1 povray failed.\n",
     run_render};

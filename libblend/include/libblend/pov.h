@@ -28,10 +28,17 @@ extern "C" {
 
 typedef struct lb_pov_options {
     int include_only;    /* 1: only the #declare'd functions (the root is LB_Field) */
+    int silhouette;      /* 1: white object, black background, no shading (for comparisons) */
     double aspect;       /* image width / height for the camera (0: 4/3) */
     double max_gradient; /* > 0: use this instead of computing it */
     int threads;         /* for the gradient sampling: 0 = all CPUs, 1 = caller only */
 } lb_pov_options;
+
+/* The camera the exporter uses: the scene's render section, or one framing
+ * the bounds. POV-Ray's conventions: left-handed, sky +y, angle the
+ * horizontal field of view in degrees, image aspect `aspect` (0: 4/3). */
+LB_API void lb_pov_camera(const lb_scene *scene, double aspect, double location[3],
+                          double look_at[3], double *angle);
 
 /* Write the scene to path (atomically). ev must be compiled from scene. The
  * file includes "libblend.inc": render with povray +L<dir of libblend.inc>.

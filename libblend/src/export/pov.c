@@ -259,6 +259,31 @@ static lb_status emit(pctx *c, const lb__node *n, int *out) {
     return b->oom ? lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN) : LB_OK;
 }
 
+void lb_pov_camera(const lb_scene *scene, double aspect, double loc[3], double at[3],
+                   double *angle) {
+    (void)aspect;
+    const lb_render *R = &scene->render;
+    *angle = R->has_camera ? R->angle : 40.0;
+    if (R->has_camera) {
+        memcpy(loc, R->location, 3 * sizeof *loc);
+        memcpy(at, R->look_at, 3 * sizeof *at);
+        return;
+    }
+    /* frame the bounding sphere from the front, a little above and to the right */
+    double diag = 0.0, ctr[3];
+    for (int d = 0; d < 3; ++d) {
+        diag += (scene->bmax[d] - scene->bmin[d]) * (scene->bmax[d] - scene->bmin[d]);
+        ctr[d] = 0.5 * (scene->bmin[d] + scene->bmax[d]);
+    }
+    diag = sqrt(diag);
+    const double dir[3] = {0.45, 0.5, -1.0}, dl = sqrt(0.45 * 0.45 + 0.25 + 1.0);
+    const double dist = 0.5 * diag / sin(0.5 * *angle * M_PI / 180.0) * 1.05;
+    for (int d = 0; d < 3; ++d) {
+        at[d] = ctr[d];
+        loc[d] = ctr[d] + dir[d] / dl * dist;
+    }
+}
+
 /* the largest |grad f| on a grid over the box */
 static lb_status max_gradient(const lb_evaluator *ev, const double lo[3], const double hi[3],
                               int threads, double *g, lb_error *err) {
@@ -289,7 +314,7 @@ lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
                              lb_error *err) {
     if (!scene || !ev || !path || !*path)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: scene, ev and path must be given", FN);
-    lb_pov_options o = {0, 0.0, 0.0, 0};
+    lb_pov_options o = {0, 0, 0.0, 0.0, 0};
     if (opt) o = *opt;
     if (!scene->has_bounds)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
@@ -297,11 +322,8 @@ lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
                         "isosurface's contained_by box)",
                         FN);
     const double *lo = scene->bmin, *hi = scene->bmax;
-    double diag = 0.0, ctr[3];
-    for (int d = 0; d < 3; ++d) {
-        diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
-        ctr[d] = 0.5 * (lo[d] + hi[d]);
-    }
+    double diag = 0.0;
+    for (int d = 0; d < 3; ++d) diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
     diag = sqrt(diag);
     sbuf b = {NULL, 0, 0, 0};
     pctx c = {&b, scene, NULL, NULL, 0, 0, 0, 1e-5 * diag, err};
@@ -319,25 +341,17 @@ lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
     if (!s && !o.include_only) {
         const lb_render *R = &scene->render;
         const double aspect = o.aspect > 0.0 ? o.aspect : 4.0 / 3.0;
-        double loc[3], at[3], angle = R->has_camera ? R->angle : 40.0;
-        if (R->has_camera) {
-            memcpy(loc, R->location, sizeof loc);
-            memcpy(at, R->look_at, sizeof at);
-        } else {
-            /* frame the bounding sphere from the front, a little above and to the right */
-            const double dir[3] = {0.45, 0.5, -1.0}, dl = sqrt(0.45 * 0.45 + 0.25 + 1.0);
-            const double dist = 0.5 * diag / sin(0.5 * angle * M_PI / 180.0) * 1.05;
-            for (int d = 0; d < 3; ++d) {
-                at[d] = ctr[d];
-                loc[d] = ctr[d] + dir[d] / dl * dist;
-            }
-        }
+        double loc[3], at[3], angle;
+        lb_pov_camera(scene, aspect, loc, at, &angle);
         sb(&b,
-           "\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb <1, 1, 1> }\n"
+           "\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb <%d, %d, %d> }\n"
            "camera { perspective location <%.17g, %.17g, %.17g> look_at <%.17g, %.17g, %.17g> "
            "right x * %.17g up y angle %.17g }\n",
-           loc[0], loc[1], loc[2], at[0], at[1], at[2], aspect, angle);
-        if (R->light_count)
+           !o.silhouette, !o.silhouette, !o.silhouette, loc[0], loc[1], loc[2], at[0], at[1], at[2],
+           aspect, angle);
+        if (o.silhouette) {
+            /* no lights: the object is its ambient white */
+        } else if (R->light_count)
             for (size_t i = 0; i < R->light_count; ++i)
                 sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb <%.17g, %.17g, %.17g> }\n",
                    R->lights[i].location[0], R->lights[i].location[1], R->lights[i].location[2],
@@ -353,7 +367,9 @@ lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
            "  texture { pigment { rgb <%.17g, %.17g, %.17g> } finish { ambient %.17g diffuse "
            "%.17g specular %.17g } }\n}\n",
            soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
-           1e-4 * diag, R->color[0], R->color[1], R->color[2], R->ambient, R->diffuse, R->specular);
+           1e-4 * diag, o.silhouette ? 1.0 : R->color[0], o.silhouette ? 1.0 : R->color[1],
+           o.silhouette ? 1.0 : R->color[2], o.silhouette ? 1.0 : R->ambient,
+           o.silhouette ? 0.0 : R->diffuse, o.silhouette ? 0.0 : R->specular);
     }
     free(c.done);
     free(c.ids);
