@@ -356,7 +356,9 @@ static void w(const char *fmt, ...) {
 
 /* the parameter list "d0, d1, ..., d15" */
 static void dlist(void) {
-    for (int i = 0; i < KMAX; ++i) w("%slbd%d", i ? ", " : "", i);
+    /* only the K in use: the macro knows K when POV-Ray parses the body */
+    w("lbd0");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), lbd%d #end", i, i);
 }
 
 static void header(void) {
@@ -1105,41 +1107,53 @@ static void displacement(int steps) {
     /* the Newton step T / T' */
     w("  #local lbS = function(lbh, ");
     dlist();
+    /* only the K terms in use are compiled (#if at parse time), and p = 2
+     * is written as products: the step is T / T' */
     w(") {\n    (-1");
     for (int i = 0; i < KMAX; ++i)
-        w(" + pow(max(0, (lbR[%d] - lbd%d + lbM[%d] * lbh) / lbR[%d]), lbP[%d])", i, i, i, i, i);
+        w("\n    #if (K > %d) #if (lbP[%d] = 2) + max(0, (lbR[%d] - lbd%d + lbM[%d] * lbh) / "
+          "lbR[%d]) "
+          "* max(0, (lbR[%d] - lbd%d + lbM[%d] * lbh) / lbR[%d]) #else + pow(max(0, (lbR[%d] - "
+          "lbd%d + lbM[%d] * lbh) / lbR[%d]), lbP[%d]) #end #end",
+          i, i, i, i, i, i, i, i, i, i, i, i, i, i, i);
     w(")\n    / (0");
     for (int i = 0; i < KMAX; ++i)
-        w(" + (lbP[%d] * lbM[%d] / lbR[%d]) * ((lbR[%d] - lbd%d + lbM[%d] * lbh) / lbR[%d] > 0) * "
-          "pow(max(0, (lbR[%d] - lbd%d + lbM[%d] * lbh) / lbR[%d]), lbP[%d] - 1)",
-          i, i, i, i, i, i, i, i, i, i, i, i);
+        w("\n    #if (K > %d) #if (lbP[%d] = 2) + (2 * lbM[%d] / lbR[%d]) * max(0, (lbR[%d] - "
+          "lbd%d "
+          "+ lbM[%d] * lbh) / lbR[%d]) #else + (lbP[%d] * lbM[%d] / lbR[%d]) * ((lbR[%d] - lbd%d + "
+          "lbM[%d] * lbh) / lbR[%d] > 0) * pow(max(0, (lbR[%d] - lbd%d + lbM[%d] * lbh) / "
+          "lbR[%d]), lbP[%d] - 1) #end #end",
+          i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i);
     w(") }\n");
-    /* N_steps = h; then E_n / N_n backwards */
-    w("  #local lbN%d = function(lbh, lbl, ", steps);
+    /* E_n(h, step at h): leave, or take the step and continue with the step
+     * at the new point (two calls per Newton step); E_steps returns h */
+    w("  #local lbE%d = function(lbh, lbs, lbl, ", steps);
     dlist();
     w(") { lbh }\n");
     for (int n = steps - 1; n >= 0; --n) {
         w("  #local lbE%d = function(lbh, lbs, lbl, ", n);
         dlist();
         w(") { select(abs(lbs) - %.17g * (1 + abs(lbh)), lbh - lbs, lbh - lbs, "
-          "lbN%d(max(lbl, lbh - lbs), lbl, ",
+          "lbE%d(max(lbl, lbh - lbs), lbS(max(lbl, lbh - lbs), ",
           TOL, n + 1);
-        dlist();
-        w(")) }\n");
-        w("  #local lbN%d = function(lbh, lbl, ", n);
-        dlist();
-        w(") { lbE%d(lbh, lbS(lbh, ", n);
         dlist();
         w("), lbl, ");
         dlist();
-        w(") }\n");
+        w(")) }\n");
     }
+    w("  #local lbB2 = function(lbh, lbl, ");
+    dlist();
+    w(") { lbE0(lbh, lbS(lbh, ");
+    dlist();
+    w("), lbl, ");
+    dlist();
+    w(") }\n");
     w("  #local lbB = function(");
     dlist();
-    w(") { lbN0(min(");
-    for (int i = 0; i < KMAX; ++i) w("%slbd%d / lbM[%d]", i ? ", " : "", i, i);
-    w("), min(");
-    for (int i = 0; i < KMAX; ++i) w("%s(lbd%d - lbR[%d]) / lbM[%d]", i ? ", " : "", i, i, i);
+    w(") { lbB2(min(lbd0 / lbM[0], 1e300");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), lbd%d / lbM[%d] #end", i, i, i);
+    w("), min((lbd0 - lbR[0]) / lbM[0], 1e300");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), (lbd%d - lbR[%d]) / lbM[%d] #end", i, i, i, i);
     w("), ");
     dlist();
     w(") }\n");
@@ -1151,7 +1165,7 @@ static void displacement(int steps) {
         if (i == 0)
             w("lbSG * F[0](x, y, z)");
         else
-            w(", #if (K > %d) lbSO * F[%d](x, y, z) #else 1e30 #end", i, i);
+            w(" #if (K > %d), lbSO * F[%d](x, y, z) #end", i, i);
     }
     w(") }\n#end\n\n");
 }
