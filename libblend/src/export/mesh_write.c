@@ -4,18 +4,16 @@
  * never leaves a partial file. Binary formats are little-endian by spec and
  * are written byte by byte here, whatever the host. */
 #define _POSIX_C_SOURCE 200809L
-#include "../common/internal.h"
+#include "atomic.h"
 
 #include <libblend/mesh.h>
 
 #include <cjson/cJSON.h>
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <unistd.h>
 
 static const char FN[] = "lb_mesh_write";
 
@@ -232,48 +230,23 @@ lb_status lb_mesh_write(const lb_mesh *mesh, const char *path, lb_mesh_format fo
                         "%s: %s: unknown mesh format; allowed: a name ending in .ply, .obj, "
                         ".stl or .glb",
                         FN, path);
-    const size_t plen = strlen(path);
-    char *tmp = malloc(plen + 16);
-    if (!tmp) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    snprintf(tmp, plen + 16, "%s.tmp.XXXXXX", path);
-    const int fd = mkstemp(tmp);
-    if (fd < 0) {
-        const int e = errno;
-        free(tmp);
-        return lb__fail(err, LB_ERR_IO, "%s: %s: cannot create a file there (%s)", FN, path,
-                        strerror(e));
+    lb__atomic a;
+    FILE *f = lb__atomic_open(FN, path, &a, err);
+    if (!f) return err ? err->status : LB_ERR_IO;
+    int ok;
+    switch (format) {
+    case LB_MESH_FORMAT_PLY:
+        ok = write_ply(f, mesh);
+        break;
+    case LB_MESH_FORMAT_OBJ:
+        ok = write_obj(f, mesh);
+        break;
+    case LB_MESH_FORMAT_STL:
+        ok = write_stl(f, mesh);
+        break;
+    default:
+        ok = write_glb(f, mesh);
+        break;
     }
-    FILE *f = fdopen(fd, "wb");
-    int ok = f != NULL;
-    if (ok) {
-        switch (format) {
-        case LB_MESH_FORMAT_PLY:
-            ok = write_ply(f, mesh);
-            break;
-        case LB_MESH_FORMAT_OBJ:
-            ok = write_obj(f, mesh);
-            break;
-        case LB_MESH_FORMAT_STL:
-            ok = write_stl(f, mesh);
-            break;
-        default:
-            ok = write_glb(f, mesh);
-            break;
-        }
-        ok = ok && fflush(f) == 0 && !ferror(f);
-        ok = (fclose(f) == 0) && ok;
-    } else {
-        close(fd);
-    }
-    const int e = errno;
-    if (ok && rename(tmp, path) != 0) ok = 0;
-    if (!ok) {
-        const int e2 = errno ? errno : e;
-        unlink(tmp);
-        free(tmp);
-        return lb__fail(err, LB_ERR_IO, "%s: %s: writing failed (%s); nothing was written", FN,
-                        path, strerror(e2));
-    }
-    free(tmp);
-    return LB_OK;
+    return lb__atomic_close(FN, path, f, ok, &a, err);
 }

@@ -3,16 +3,15 @@
  * lights and material. */
 #define _POSIX_C_SOURCE 200809L
 #include "../scene/scene_internal.h"
+#include "atomic.h"
 
 #include <libblend/pov.h>
 
-#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -378,29 +377,12 @@ lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
         free(b.s);
         return s;
     }
-    /* atomically: a temporary file in the same folder, renamed when complete */
-    const size_t pl = strlen(path);
-    char *tmp = malloc(pl + 16);
-    if (!tmp) {
-        free(b.s);
-        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    }
-    snprintf(tmp, pl + 16, "%s.tmp.XXXXXX", path);
-    const int fd = mkstemp(tmp);
-    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-    int ok = f && fwrite(b.s, 1, b.n, f) == b.n;
-    if (f)
-        ok = (fclose(f) == 0) && ok;
-    else if (fd >= 0)
-        close(fd);
-    const int e = errno;
-    if (ok && rename(tmp, path) != 0) ok = 0;
-    if (!ok) {
-        if (fd >= 0) unlink(tmp);
-        s = lb__fail(err, LB_ERR_IO, "%s: %s: writing failed (%s); nothing was written", FN, path,
-                     strerror(errno ? errno : e));
-    }
-    free(tmp);
+    lb__atomic a;
+    FILE *f = lb__atomic_open(FN, path, &a, err);
+    if (!f)
+        s = err ? err->status : LB_ERR_IO;
+    else
+        s = lb__atomic_close(FN, path, f, fwrite(b.s, 1, b.n, f) == b.n, &a, err);
     free(b.s);
     if (!s && out_gradient) *out_gradient = g;
     return s;

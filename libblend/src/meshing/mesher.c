@@ -101,6 +101,25 @@ static lb_status make_grid(const lb_evaluator *ev, const lb_mesh_options *o, lb_
     return LB_OK;
 }
 
+/* phi_c's interval on the box [bl, bh] from the field's interval [flo, fhi]:
+ * phi = f or 0.5 - f, and for a closed mesh the max with the region box's
+ * terms bmin - X and X - bmax (each linear, so exact on the box). */
+static void phi_interval(const lb__grid *g, const double bl[3], const double bh[3], double flo,
+                         double fhi, double *lo, double *hi) {
+    double plo = g->soft ? 0.5 - fhi : flo, phi = g->soft ? 0.5 - flo : fhi;
+    if (g->closed)
+        for (int d = 0; d < 3; ++d) {
+            const double l1 = g->bmin[d] - bh[d], h1 = g->bmin[d] - bl[d];
+            const double l2 = bl[d] - g->bmax[d], h2 = bh[d] - g->bmax[d];
+            if (l1 > plo) plo = l1;
+            if (l2 > plo) plo = l2;
+            if (h1 > phi) phi = h1;
+            if (h2 > phi) phi = h2;
+        }
+    *lo = plo;
+    *hi = phi;
+}
+
 /* An interval of phi_c over the nodes [n0, n1] (inclusive) of the grid. */
 static lb_status box_phi(const lb_evaluator *ev, const lb__grid *g, const uint64_t n0[3],
                          const uint64_t n1[3], double *lo, double *hi, lb_error *err) {
@@ -110,20 +129,7 @@ static lb_status box_phi(const lb_evaluator *ev, const lb__grid *g, const uint64
     double flo, fhi;
     lb_status s = lb_evaluator_bounds(ev, bl, bh, &flo, &fhi, err);
     if (s) return s;
-    double plo = g->soft ? 0.5 - fhi : flo, phi = g->soft ? 0.5 - flo : fhi;
-    if (g->closed) {
-        for (int d = 0; d < 3; ++d) {
-            /* max of the box terms g->bmin - X and X - g->bmax, each linear */
-            const double l1 = g->bmin[d] - bh[d], h1 = g->bmin[d] - bl[d];
-            const double l2 = bl[d] - g->bmax[d], h2 = bh[d] - g->bmax[d];
-            if (l1 > plo) plo = l1;
-            if (l2 > plo) plo = l2;
-            if (h1 > phi) phi = h1;
-            if (h2 > phi) phi = h2;
-        }
-    }
-    *lo = plo;
-    *hi = phi;
+    phi_interval(g, bl, bh, flo, fhi, lo, hi);
     return LB_OK;
 }
 
@@ -227,19 +233,7 @@ static void sub_phi(const lb_evaluator *ev, const lb__grid *g, const lb__plan *p
     lb__node_pos(g, n1[0], n1[1], n1[2], bh);
     lb__box_centre(bl, bh, bc, br);
     lb__bounds_pass_sub(ev, plan, bc, br, R);
-    const lb__iv f = R[ev->out];
-    double plo = g->soft ? 0.5 - f.hi : f.lo, phi = g->soft ? 0.5 - f.lo : f.hi;
-    if (g->closed)
-        for (int d = 0; d < 3; ++d) {
-            const double l1 = g->bmin[d] - bh[d], h1 = g->bmin[d] - bl[d];
-            const double l2 = bl[d] - g->bmax[d], h2 = bh[d] - g->bmax[d];
-            if (l1 > plo) plo = l1;
-            if (l2 > plo) plo = l2;
-            if (h1 > phi) phi = h1;
-            if (h2 > phi) phi = h2;
-        }
-    *lo = plo;
-    *hi = phi;
+    phi_interval(g, bl, bh, R[ev->out].lo, R[ev->out].hi, lo, hi);
 }
 
 /* Inside a kept block, the sub-boxes of at most 2^3 cells whose interval
