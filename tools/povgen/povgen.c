@@ -22,7 +22,7 @@
 #include <string.h>
 
 #define KMAX 16    /* arguments of a k-ary macro */
-#define TOL 1e-10 /* early exit: the Newton step below TOL (1 + abs(h)); the exit takes it */
+#define TOL 1e-10  /* early exit: the Newton step below TOL (1 + abs(h)); the exit takes it */
 #define P_MIN 1.05 /* documented ranges of the root-solved macros */
 #define P_MAX 16.0
 #define M_MIN 0.05
