@@ -42,6 +42,25 @@ static double unit(rng *r) {
 static double logu(rng *r, double a, double b) {
     return exp(log(a) + (log(b) - log(a)) * unit(r));
 }
+/* p in [P_MIN, P_MAX]: 2 (the closed form), an integer, or general */
+static double rand_p(rng *g) {
+    const double u = unit(g);
+    const double p = u < 0.3   ? 2.0
+                     : u < 0.6 ? (double)(1 + (int)(unit(g) * P_MAX))
+                               : logu(g, P_MIN, P_MAX);
+    return p < P_MIN ? 2.0 : p;
+}
+
+/* A solver's verdict over its random cases: the steps it needs, or exit. */
+static int steps_needed(const char *what, int worst, double maxerr) {
+    if (worst > 400 || maxerr > 1e-10) {
+        fprintf(stderr, "povgen: the %s SDL recurrence misses the C library (%d steps, error %g)\n",
+                what, worst, maxerr);
+        exit(1);
+    }
+    fprintf(stderr, "povgen: %s: %d steps cover every case (error <= %.2g)\n", what, worst, maxerr);
+    return worst + 2;
+}
 
 /* The recurrence of LB_Displacement's SDL, step for step (same formulas,
  * same order of operations as the emitted text). Returns the value and the
@@ -69,6 +88,22 @@ static double step_sim(int k, const double *d, const double *r, const double *p,
     return h;
 }
 
+/* One case: the SDL recurrence against lb_displacement. */
+static void displacement_case(int k, const double *d, const double *r, const double *p,
+                              const double *m, int *worst, double *maxerr) {
+    int used = 0;
+    const double v = step_sim(k, d, r, p, m, 400, &used);
+    double ref;
+    lb_error e;
+    if (lb_displacement(LB_UNION, (size_t)k, d, r, p, m, &ref, NULL, &e)) {
+        fprintf(stderr, "povgen: %s\n", e.message);
+        exit(1);
+    }
+    const double err = fabs(v - ref) / (1.0 + fabs(ref));
+    if (used > *worst) *worst = used;
+    if (err > *maxerr) *maxerr = err;
+}
+
 static int choose_steps(void) {
     rng g = {20261122};
     int worst = 0;
@@ -80,24 +115,10 @@ static int choose_steps(void) {
         for (int i = 0; i < k; ++i) {
             r[i] = scale * logu(&g, 0.05, 1.0);
             d[i] = scale * (2.0 * unit(&g) - 1.0);
-            const double u = unit(&g);
-            p[i] = u < 0.3   ? 2.0
-                   : u < 0.6 ? (double)(1 + (int)(unit(&g) * P_MAX))
-                             : logu(&g, P_MIN, P_MAX);
-            if (p[i] < P_MIN) p[i] = 2.0;
+            p[i] = rand_p(&g);
             m[i] = logu(&g, M_MIN, M_MAX);
         }
-        int used = 0;
-        const double v = step_sim(k, d, r, p, m, 400, &used);
-        double ref;
-        lb_error e;
-        if (lb_displacement(LB_UNION, (size_t)k, d, r, p, m, &ref, NULL, &e)) {
-            fprintf(stderr, "povgen: %s\n", e.message);
-            exit(1);
-        }
-        const double err = fabs(v - ref) / (1.0 + fabs(ref));
-        if (used > worst) worst = used;
-        if (err > maxerr) maxerr = err;
+        displacement_case(k, d, r, p, m, &worst, &maxerr);
     }
     /* the scale method's use: d = -1 (B_A, m = y/min y >= 1) or d = 1 (B_S, m = y/max y
      * in (1 - r, 1]) */
@@ -112,32 +133,11 @@ static int choose_steps(void) {
                    : bs   ? 1.0 - r[i] * unit(&g)
                           : 1.0 + logu(&g, 1e-6, 1.0) * (1.0 + r[i]);
             if (!(m[i] > 0.0)) m[i] = 1e-3;
-            const double u = unit(&g);
-            p[i] = u < 0.3   ? 2.0
-                   : u < 0.6 ? (double)(1 + (int)(unit(&g) * P_MAX))
-                             : logu(&g, P_MIN, P_MAX);
-            if (p[i] < P_MIN) p[i] = 2.0;
+            p[i] = rand_p(&g);
         }
-        int used = 0;
-        const double v = step_sim(k, d, r, p, m, 400, &used);
-        double ref;
-        lb_error e;
-        if (lb_displacement(LB_UNION, (size_t)k, d, r, p, m, &ref, NULL, &e)) {
-            fprintf(stderr, "povgen: %s\n", e.message);
-            exit(1);
-        }
-        const double err = fabs(v - ref) / (1.0 + fabs(ref));
-        if (used > worst) worst = used;
-        if (err > maxerr) maxerr = err;
+        displacement_case(k, d, r, p, m, &worst, &maxerr);
     }
-    if (worst > 400 || maxerr > 1e-10) {
-        fprintf(stderr, "povgen: the SDL recurrence misses the C library (%d steps, error %g)\n",
-                worst, maxerr);
-        exit(1);
-    }
-    fprintf(stderr, "povgen: displacement: %d Newton steps cover every case (error <= %.2g)\n",
-            worst, maxerr);
-    return worst + 2;
+    return steps_needed("displacement", worst, maxerr);
 }
 
 /* ---- soft non-uniform blends: bracketed Newton in lambda = ln h ---- */
@@ -161,14 +161,17 @@ static void soft_TD(int u, int k, const double *a, const double *r, const double
     *D = d;
 }
 
-/* the SDL recurrence: start at the non-blending end, Newton inside the
- * bracket, bisection otherwise; exit when |T/D| < LTOL */
-static double soft_sim(int u, int k, const double *a, const double *r, const double *p,
-                       const double *m, double lo, double hi, double lam, int steps, int *used) {
+/* The SDL's bracketed Newton in lambda, shared by the soft solvers: start
+ * at `lam`, Newton inside [lo, hi], bisection otherwise; exit when
+ * |T/D| < LTOL. *used becomes the most steps any call evaluated. */
+typedef void (*td_fn)(const void *ctx, double lam, double *T, double *D);
+
+static double bnewton_sim(td_fn td, const void *ctx, double lo, double hi, double lam, int steps,
+                          int *used) {
     for (int n = 0; n < steps; ++n) {
         double T, D;
-        soft_TD(u, k, a, r, p, m, lam, &T, &D);
-        *used = n + 1;
+        td(ctx, lam, &T, &D);
+        if (n + 1 > *used) *used = n + 1;
         const double st = T / D;
         if (fabs(st) - LTOL <= 0.0) return fmin(hi, fmax(lo, lam - st));
         if (T > 0.0)
@@ -180,6 +183,16 @@ static double soft_sim(int u, int k, const double *a, const double *r, const dou
     }
     *used = steps + 1;
     return lam;
+}
+
+typedef struct sh {
+    int u, k;
+    const double *a, *r, *p, *m;
+} sh;
+
+static void sh_TD(const void *c, double lam, double *T, double *D) {
+    const sh *q = c;
+    soft_TD(q->u, q->k, q->a, q->r, q->p, q->m, lam, T, D);
 }
 
 static int choose_soft_steps(void) {
@@ -194,11 +207,7 @@ static int choose_soft_steps(void) {
             x[i] = unit(&g) < 0.1 ? 1e-9 * unit(&g) : unit(&g);
             r[i] = u ? logu(&g, 0.02, 1.0) : logu(&g, 0.02, 3.0);
             if (u && unit(&g) < 0.1) r[i] = 1.0;
-            const double q = unit(&g);
-            p[i] = q < 0.3   ? 2.0
-                   : q < 0.6 ? (double)(1 + (int)(unit(&g) * P_MAX))
-                             : logu(&g, P_MIN, P_MAX);
-            if (p[i] < P_MIN) p[i] = 2.0;
+            p[i] = rand_p(&g);
             m[i] = logu(&g, 0.05, 20.0);
         }
         double ref;
@@ -222,22 +231,15 @@ static int choose_soft_steps(void) {
             other = u ? fmax(other, l) : fmin(other, l);
         }
         int used = 0;
-        const double lam = u ? soft_sim(u, k, a, r, p, m, nb, other, nb, 400, &used)
-                             : soft_sim(u, k, a, r, p, m, other, nb, nb, 400, &used);
+        const sh q = {u, k, a, r, p, m};
+        const double lam = u ? bnewton_sim(sh_TD, &q, nb, other, nb, 400, &used)
+                             : bnewton_sim(sh_TD, &q, other, nb, nb, 400, &used);
         const double v = exp(lam);
         const double err = fabs(v - ref) / fmax(1.0, fabs(ref));
         if (used > worst) worst = used;
         if (err > maxerr) maxerr = err;
     }
-    if (worst > 400 || maxerr > 1e-10) {
-        fprintf(stderr,
-                "povgen: the soft SDL recurrence misses the C library (%d steps, error %g)\n",
-                worst, maxerr);
-        exit(1);
-    }
-    fprintf(stderr, "povgen: soft blends: %d steps cover every case (error <= %.2g)\n", worst,
-            maxerr);
-    return worst + 2;
+    return steps_needed("soft blends", worst, maxerr);
 }
 
 /* The soft conic's two solves (chord, then H) in lambda, as the SDL does them. */
@@ -246,7 +248,8 @@ typedef struct sc {
     int u, chord;
 } sc;
 
-static void sc_TD(const sc *c, double lam, double *T, double *D) {
+static void sc_TD(const void *vc, double lam, double *T, double *D) {
+    const sc *c = vc;
     double uu[2], du[2];
     for (int i = 0; i < 2; ++i) {
         const double z = exp(c->a[i] - c->m[i] * lam);
@@ -267,24 +270,6 @@ static void sc_TD(const sc *c, double lam, double *T, double *D) {
     const double H2 = 2.0 * (r1 * r1 * (uu[1] - r2) + c->p * uu[0]);
     *T = -sg * n * H;
     *D = -sg * n * (H1 * du[0] + H2 * du[1]);
-}
-
-static double sc_sim(const sc *c, double lo, double hi, double lam, int steps, int *used) {
-    for (int n = 0; n < steps; ++n) {
-        double T, D;
-        sc_TD(c, lam, &T, &D);
-        if (n + 1 > *used) *used = n + 1;
-        const double st = T / D;
-        if (fabs(st) - LTOL <= 0.0) return fmin(hi, fmax(lo, lam - st));
-        if (T > 0.0)
-            hi = lam;
-        else
-            lo = lam;
-        const double nx = lam - st;
-        lam = nx > lo && nx < hi ? nx : 0.5 * (lo + hi);
-    }
-    *used = steps + 1;
-    return lam;
 }
 
 static int choose_sconic_steps(void) {
@@ -323,25 +308,18 @@ static int choose_sconic_steps(void) {
                 far = C.u ? fmax(far, l) : fmin(far, l);
             }
             C.chord = 1;
-            const double lc =
-                C.u ? sc_sim(&C, nb, far, nb, 400, &used) : sc_sim(&C, far, nb, nb, 400, &used);
+            const double lc = C.u ? bnewton_sim(sc_TD, &C, nb, far, nb, 400, &used)
+                                  : bnewton_sim(sc_TD, &C, far, nb, nb, 400, &used);
             C.chord = 0;
-            const double lam =
-                C.u ? sc_sim(&C, nb, lc, nb, 400, &used) : sc_sim(&C, lc, nb, nb, 400, &used);
+            const double lam = C.u ? bnewton_sim(sc_TD, &C, nb, lc, nb, 400, &used)
+                                   : bnewton_sim(sc_TD, &C, lc, nb, nb, 400, &used);
             v = exp(lam);
         }
         const double err = fabs(v - ref) / fmax(1.0, fabs(ref));
         if (used > worst) worst = used;
         if (err > maxerr) maxerr = err;
     }
-    if (worst > 400 || maxerr > 1e-10) {
-        fprintf(stderr, "povgen: the soft conic recurrence misses the C library (%d, %g)\n", worst,
-                maxerr);
-        exit(1);
-    }
-    fprintf(stderr, "povgen: soft conic: %d steps per solve cover every case (error <= %.2g)\n",
-            worst, maxerr);
-    return worst + 2;
+    return steps_needed("soft conic", worst, maxerr);
 }
 
 /* ---- writing ---- */
