@@ -7,16 +7,13 @@
 #define _POSIX_C_SOURCE 200809L
 #include "testlib.h"
 
-#include <dirent.h>
 #include <stdlib.h>
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
 
-#ifndef SOURCE_DIR
-#error "SOURCE_DIR must be defined"
-#endif
+#include "scenelist.h"
 
 /* ---- helpers ---- */
 
@@ -157,28 +154,9 @@ static void expect_closed_manifold(const char *what, const lb_mesh *m) {
                  what, t.closed, t.oriented, t.manifold, t.volume, m->ntriangles, t.boundary_edges);
 }
 
-#define MAX_SCENES 64
-static char scene_paths[MAX_SCENES][1024];
-static size_t nscenes;
-
 static int setup(void **state) {
     (void)state;
-    const char *dirs[2] = {"scenes", "tests/data/scenes"};
-    for (int i = 0; i < 2; ++i) {
-        char full[512];
-        snprintf(full, sizeof full, "%s/%s", SOURCE_DIR, dirs[i]);
-        DIR *d = opendir(full);
-        if (!d) return -1;
-        struct dirent *e;
-        while ((e = readdir(d)) && nscenes < MAX_SCENES) {
-            const size_t len = strlen(e->d_name);
-            if (len > 5 && strcmp(e->d_name + len - 5, ".json") == 0)
-                snprintf(scene_paths[nscenes++], sizeof scene_paths[0], "%.500s/%.500s", full,
-                         e->d_name);
-        }
-        closedir(d);
-    }
-    return nscenes >= 17 ? 0 : -1;
+    return collect_scenes();
 }
 
 #define HEAD "{\"format\": \"libblend-scene\", \"version\": 1, "

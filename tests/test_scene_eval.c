@@ -5,37 +5,11 @@
 #define _POSIX_C_SOURCE 200809L
 #include "testlib.h"
 
-#include <dirent.h>
-
-#ifndef SOURCE_DIR
-#error "SOURCE_DIR must be defined"
-#endif
-
-#define MAX_SCENES 64
-
-static char scene_paths[MAX_SCENES][1024];
-static size_t nscenes;
-
-static void collect(const char *dir) {
-    char full[512];
-    snprintf(full, sizeof full, "%s/%s", SOURCE_DIR, dir);
-    DIR *d = opendir(full);
-    assert_non_null(d);
-    struct dirent *e;
-    while ((e = readdir(d)) && nscenes < MAX_SCENES) {
-        const size_t len = strlen(e->d_name);
-        if (len > 5 && strcmp(e->d_name + len - 5, ".json") == 0)
-            snprintf(scene_paths[nscenes++], sizeof scene_paths[0], "%.500s/%.500s", full,
-                     e->d_name);
-    }
-    closedir(d);
-}
+#include "scenelist.h"
 
 static int setup(void **state) {
     (void)state;
-    collect("scenes");
-    collect("tests/data/scenes");
-    return nscenes >= 17 ? 0 : -1;
+    return collect_scenes();
 }
 
 typedef struct loaded {

@@ -33,6 +33,14 @@ static double range_neg(rng *r) { /* a conic shape factor: 0, or in [-3, 0.95) *
 static double logu(rng *r, double a, double b) {
     return exp(range(r, log(a), log(b)));
 }
+/* p in [1.05, 16]: 2 (the closed form), an integer, or general */
+static double rand_p(rng *g) {
+    const double u = unit(g);
+    const double p = u < 0.3   ? 2.0
+                     : u < 0.6 ? (double)(1 + (int)(unit(g) * 16))
+                               : logu(g, 1.05, 16);
+    return p < 1.05 ? 2.0 : p;
+}
 
 #define MAXCASES 100000
 static double expect[MAXCASES];
@@ -76,9 +84,7 @@ static void displacement_cases(rng *g) {
             b[i] = tie ? 0.0 : scale * range(g, -1.0, 1.0);
             if (alone && i > 0) b[i] += 50.0 * scale * (op == 1 ? -1 : 1); /* one active term */
             r[i] = scale * logu(g, 0.05, 1.0);
-            const double u = unit(g);
-            p[i] = u < 0.3 ? 2.0 : u < 0.6 ? (double)(1 + (int)(unit(g) * 16)) : logu(g, 1.05, 16);
-            if (p[i] < 1.05) p[i] = 2.0;
+            p[i] = rand_p(g);
             m[i] = logu(g, 0.05, 20.0);
         }
         args_array("A", k, a, b);
@@ -148,9 +154,7 @@ static void scale_cases(rng *g) {
             a[i] = range(g, 0.5, 1.5);
             b[i] = range(g, -1.0, 2.0);
             r[i] = op == 0 ? logu(g, 0.05, 3.0) : logu(g, 0.05, 1.0);
-            const double u = unit(g);
-            p[i] = u < 0.3 ? 2.0 : u < 0.6 ? (double)(1 + (int)(unit(g) * 16)) : logu(g, 1.05, 16);
-            if (p[i] < 1.05) p[i] = 2.0;
+            p[i] = rand_p(g);
         }
         args_array("A", k, a, b);
         farray("R", k, r);
@@ -189,9 +193,7 @@ static void bounded_cases(rng *g) {
             const double s2 = set % 13 == 0 ? 1.0 / sc : sc; /* a wrong-sized bounding solid */
             ca[i] = a[i] / s2;
             cb[i] = (b[i] + 1.0) / s2 - 1.0;
-            const double u = unit(g);
-            p[i] = u < 0.3 ? 2.0 : u < 0.6 ? (double)(1 + (int)(unit(g) * 16)) : logu(g, 1.05, 16);
-            if (p[i] < 1.05) p[i] = 2.0;
+            p[i] = rand_p(g);
         }
         args_array("A", k, a, b);
         args_array("C", k, ca, cb);
@@ -228,9 +230,7 @@ static void soft_hyper_cases(rng *g) {
             if (set % 10 == 0 && i == k - 1) a[i] = b[i] = 0.0; /* a zero field */
             r[i] = op == 0 ? logu(g, 0.02, 1.0) : logu(g, 0.02, 3.0);
             if (op == 0 && unit(g) < 0.1) r[i] = 1.0;
-            const double u = unit(g);
-            p[i] = u < 0.3 ? 2.0 : u < 0.6 ? (double)(1 + (int)(unit(g) * 16)) : logu(g, 1.05, 16);
-            if (p[i] < 1.05) p[i] = 2.0;
+            p[i] = rand_p(g);
             m[i] = logu(g, 0.05, 20.0);
         }
         args_array("A", k, a, b);
