@@ -12,11 +12,12 @@ PACKAGES=(
   python3-numpy              # tests: independent mesh readers and checks (tests/mesh/)
   povray                     # tests: the generated POV-Ray include, run by POV-Ray itself
   openimageio-tools          # tests: idiff compares POV-Ray renders with libblend silhouettes
+  blender                    # tests: the add-on in headless Blender (blender_addon_c/)
 )
 
 # `install-deps.sh bench`: also what the benchmarks compare against
 if [ "${1:-}" = "bench" ]; then
-  PACKAGES+=(blender python3-skimage)
+  PACKAGES+=(python3-skimage)
 fi
 
 missing=()

@@ -1,0 +1,392 @@
+"""ctypes binding of libblend's C API: scenes, compiled evaluators, bounds,
+meshes and POV-Ray export, for plain Python (numpy) and for the Blender
+add-on alike. No Blender import here.
+
+    import binding
+    lib = binding.load()                      # LIBBLEND_LIBRARY or ./lib/libblend.so
+    scene = lib.parse_scene(text, "my.json")  # LibblendError with the C message on bad input
+    ev = scene.compile()
+    values, grads = ev.eval(points)           # points: (n, 3) array
+    mesh = ev.mesh(bmin, bmax, resolution=64) # mesh.positions (n, 3), mesh.triangles (t, 3)
+
+Contract: every failure of the library becomes a LibblendError whose text is
+the library's own message (file, JSON path, allowed values); a library that
+is missing or of another version raises LibraryError saying which file was
+tried and what to do. Handles free their C objects when garbage collected or
+on close(). Library calls release the GIL (ctypes), so meshing may run on a
+worker thread; no C callback is ever passed (no foreign-thread callbacks);
+cancel a running mesh with a CancelToken from any thread.
+"""
+import ctypes
+import os
+
+try:
+    import numpy as np
+except ImportError:  # pragma: no cover - reported when a numpy function is used
+    np = None
+
+#: the library version this binding is written for (major, minor)
+API_VERSION = (0, 1)
+ENV_LIBRARY = "LIBBLEND_LIBRARY"
+
+STATUS_NAMES = {0: "ok", 1: "invalid argument", 2: "not finite", 3: "no memory",
+                4: "internal error", 5: "cancelled", 6: "i/o error"}
+STATUS_CANCELLED = 5
+FORMATS = {"auto": 0, "ply": 1, "obj": 2, "stl": 3, "glb": 4}
+MESH_OPEN_BOUNDARY = 1
+
+
+class LibblendError(Exception):
+    """A failure reported by libblend; .status is the C status code."""
+
+    def __init__(self, message, status=4):
+        super().__init__(message)
+        self.status = status
+        self.message = message
+
+
+class LibraryError(LibblendError):
+    """libblend.so could not be loaded or is not the version this binding needs."""
+
+
+class Cancelled(LibblendError):
+    """A run was cancelled through a CancelToken."""
+
+
+class _Error(ctypes.Structure):
+    _fields_ = [("status", ctypes.c_int), ("message", ctypes.c_char * 512)]
+
+
+class _MeshOptions(ctypes.Structure):
+    _fields_ = [("bmin", ctypes.c_double * 3), ("bmax", ctypes.c_double * 3),
+                ("resolution", ctypes.c_uint), ("cell_size", ctypes.c_double),
+                ("flags", ctypes.c_uint), ("threads", ctypes.c_int),
+                ("max_memory", ctypes.c_size_t), ("progress", ctypes.c_void_p),
+                ("user", ctypes.c_void_p), ("cancel", ctypes.POINTER(ctypes.c_int))]
+
+
+class _Mesh(ctypes.Structure):
+    _fields_ = [("nvertices", ctypes.c_size_t), ("ntriangles", ctypes.c_size_t),
+                ("positions", ctypes.POINTER(ctypes.c_double)),
+                ("normals", ctypes.POINTER(ctypes.c_double)),
+                ("triangles", ctypes.POINTER(ctypes.c_uint32)),
+                ("origin", ctypes.c_double * 3), ("cell", ctypes.c_double * 3),
+                ("cells", ctypes.c_uint * 3)]
+
+
+class _PovOptions(ctypes.Structure):
+    _fields_ = [("include_only", ctypes.c_int), ("silhouette", ctypes.c_int),
+                ("aspect", ctypes.c_double), ("max_gradient", ctypes.c_double),
+                ("threads", ctypes.c_int)]
+
+
+class _Stats(ctypes.Structure):
+    _fields_ = [("nodes", ctypes.c_size_t), ("primitives", ctypes.c_size_t),
+                ("operators", ctypes.c_size_t), ("depth", ctypes.c_size_t)]
+
+
+_P = ctypes.c_void_p
+_D = ctypes.POINTER(ctypes.c_double)
+_ERR = ctypes.POINTER(_Error)
+
+# name: (restype, argtypes)
+_SIGNATURES = {
+    "lb_version": (ctypes.c_int, []),
+    "lb_status_string": (ctypes.c_char_p, [ctypes.c_int]),
+    "lb_scene_parse": (ctypes.c_int, [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_char_p,
+                                      ctypes.POINTER(_P), _ERR]),
+    "lb_scene_load": (ctypes.c_int, [ctypes.c_char_p, ctypes.POINTER(_P), _ERR]),
+    "lb_scene_free": (None, [_P]),
+    "lb_scene_convention": (ctypes.c_int, [_P]),
+    "lb_scene_bounds": (ctypes.c_int, [_P, _D, _D]),
+    "lb_scene_stats_get": (None, [_P, ctypes.POINTER(_Stats)]),
+    "lb_scene_describe": (ctypes.c_size_t, [_P, ctypes.c_char_p, ctypes.c_size_t]),
+    "lb_evaluator_create": (ctypes.c_int, [_P, ctypes.POINTER(_P), _ERR]),
+    "lb_evaluator_free": (None, [_P]),
+    "lb_evaluator_size": (ctypes.c_size_t, [_P]),
+    "lb_evaluator_eval": (ctypes.c_int, [_P, ctypes.c_size_t, _D, _D, _D, _D, _D, _D, _D,
+                                         ctypes.c_int, _ERR]),
+    "lb_evaluator_bounds": (ctypes.c_int, [_P, _D, _D, _D, _D, _ERR]),
+    "lb_mesh_options_init": (None, [ctypes.POINTER(_MeshOptions)]),
+    "lb_mesh_create": (ctypes.c_int, [_P, ctypes.POINTER(_MeshOptions),
+                                      ctypes.POINTER(ctypes.POINTER(_Mesh)), _ERR]),
+    "lb_mesh_free": (None, [ctypes.POINTER(_Mesh)]),
+    "lb_mesh_write": (ctypes.c_int, [ctypes.POINTER(_Mesh), ctypes.c_char_p, ctypes.c_int, _ERR]),
+    "lb_scene_write_pov": (ctypes.c_int, [_P, _P, ctypes.POINTER(_PovOptions), ctypes.c_char_p,
+                                          _D, _ERR]),
+}
+
+
+def _candidates():
+    here = os.path.dirname(os.path.abspath(__file__))
+    return [os.path.join(here, "lib", "libblend.so"), os.path.join(here, "libblend.so")]
+
+
+def default_path():
+    """The library file load() would try: $LIBBLEND_LIBRARY, else the copy
+    next to this module (lib/libblend.so)."""
+    env = os.environ.get(ENV_LIBRARY)
+    if env:
+        return env
+    for c in _candidates():
+        if os.path.exists(c):
+            return c
+    return _candidates()[0]
+
+
+def _need_numpy():
+    if np is None:
+        raise LibblendError("numpy is needed for arrays: install python3-numpy "
+                            "(Blender's Python has it)", 1)
+
+
+def _dptr(a):
+    return a.ctypes.data_as(_D)
+
+
+class Library:
+    """One loaded libblend.so. Cheap to keep; thread-safe (the C library has
+    no global state)."""
+
+    def __init__(self, path):
+        self.path = path
+        if not os.path.exists(path):
+            how = ("$%s points to it" % ENV_LIBRARY) if os.environ.get(ENV_LIBRARY) == path else \
+                "the add-on's lib/ folder should hold it"
+            raise LibraryError(
+                "libblend library not found: %s (%s). Fix: build libblend (cmake --build BUILD) and "
+                "install the add-on zip from BUILD/blender_addon/, or set %s to the path of "
+                "libblend.so" % (path, how, ENV_LIBRARY), 6)
+        try:
+            self._c = ctypes.CDLL(path)
+        except OSError as e:
+            raise LibraryError("libblend library %s could not be loaded: %s. Fix: rebuild libblend "
+                               "for this machine or point %s at a working libblend.so"
+                               % (path, e, ENV_LIBRARY), 6) from None
+        missing = [n for n in _SIGNATURES if not hasattr(self._c, n)]
+        if "lb_version" in missing:
+            raise LibraryError("%s is not libblend (no lb_version symbol). Fix: point %s at "
+                               "libblend.so" % (path, ENV_LIBRARY), 6)
+        self._c.lb_version.restype = ctypes.c_int
+        v = self._c.lb_version()
+        self.version = (v // 10000, v // 100 % 100, v % 100)
+        if self.version[:2] != API_VERSION or missing:
+            raise LibraryError(
+                "%s is libblend %d.%d.%d but this add-on needs %d.%d.x%s. Fix: install the add-on "
+                "zip built together with the library, or point %s at the matching libblend.so"
+                % ((path,) + self.version + API_VERSION +
+                   ((" (missing: %s)" % ", ".join(missing)) if missing else "",) + (ENV_LIBRARY,)), 6)
+        for name, (res, args) in _SIGNATURES.items():
+            f = getattr(self._c, name)
+            f.restype = res
+            f.argtypes = args
+
+    def _check(self, status, err, what):
+        if status == 0:
+            return
+        msg = err.message.decode("utf-8", "replace") or self._c.lb_status_string(status).decode()
+        cls = Cancelled if status == STATUS_CANCELLED else LibblendError
+        raise cls(msg if msg.startswith(what) else "%s: %s" % (what, msg), status)
+
+    def parse_scene(self, text, name=None):
+        """Parse and validate a scene from a str or bytes (JSON, docs/scene-format.md)."""
+        data = text.encode("utf-8") if isinstance(text, str) else bytes(text)
+        out, err = _P(), _Error()
+        st = self._c.lb_scene_parse(data, len(data), name.encode("utf-8") if name else None,
+                                    ctypes.byref(out), ctypes.byref(err))
+        self._check(st, err, "scene")
+        return Scene(self, out)
+
+    def load_scene(self, path):
+        """Read, parse and validate a scene file."""
+        out, err = _P(), _Error()
+        st = self._c.lb_scene_load(os.fsencode(path), ctypes.byref(out), ctypes.byref(err))
+        self._check(st, err, "scene")
+        return Scene(self, out)
+
+
+class _Handle:
+    _free = None
+
+    def __init__(self, lib, ptr):
+        self.lib = lib
+        self._p = ptr
+
+    def close(self):
+        if self._p is not None and self._p.value:
+            getattr(self.lib._c, self._free)(self._p)
+        self._p = None
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *a):
+        self.close()
+
+    @property
+    def ptr(self):
+        if self._p is None:
+            raise LibblendError("%s used after close()" % type(self).__name__, 1)
+        return self._p
+
+
+class Scene(_Handle):
+    """A parsed, validated scene (immutable)."""
+    _free = "lb_scene_free"
+
+    @property
+    def convention(self):
+        return "soft" if self.lib._c.lb_scene_convention(self.ptr) == 1 else "zero"
+
+    @property
+    def bounds(self):
+        """((x, y, z), (x, y, z)) from the scene's "bounds", or None."""
+        lo, hi = (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
+        if not self.lib._c.lb_scene_bounds(self.ptr, lo, hi):
+            return None
+        return tuple(lo), tuple(hi)
+
+    @property
+    def stats(self):
+        s = _Stats()
+        self.lib._c.lb_scene_stats_get(self.ptr, ctypes.byref(s))
+        return {"nodes": s.nodes, "primitives": s.primitives, "operators": s.operators,
+                "depth": s.depth}
+
+    def describe(self):
+        n = self.lib._c.lb_scene_describe(self.ptr, None, 0)
+        buf = ctypes.create_string_buffer(n + 1)
+        self.lib._c.lb_scene_describe(self.ptr, buf, n + 1)
+        return buf.value.decode("utf-8", "replace")
+
+    def compile(self):
+        """Compile into an Evaluator (independent of this scene afterwards)."""
+        out, err = _P(), _Error()
+        st = self.lib._c.lb_evaluator_create(self.ptr, ctypes.byref(out), ctypes.byref(err))
+        self.lib._check(st, err, "compile")
+        return Evaluator(self.lib, out)
+
+    def write_pov(self, evaluator, path, include_only=False, silhouette=False, aspect=0.0,
+                  max_gradient=0.0, threads=0):
+        """Write a renderable POV-Ray scene (atomically); returns the max_gradient written.
+        The file includes "libblend.inc" (povray_include/)."""
+        o = _PovOptions(int(bool(include_only)), int(bool(silhouette)), float(aspect),
+                        float(max_gradient), int(threads))
+        g, err = ctypes.c_double(0.0), _Error()
+        st = self.lib._c.lb_scene_write_pov(self.ptr, evaluator.ptr, ctypes.byref(o),
+                                            os.fsencode(path), ctypes.byref(g), ctypes.byref(err))
+        self.lib._check(st, err, "pov export")
+        return g.value
+
+
+class CancelToken:
+    """A flag the C mesher polls; cancel() from any thread stops the run
+    (mesh() then raises Cancelled)."""
+
+    def __init__(self):
+        self._flag = ctypes.c_int(0)
+
+    def cancel(self):
+        self._flag.value = 1
+
+    @property
+    def cancelled(self):
+        return bool(self._flag.value)
+
+
+class Evaluator(_Handle):
+    """A compiled scene: values, gradients, interval bounds and meshes.
+    Read-only: any number of threads may use one evaluator at once."""
+    _free = "lb_evaluator_free"
+
+    def __len__(self):
+        return self.lib._c.lb_evaluator_size(self.ptr)
+
+    def eval(self, points, threads=0, gradient=True):
+        """values (n,) and, if gradient, gradients (n, 3) at points (n, 3).
+        threads: 0 = all CPUs, 1 = the calling thread only."""
+        _need_numpy()
+        P = np.asarray(points, dtype=np.float64)
+        if P.ndim != 2 or P.shape[1] != 3:
+            raise LibblendError("points: shape %s; allowed: (n, 3)" % (P.shape,), 1)
+        x, y, z = (np.ascontiguousarray(P[:, i]) for i in range(3))
+        n = len(x)
+        v = np.empty(n)
+        g = [np.empty(n) for _ in range(3)] if gradient else None
+        err = _Error()
+        null = ctypes.cast(None, _D)
+        st = self.lib._c.lb_evaluator_eval(self.ptr, n, _dptr(x), _dptr(y), _dptr(z), _dptr(v),
+                                           *([_dptr(a) for a in g] if g else [null] * 3),
+                                           int(threads), ctypes.byref(err))
+        self.lib._check(st, err, "eval")
+        return (v, np.stack(g, axis=1)) if gradient else (v, None)
+
+    def bounds(self, bmin, bmax):
+        """(lo, hi): an interval containing the field everywhere in the box."""
+        lo, hi, err = ctypes.c_double(), ctypes.c_double(), _Error()
+        a = (ctypes.c_double * 3)(*map(float, bmin))
+        b = (ctypes.c_double * 3)(*map(float, bmax))
+        st = self.lib._c.lb_evaluator_bounds(self.ptr, a, b, ctypes.byref(lo), ctypes.byref(hi),
+                                             ctypes.byref(err))
+        self.lib._check(st, err, "bounds")
+        return lo.value, hi.value
+
+    def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
+             max_memory=0, cancel=None):
+        """Mesh the field over the box [bmin, bmax] (docs/meshing.md). Returns a
+        Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called."""
+        _need_numpy()
+        o = _MeshOptions()
+        self.lib._c.lb_mesh_options_init(ctypes.byref(o))
+        for i in range(3):
+            o.bmin[i], o.bmax[i] = float(bmin[i]), float(bmax[i])
+        o.resolution = int(resolution)
+        o.cell_size = float(cell_size)
+        o.flags = MESH_OPEN_BOUNDARY if open_boundary else 0
+        o.threads = int(threads)
+        o.max_memory = int(max_memory)
+        if cancel is not None:
+            o.cancel = ctypes.pointer(cancel._flag)
+        out, err = ctypes.POINTER(_Mesh)(), _Error()
+        st = self.lib._c.lb_mesh_create(self.ptr, ctypes.byref(o), ctypes.byref(out),
+                                        ctypes.byref(err))
+        self.lib._check(st, err, "mesh")
+        try:
+            m = out.contents
+            nv, nt = m.nvertices, m.ntriangles
+            if nv:
+                pos = np.ctypeslib.as_array(m.positions, shape=(nv, 3)).copy()
+                nrm = np.ctypeslib.as_array(m.normals, shape=(nv, 3)).copy()
+            else:
+                pos, nrm = np.zeros((0, 3)), np.zeros((0, 3))
+            tri = np.ctypeslib.as_array(m.triangles, shape=(nt, 3)).copy() if nt else \
+                np.zeros((0, 3), dtype=np.uint32)
+            return Mesh(pos, nrm, tri, tuple(m.origin), tuple(m.cell), tuple(m.cells))
+        finally:
+            self.lib._c.lb_mesh_free(out)
+
+
+class Mesh:
+    """A triangle mesh: positions (n, 3) float64, unit normals (n, 3) from the
+    analytic gradient, triangles (t, 3) uint32 counter-clockwise from outside;
+    origin, cell and cells describe the grid used."""
+
+    def __init__(self, positions, normals, triangles, origin, cell, cells):
+        self.positions, self.normals, self.triangles = positions, normals, triangles
+        self.origin, self.cell, self.cells = origin, cell, cells
+
+    def volume(self):
+        """Enclosed volume (divergence theorem); exact for a closed mesh."""
+        V = self.positions[self.triangles.astype(np.int64)]
+        return float(np.einsum("ij,ij->i", V[:, 0], np.cross(V[:, 1], V[:, 2])).sum() / 6.0)
+
+
+def load(path=None):
+    """Load libblend.so (path, else $LIBBLEND_LIBRARY, else the add-on's lib/ copy)."""
+    return Library(path or default_path())

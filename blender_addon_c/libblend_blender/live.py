@@ -1,0 +1,369 @@
+"""Meshing fields into Blender meshes: live (debounced, on a worker thread)
+and on demand (synchronously).
+
+Flow of a live update: a setting's update callback or a transform change
+seen by the depsgraph handler calls mark_dirty(); a timer on Blender's main
+loop waits DEBOUNCE seconds after the last edit, reads the tree into scene
+JSON (main thread: bpy data is only touched there), and starts a worker
+thread that parses, compiles and meshes it in libblend (ctypes releases the
+GIL, so Blender stays responsive). An edit during a run cancels that run
+(CancelToken, polled by the C mesher). The timer moves a finished mesh into
+the Blender mesh with foreach_set (no per-vertex Python). The library never
+calls back into Python.
+"""
+import os
+import threading
+import time
+
+import bpy
+
+from . import binding, tree
+
+DEBOUNCE = 0.03       # seconds of quiet after an edit before a live remesh starts
+TICK = 0.01           # timer period while work is pending
+AUTO_ANALYTIC = 250000  # "Auto" normals: analytic below this many triangles
+
+_lib = None
+_lib_error = None
+_states = {}   # output name -> _State
+_timer_on = False
+
+
+class _State:
+    def __init__(self):
+        self.dirty = False
+        self.t_edit = 0.0
+        self.job = None
+        self.status = ""
+        self.error = False
+        self.last = {}  # timings of the last update (seconds)
+
+
+class _Job:
+    def __init__(self, text, name, bmin, bmax, resolution, open_boundary, threads, paths):
+        self.text, self.name = text, name
+        self.bmin, self.bmax, self.resolution = bmin, bmax, resolution
+        self.open_boundary, self.threads, self.paths = open_boundary, threads, paths
+        self.cancel = binding.CancelToken()
+        self.mesh = None
+        self.error = None
+        self.seconds = 0.0
+        self.t_start = time.perf_counter()
+        self.done = threading.Event()
+
+    def run(self):
+        t0 = time.perf_counter()
+        try:
+            self.mesh = mesh_text(self.text, self.name, self.bmin, self.bmax, self.resolution,
+                                  self.open_boundary, self.threads, self.cancel)
+        except binding.Cancelled:
+            self.error = None
+        except binding.LibblendError as e:
+            self.error = tree.explain(str(e), self.paths)
+        except Exception as e:  # a bug: keep Blender alive and say so
+            self.error = "internal error: %r" % (e,)
+        self.seconds = time.perf_counter() - t0
+        self.done.set()
+
+
+# --------------------------------------------------------------------------- library
+
+def prefs():
+    addon = bpy.context.preferences.addons.get(__package__)
+    return addon.preferences if addon else None
+
+
+def library():
+    """The loaded library; raises binding.LibraryError with the reason (kept
+    until reload_library() so every panel and operator can show it)."""
+    global _lib, _lib_error
+    if _lib is None and _lib_error is None:
+        p = prefs()
+        path = (p.library_path if p and p.library_path else None)
+        try:
+            _lib = binding.load(bpy.path.abspath(path) if path else None)
+        except binding.LibraryError as e:
+            _lib_error = e
+    if _lib is None:
+        raise _lib_error
+    return _lib
+
+
+def library_status():
+    """(ok, text) for the UI."""
+    try:
+        lib = library()
+        return True, "libblend %d.%d.%d (%s)" % (lib.version + (os.path.basename(lib.path),))
+    except binding.LibraryError as e:
+        return False, str(e)
+
+
+def reload_library():
+    global _lib, _lib_error
+    _lib, _lib_error = None, None
+    return library_status()
+
+
+def threads():
+    p = prefs()
+    return p.threads if p else 0
+
+
+def mesh_text(text, name, bmin, bmax, resolution, open_boundary=False, nthreads=0, cancel=None):
+    lib = library()
+    with lib.parse_scene(text, name) as scene, scene.compile() as ev:
+        return ev.mesh(bmin, bmax, resolution=resolution, open_boundary=open_boundary,
+                       threads=nthreads, cancel=cancel)
+
+
+# --------------------------------------------------------------------------- mesh data
+
+def set_mesh_data(me, mesh, normals="AUTO"):
+    """Replace me's geometry by the libblend mesh (numpy arrays, foreach_set)."""
+    import numpy as np
+    nv, nt = len(mesh.positions), len(mesh.triangles)
+    me.clear_geometry()
+    if nt:
+        me.vertices.add(nv)
+        me.vertices.foreach_set("co", mesh.positions.astype(np.float32).ravel())
+        me.loops.add(3 * nt)
+        me.loops.foreach_set("vertex_index", mesh.triangles.astype(np.int32).ravel())
+        me.polygons.add(nt)
+        me.polygons.foreach_set("loop_start", np.arange(0, 3 * nt, 3, dtype=np.int32))
+        try:  # Blender < 4.0 needs loop_total; later versions derive it
+            me.polygons.foreach_set("loop_total", np.full(nt, 3, dtype=np.int32))
+        except (AttributeError, TypeError, RuntimeError):
+            pass
+        me.update(calc_edges=True)
+        me.polygons.foreach_set("use_smooth", np.ones(nt, dtype=bool))
+        if normals == "ANALYTIC" or (normals == "AUTO" and nt < AUTO_ANALYTIC):
+            if hasattr(me, "use_auto_smooth"):  # Blender < 4.1
+                me.use_auto_smooth = True
+                me.auto_smooth_angle = 3.14159
+            me.normals_split_custom_set_from_vertices(mesh.normals)
+    me.update()
+
+
+# --------------------------------------------------------------------------- jobs
+
+def _state(name):
+    st = _states.get(name)
+    if st is None:
+        st = _states[name] = _State()
+    return st
+
+
+def state_of(output):
+    return _state(output.name)
+
+
+def _region(output):
+    s = output.libblend
+    return tuple(s.bounds_min), tuple(s.bounds_max)
+
+
+def prepare(output, resolution):
+    """Read the tree (main thread) into a _Job; raises tree.TreeError."""
+    text, paths = tree.to_json(output)
+    bmin, bmax = _region(output)
+    return _Job(text, output.name + ".json", bmin, bmax, resolution,
+                output.libblend.open_boundary, threads(), paths)
+
+
+def _finish(output, st, job, t_start):
+    if job.error:
+        st.status, st.error = job.error, True
+        return False
+    t0 = time.perf_counter()
+    set_mesh_data(output.data, job.mesh, output.libblend.normals)
+    st.last = {"mesh": job.seconds, "apply": time.perf_counter() - t0,
+               "total": time.perf_counter() - t_start}
+    st.status = "%d triangles, %d cells, %.0f ms (libblend %.0f ms)" % (
+        len(job.mesh.triangles), job.resolution, 1000 * st.last["total"], 1000 * job.seconds)
+    st.error = False
+    return True
+
+
+def update_now(output, final=False):
+    """Mesh the output synchronously on this thread; returns (ok, message)."""
+    st = _state(output.name)
+    t0 = time.perf_counter()
+    if st.job:
+        st.job.cancel.cancel()
+    try:
+        job = prepare(output, output.libblend.render_resolution if final
+                      else output.libblend.preview_resolution)
+    except (tree.TreeError, binding.LibraryError) as e:
+        st.status, st.error = str(e), True
+        return False, str(e)
+    job.run()
+    ok = _finish(output, st, job, t0)
+    st.dirty = False
+    return ok, st.status
+
+
+def mark_dirty(obj):
+    """Called when something that shapes obj's field changed."""
+    out = tree.output_of(obj)
+    if out is None or not out.libblend.live:
+        return
+    st = _state(out.name)
+    st.dirty = True
+    st.t_edit = time.perf_counter()
+    if st.job:
+        st.job.cancel.cancel()  # obsolete: start again after the debounce
+    _ensure_timer()
+
+
+def _ensure_timer():
+    global _timer_on
+    if not _timer_on and not bpy.app.background:
+        bpy.app.timers.register(tick, first_interval=TICK)
+        _timer_on = True
+
+
+def tick():
+    """The timer: start debounced jobs, move finished meshes in. Returns the
+    next interval, or None when nothing is pending (timer stops)."""
+    global _timer_on
+    now = time.perf_counter()
+    pending = False
+    for name in list(_states):
+        st = _states[name]
+        out = bpy.data.objects.get(name)
+        if out is None or out.libblend.kind != "OUTPUT":
+            if st.job:
+                st.job.cancel.cancel()
+            del _states[name]
+            continue
+        if st.job is not None:
+            if st.job.done.is_set():
+                job, st.job = st.job, None
+                if not job.cancel.cancelled:
+                    _finish(out, st, job, job.t_start)
+            else:
+                pending = True
+                continue
+        if st.dirty:
+            if now - st.t_edit < DEBOUNCE:
+                pending = True
+                continue
+            st.dirty = False
+            try:
+                job = prepare(out, out.libblend.preview_resolution)
+            except (tree.TreeError, binding.LibraryError) as e:
+                st.status, st.error = str(e), True
+                continue
+            job.t_start = st.t_edit
+            st.job = job
+            threading.Thread(target=job.run, name="libblend-mesh", daemon=True).start()
+            pending = True
+    if not pending:
+        _timer_on = False
+        return None
+    return TICK
+
+
+def cancel_all():
+    for st in _states.values():
+        if st.job:
+            st.job.cancel.cancel()
+            st.job.done.wait(10)
+            st.job = None
+
+
+# --------------------------------------------------------------------------- handlers
+
+@bpy.app.handlers.persistent
+def on_depsgraph(scene, depsgraph):
+    for u in depsgraph.updates:
+        idb = u.id
+        if isinstance(idb, bpy.types.Object):
+            obj = idb.original
+            if tree.is_node(obj) and u.is_updated_transform:
+                mark_dirty(obj)
+
+
+_structure = {}
+
+
+@bpy.app.handlers.persistent
+def on_structure(scene, depsgraph):
+    """Nodes added, deleted or re-parented: compare each output's node set."""
+    for obj in scene.objects:
+        if obj.libblend.kind != "OUTPUT":
+            continue
+        sig = _signature(obj)
+        if _structure.get(obj.name) != sig:
+            if obj.name in _structure:
+                mark_dirty(obj)
+            _structure[obj.name] = sig
+
+
+def _signature(out):
+    sig, stack = [], [out]
+    while stack:
+        o = stack.pop()
+        for c in o.children:
+            if tree.is_node(c):
+                sig.append((c.name, o.name))
+                stack.append(c)
+    return tuple(sorted(sig))
+
+
+@bpy.app.handlers.persistent
+def on_undo(*_):
+    cancel_all()
+    for obj in bpy.data.objects:
+        if obj.libblend.kind == "OUTPUT":
+            mark_dirty(obj)
+
+
+@bpy.app.handlers.persistent
+def on_load(*_):
+    cancel_all()
+    _states.clear()
+    _structure.clear()
+
+
+_render_swapped = []
+
+
+@bpy.app.handlers.persistent
+def on_render_init(scene, *_):
+    """Final renders use each field's render resolution."""
+    for obj in scene.objects:
+        s = obj.libblend
+        if s.kind == "OUTPUT" and s.render_resolution != s.preview_resolution:
+            ok, _msg = update_now(obj, final=True)
+            if ok:
+                _render_swapped.append(obj.name)
+
+
+@bpy.app.handlers.persistent
+def on_render_done(scene, *_):
+    while _render_swapped:
+        obj = bpy.data.objects.get(_render_swapped.pop())
+        if obj is not None:
+            update_now(obj)
+
+
+_HANDLERS = [("depsgraph_update_post", on_depsgraph), ("depsgraph_update_post", on_structure),
+             ("undo_post", on_undo), ("redo_post", on_undo), ("load_post", on_load),
+             ("render_init", on_render_init), ("render_complete", on_render_done),
+             ("render_cancel", on_render_done)]
+
+
+def register():
+    for name, fn in _HANDLERS:
+        getattr(bpy.app.handlers, name).append(fn)
+
+
+def unregister():
+    cancel_all()
+    for name, fn in _HANDLERS:
+        lst = getattr(bpy.app.handlers, name)
+        if fn in lst:
+            lst.remove(fn)
+    if bpy.app.timers.is_registered(tick):
+        bpy.app.timers.unregister(tick)

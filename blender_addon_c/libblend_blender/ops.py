@@ -1,0 +1,380 @@
+"""Operators (F3 search: "libblend"). Each one is undoable and reports
+problems in Blender's status bar instead of raising."""
+import json
+import os
+import shutil
+import tempfile
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
+from mathutils import Matrix
+
+from . import binding, live, props, tree
+
+
+def _active(context):
+    return context.view_layer.objects.active
+
+
+def _selected(context):
+    return [o for o in context.view_layer.objects if o.select_get()]
+
+
+def _make_active(context, obj):
+    for o in _selected(context):
+        o.select_set(False)
+    obj.select_set(True)
+    context.view_layer.objects.active = obj
+
+
+def _next_order(parent):
+    args = tree.children(parent)
+    return (max(a.libblend.order for a in args) + 1) if args else 0
+
+
+def _target_parent(context, op):
+    """Where a new node goes: the active blend or output, or the active node's parent."""
+    a = _active(context)
+    if a is None or tree.output_of(a) is None:
+        op.report({"ERROR"}, "select a libblend field (Add > libblend Field) or one of its nodes "
+                             "first")
+        return None
+    if a.libblend.kind in ("OUTPUT", "BLEND"):
+        return a
+    return a.parent
+
+
+def _new_node(context, parent, name, display):
+    obj = bpy.data.objects.new(name, None)
+    obj.empty_display_type = display
+    obj.empty_display_size = 0.5
+    coll = parent.users_collection[0] if parent.users_collection else context.collection
+    coll.objects.link(obj)
+    obj.parent = parent
+    obj.matrix_parent_inverse = Matrix.Identity(4)
+    return obj
+
+
+def _blend_items(self, context):
+    a = context.view_layer.objects.active if context else None
+    out = tree.output_of(a) if a else None
+    if out is not None and out.libblend.convention == "soft":
+        return props.BLENDS_SOFT + [b for b in props.BLENDS_ZERO if b[0] in ("min", "max",
+                                                                              "complement")]
+    return props.BLENDS_ZERO
+
+
+class LIBBLEND_OT_add_field(bpy.types.Operator):
+    """Add a libblend field: a mesh object meshed from a blend tree of primitives"""
+    bl_idname = "libblend.add_field"
+    bl_label = "libblend Field"
+    bl_options = {"REGISTER", "UNDO"}
+
+    convention: EnumProperty(name="Convention", items=[
+        ("zero", "Zero (distance-like)", ""), ("soft", "Soft (kernels)", "")])
+    with_sphere: BoolProperty(name="Start with a Sphere", default=True)
+
+    def execute(self, context):
+        me = bpy.data.meshes.new("libblend field")
+        out = bpy.data.objects.new("libblend field", me)
+        context.collection.objects.link(out)
+        out.location = context.scene.cursor.location
+        s = out.libblend
+        s.kind = "OUTPUT"
+        s.live = False
+        s.convention = self.convention
+        if self.with_sphere:
+            sph = _new_node(context, out, "sphere", "SPHERE")
+            sph.libblend.kind = "PRIMITIVE"
+            sph.libblend.prim_type = "sphere"
+        s.live = True
+        _make_active(context, out)
+        if self.with_sphere:
+            live.update_now(out)
+        return {"FINISHED"}
+
+
+class LIBBLEND_OT_add_primitive(bpy.types.Operator):
+    """Add a libblend primitive under the active blend (or field)"""
+    bl_idname = "libblend.add_primitive"
+    bl_label = "Add libblend Primitive"
+    bl_options = {"REGISTER", "UNDO"}
+
+    prim_type: EnumProperty(name="Primitive", items=props.PRIMITIVES)
+    location: FloatVectorProperty(name="Location", subtype="TRANSLATION",
+                                  description="relative to the parent node")
+    rotation: FloatVectorProperty(name="Rotation", subtype="EULER")
+
+    def execute(self, context):
+        parent = _target_parent(context, self)
+        if parent is None:
+            return {"CANCELLED"}
+        if parent.libblend.kind == "OUTPUT" and tree.children(parent):
+            self.report({"ERROR"}, "field '%s' already has its root node; select a blend node "
+                                   "to add the primitive to" % parent.name)
+            return {"CANCELLED"}
+        obj = _new_node(context, parent, self.prim_type, tree.EMPTY_DISPLAY[self.prim_type])
+        obj.location, obj.rotation_euler = self.location, self.rotation
+        s = obj.libblend
+        s.kind, s.prim_type, s.order = "PRIMITIVE", self.prim_type, _next_order(parent)
+        _make_active(context, obj)
+        live.mark_dirty(obj)
+        return {"FINISHED"}
+
+
+class LIBBLEND_OT_add_blend(bpy.types.Operator):
+    """Add a libblend blend node; selected sibling nodes become its arguments"""
+    bl_idname = "libblend.add_blend"
+    bl_label = "Add libblend Blend"
+    bl_options = {"REGISTER", "UNDO"}
+
+    blend_type: EnumProperty(name="Operator", items=_blend_items)
+    op: EnumProperty(name="Set Operation", items=props.OPS)
+    wrap_selected: BoolProperty(name="Blend Selected", default=True,
+                                description="make the selected nodes its arguments")
+
+    def execute(self, context):
+        a = _active(context)
+        if a is None or tree.output_of(a) is None:
+            self.report({"ERROR"}, "select a libblend field or one of its nodes first")
+            return {"CANCELLED"}
+        sel = [o for o in _selected(context) if tree.is_node(o)] if self.wrap_selected else []
+        if sel:
+            parent = sel[0].parent
+            if any(o.parent != parent for o in sel):
+                self.report({"ERROR"}, "the selected nodes have different parents; select "
+                                       "siblings to blend them")
+                return {"CANCELLED"}
+            order = min(o.libblend.order for o in sel)
+        else:
+            parent = a if a.libblend.kind in ("OUTPUT", "BLEND") else a.parent
+            if parent.libblend.kind == "OUTPUT" and tree.children(parent):
+                self.report({"ERROR"}, "field '%s' already has its root node; select it to "
+                                       "blend it with new nodes" % parent.name)
+                return {"CANCELLED"}
+            order = _next_order(parent)
+        obj = _new_node(context, parent, self.blend_type, "PLAIN_AXES")
+        s = obj.libblend
+        s.kind, s.blend_type, s.op, s.order = "BLEND", self.blend_type, self.op, order
+        for i, o in enumerate(sorted(sel, key=lambda o: (o.libblend.order, o.name))):
+            w = o.matrix_world.copy()
+            o.parent = obj
+            o.matrix_parent_inverse = Matrix.Identity(4)
+            o.matrix_world = w
+            o.libblend.order = i
+        _make_active(context, obj)
+        live.mark_dirty(obj)
+        return {"FINISHED"}
+
+
+class LIBBLEND_OT_add_bound(bpy.types.Operator):
+    """Add a bounding solid to the active node (for bounded blends): a larger copy of it"""
+    bl_idname = "libblend.add_bound"
+    bl_label = "Add Bounding Solid"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        a = context.view_layer.objects.active
+        return a is not None and a.libblend.kind == "PRIMITIVE"
+
+    def execute(self, context):
+        a = _active(context)
+        if tree.children(a, "BOUND"):
+            self.report({"ERROR"}, "'%s' already has a bounding solid" % a.name)
+            return {"CANCELLED"}
+        b = _new_node(context, a, a.libblend.prim_type + " bound", "SPHERE")
+        for key in a.libblend.bl_rna.properties.keys():
+            if key not in ("rna_type", "name", "role", "order", "arg_override"):
+                try:
+                    setattr(b.libblend, key, getattr(a.libblend, key))
+                except (AttributeError, TypeError):
+                    pass
+        b.libblend.role = "BOUND"
+        b.scale = (1.5, 1.5, 1.5)
+        b.empty_display_type = "SPHERE"
+        _make_active(context, b)
+        live.mark_dirty(b)
+        return {"FINISHED"}
+
+
+class LIBBLEND_OT_move_argument(bpy.types.Operator):
+    """Move the active node one place up or down among its parent's arguments"""
+    bl_idname = "libblend.move_argument"
+    bl_label = "Move Argument"
+    bl_options = {"REGISTER", "UNDO"}
+
+    direction: EnumProperty(items=[("UP", "Up", ""), ("DOWN", "Down", "")])
+
+    def execute(self, context):
+        a = _active(context)
+        if not tree.is_node(a) or a.parent is None:
+            return {"CANCELLED"}
+        args = tree.children(a.parent)
+        i = args.index(a)
+        j = i - 1 if self.direction == "UP" else i + 1
+        if 0 <= j < len(args):
+            args[i], args[j] = args[j], args[i]
+        for k, o in enumerate(args):
+            o.libblend.order = k
+        live.mark_dirty(a)
+        return {"FINISHED"}
+
+
+def _output(context, op):
+    a = _active(context)
+    out = tree.output_of(a) if a else None
+    if out is None:
+        op.report({"ERROR"}, "select a libblend field or one of its nodes first")
+    return out
+
+
+class LIBBLEND_OT_update_mesh(bpy.types.Operator):
+    """Remesh the active libblend field now"""
+    bl_idname = "libblend.update_mesh"
+    bl_label = "Update libblend Mesh"
+    bl_options = {"REGISTER", "UNDO"}
+
+    final: BoolProperty(name="Render Resolution", default=False)
+
+    def execute(self, context):
+        out = _output(context, self)
+        if out is None:
+            return {"CANCELLED"}
+        ok, msg = live.update_now(out, final=self.final)
+        self.report({"INFO"} if ok else {"ERROR"}, msg)
+        return {"FINISHED"} if ok else {"CANCELLED"}
+
+
+class LIBBLEND_OT_reload_library(bpy.types.Operator):
+    """Load libblend.so again (after installing it or changing its path)"""
+    bl_idname = "libblend.reload_library"
+    bl_label = "Reload libblend Library"
+
+    def execute(self, context):
+        ok, msg = live.reload_library()
+        self.report({"INFO"} if ok else {"ERROR"}, msg)
+        return {"FINISHED"} if ok else {"CANCELLED"}
+
+
+def _atomic_write(path, text):
+    d = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".libblend-", dir=d)
+    try:
+        with os.fdopen(fd, "w") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+class LIBBLEND_OT_import_scene(bpy.types.Operator, ImportHelper):
+    """Import a libblend scene file (.json) as a field with its blend tree"""
+    bl_idname = "libblend.import_scene"
+    bl_label = "Import libblend Scene"
+    bl_options = {"REGISTER", "UNDO"}
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    def execute(self, context):
+        try:
+            lib = live.library()
+            # libblend validates first: the same messages as blendtool (file:line:col, JSON path)
+            lib.load_scene(self.filepath).close()
+            with open(self.filepath, encoding="utf-8") as f:
+                scene = json.load(f)
+        except (binding.LibblendError, OSError, ValueError) as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        name = scene.get("title") or os.path.splitext(os.path.basename(self.filepath))[0]
+        out = tree.from_scene(scene, context.collection, name)
+        _make_active(context, out)
+        ok, msg = live.update_now(out)
+        self.report({"INFO"} if ok else {"WARNING"}, msg)
+        return {"FINISHED"}
+
+
+class LIBBLEND_OT_export_scene(bpy.types.Operator, ExportHelper):
+    """Export the active libblend field as a scene file (.json) for blendtool and batch jobs"""
+    bl_idname = "libblend.export_scene"
+    bl_label = "Export libblend Scene"
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    def execute(self, context):
+        out = _output(context, self)
+        if out is None:
+            return {"CANCELLED"}
+        try:
+            text, paths = tree.to_json(out)
+            live.library().parse_scene(text, os.path.basename(self.filepath)).close()
+            _atomic_write(self.filepath, text + "\n")
+        except tree.TreeError as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        except binding.LibblendError as e:
+            self.report({"ERROR"}, tree.explain(str(e), paths))
+            return {"CANCELLED"}
+        except OSError as e:
+            self.report({"ERROR"}, "cannot write %s: %s" % (self.filepath, e.strerror))
+            return {"CANCELLED"}
+        self.report({"INFO"}, "wrote %s" % self.filepath)
+        return {"FINISHED"}
+
+
+def include_file():
+    """libblend.inc shipped with the add-on (or next to the source tree)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    for p in (os.path.join(here, "povray", "libblend.inc"),
+              os.path.join(here, "..", "..", "povray_include", "libblend.inc")):
+        if os.path.exists(p):
+            return os.path.normpath(p)
+    return None
+
+
+class LIBBLEND_OT_export_pov(bpy.types.Operator, ExportHelper):
+    """Export the active libblend field as a POV-Ray scene (isosurface with an exact max_gradient)"""
+    bl_idname = "libblend.export_pov"
+    bl_label = "Export POV-Ray Scene"
+    filename_ext = ".pov"
+    filter_glob: StringProperty(default="*.pov", options={"HIDDEN"})
+
+    include_only: BoolProperty(name="Functions Only", default=False,
+                               description="only the #declare'd functions (root: LB_Field)")
+
+    def execute(self, context):
+        out = _output(context, self)
+        if out is None:
+            return {"CANCELLED"}
+        paths = {}
+        try:
+            text, paths = tree.to_json(out)
+            lib = live.library()
+            with lib.parse_scene(text, out.name) as scene, scene.compile() as ev:
+                g = scene.write_pov(ev, self.filepath, include_only=self.include_only,
+                                    threads=live.threads())
+            inc = include_file()
+            dst = os.path.join(os.path.dirname(os.path.abspath(self.filepath)), "libblend.inc")
+            if inc and os.path.abspath(inc) != dst:  # render with: povray +I<file> (no +L needed)
+                shutil.copyfile(inc, dst + ".tmp")
+                os.replace(dst + ".tmp", dst)
+        except tree.TreeError as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        except binding.LibblendError as e:
+            self.report({"ERROR"}, tree.explain(str(e), paths))
+            return {"CANCELLED"}
+        except OSError as e:
+            self.report({"ERROR"}, "cannot write next to %s: %s" % (self.filepath, e))
+            return {"CANCELLED"}
+        self.report({"INFO"}, "wrote %s (max_gradient %.4g)" % (self.filepath, g))
+        return {"FINISHED"}
+
+
+CLASSES = [LIBBLEND_OT_add_field, LIBBLEND_OT_add_primitive, LIBBLEND_OT_add_blend,
+           LIBBLEND_OT_add_bound, LIBBLEND_OT_move_argument, LIBBLEND_OT_update_mesh,
+           LIBBLEND_OT_reload_library, LIBBLEND_OT_import_scene, LIBBLEND_OT_export_scene,
+           LIBBLEND_OT_export_pov]

@@ -1,0 +1,357 @@
+"""The Blender add-on, for real, in headless Blender:
+
+    blender -b --factory-startup --python-exit-code 1 --python test_addon.py -- \
+        ADDON_PARENT BLENDTOOL SOURCE_DIR WORK_DIR
+
+Enables the add-on from the build tree, builds the hsu2006 Fig. 9 wheel
+(crossing cylinders with bulge elimination, cut by a cylinder, blended with a
+torus) with the add-on's own operators, meshes it, and checks: the Blender
+mesh is closed and 2-manifold; its volume matches `blendtool mesh` of the
+exported scene within 0.5 %; the exported scene is the paper's figure (same
+field as scenes/hsu2006-fig9-m1.json); changing one m moves only vertices
+within the later blend's reach; export -> import -> export gives the same
+file, for the wheel and for every scene in scenes/; bad scenes, broken trees
+and a broken library path are reported errors, not crashes.
+"""
+import glob
+import json
+import math
+import os
+import subprocess
+import sys
+
+import bpy
+import addon_utils
+import numpy as np
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+ADDON_PARENT, BLENDTOOL, SRC, WORK = argv[:4]
+os.makedirs(WORK, exist_ok=True)
+sys.path.insert(0, ADDON_PARENT)
+sys.path.insert(0, os.path.join(SRC, "tests", "mesh"))
+import meshcheck  # noqa: E402
+
+os.environ.pop("LIBBLEND_LIBRARY", None)  # the add-on's own lib/libblend.so
+mod = addon_utils.enable("libblend_blender", default_set=True)
+assert mod is not None, "the add-on did not enable"
+import libblend_blender as lbb  # noqa: E402
+from libblend_blender import binding, live, tree  # noqa: E402
+
+ok, msg = live.library_status()
+assert ok, msg
+print("library:", msg)
+lib = live.library()
+checks = 0
+
+
+def check(cond, what):
+    global checks
+    checks += 1
+    if not cond:
+        raise AssertionError(what)
+
+
+def activate(obj):
+    for o in bpy.context.view_layer.objects:
+        o.select_set(False)
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+
+
+def active():
+    return bpy.context.view_layer.objects.active
+
+
+def blender_mesh(obj):
+    me = obj.data
+    V = np.empty(3 * len(me.vertices), dtype=np.float32)
+    me.vertices.foreach_get("co", V)
+    tot = np.empty(len(me.polygons), dtype=np.int32)
+    me.polygons.foreach_get("loop_total", tot)
+    check(np.all(tot == 3), "all faces are triangles")
+    L = np.empty(len(me.loops), dtype=np.int32)
+    me.loops.foreach_get("vertex_index", L)
+    return V.reshape(-1, 3).astype(np.float64), L.reshape(-1, 3).astype(np.int64)
+
+
+def field(path_or_text, pts):
+    sc = lib.load_scene(path_or_text) if os.path.exists(path_or_text) else \
+        lib.parse_scene(path_or_text)
+    with sc, sc.compile() as ev:
+        return ev.eval(pts, gradient=False)[0]
+
+
+# ---------------------------------------------------------------- build the wheel
+bpy.ops.libblend.add_field(convention="zero", with_sphere=False)
+out = active()
+check(out.libblend.kind == "OUTPUT", "add_field made an output")
+out.libblend.live = False
+out.libblend.bounds_min = (-1.9, -1.9, -0.6)
+out.libblend.bounds_max = (1.9, 1.9, 0.6)
+out.libblend.preview_resolution = 64
+bpy.ops.libblend.add_blend(blend_type="displacement", op="union", wrap_selected=False)
+b1 = active()
+b1.libblend.r, b1.libblend.p = 0.3, 2.0
+bpy.ops.libblend.add_blend(blend_type="max", wrap_selected=False)
+mx = active()
+check(mx.parent == b1, "a blend added with a blend active goes under it")
+bpy.ops.libblend.add_blend(blend_type="displacement", op="union", wrap_selected=False)
+b2 = active()
+b2.libblend.r, b2.libblend.bulge = 0.3, True
+bpy.ops.libblend.add_primitive(prim_type="cylinder", rotation=(0, math.pi / 2, 0))
+cx = active()
+cx.libblend.radius = 0.18
+bpy.ops.libblend.add_primitive(prim_type="cylinder", rotation=(math.pi / 2, 0, 0))
+cy = active()
+cy.libblend.radius = 0.18
+check(cy.parent == b2 and tree.children(b2) == [cx, cy], "siblings in the order added")
+activate(mx)
+bpy.ops.libblend.add_primitive(prim_type="cylinder")
+active().libblend.radius = 1.45
+activate(b1)
+bpy.ops.libblend.add_primitive(prim_type="torus")
+tor = active()
+tor.libblend.major_radius, tor.libblend.minor_radius = 1.4, 0.2
+out.libblend.live = True
+activate(out)
+res = bpy.ops.libblend.update_mesh()
+check(res == {"FINISHED"}, "update_mesh finished")
+
+V1, F1 = blender_mesh(out)
+info = meshcheck.check(V1, F1)
+print("wheel at 64:", {k: info[k] for k in ("vertices", "triangles", "closed", "manifold",
+                                             "oriented", "volume", "euler")})
+check(info["triangles"] > 1000, "the wheel has a mesh")
+check(info["closed"] and info["manifold"] and info["oriented"], "closed, oriented 2-manifold")
+# smooth shading with the library's normals
+me = out.data
+sm = np.empty(len(me.polygons), dtype=bool)
+me.polygons.foreach_get("use_smooth", sm)
+check(sm.all(), "smooth shaded")
+me.calc_normals_split()
+ln = np.empty(3 * len(me.loops), dtype=np.float32)
+me.loops.foreach_get("normal", ln)
+ln = ln.reshape(-1, 3)
+with lib.parse_scene(tree.to_json(out)[0]) as sc, sc.compile() as ev:
+    _, g = ev.eval(V1[F1.reshape(-1)])
+gn = g / np.linalg.norm(g, axis=1)[:, None]
+cos = np.einsum("ij,ij->i", gn, ln)
+# the region's caps have the cap plane's normal, not the field's: skip loops on the region boundary
+on_cap = np.any(np.abs(np.abs(V1[F1.reshape(-1)]) - np.array([1.9, 1.9, 0.6])) < 1e-5, axis=1)
+print("loop normals vs analytic: min cos %.6f over %d loops" % (cos[~on_cap].min(), (~on_cap).sum()))
+check(cos[~on_cap].min() > 0.999, "split normals are the analytic ones")
+
+# ---------------------------------------------------------------- against blendtool
+wheel = os.path.join(WORK, "wheel.json")
+check(bpy.ops.libblend.export_scene(filepath=wheel) == {"FINISHED"}, "export_scene")
+
+
+def blendtool_volume(res):
+    ply = os.path.join(WORK, "wheel-%d.ply" % res)
+    subprocess.run([BLENDTOOL, "mesh", wheel, "-o", ply, "--resolution", str(res), "--quiet"],
+                   check=True)
+    Vb, _Nb, Fb = meshcheck.read(ply)
+    return meshcheck.check(Vb, Fb)["volume"]
+
+
+# the preview mesh moved into Blender loses nothing (float32 positions aside)
+vol64 = blendtool_volume(64)
+print("volume at 64 cells: blender %.7f, blendtool %.7f" % (info["volume"], vol64))
+check(abs(info["volume"] - vol64) < 1e-5 * vol64, "Blender's preview mesh = blendtool's at 64")
+# the render-resolution mesh against an independent finer blendtool run
+out.libblend.render_resolution = 128
+activate(out)
+check(bpy.ops.libblend.update_mesh(final=True) == {"FINISHED"}, "update_mesh at render resolution")
+Vf, Ff = blender_mesh(out)
+infof = meshcheck.check(Vf, Ff)
+check(infof["closed"] and infof["manifold"], "render-resolution mesh closed and manifold")
+vol256 = blendtool_volume(256)
+rel = abs(infof["volume"] - vol256) / vol256
+print("volume: blender (128 cells) %.6f, blendtool (256 cells) %.6f, rel %.2e"
+      % (infof["volume"], vol256, rel))
+check(rel < 0.005, "volume within 0.5 % of blendtool mesh")
+check(live.update_now(out)[0], "back to the preview mesh")
+
+# the add-on's wheel is the paper's figure (the committed scene file, m1 = 1)
+rng = np.random.default_rng(7)
+pts = rng.uniform([-1.9, -1.9, -0.6], [1.9, 1.9, 0.6], size=(4000, 3))
+fa, fb = field(wheel, pts), field(os.path.join(SRC, "scenes", "hsu2006-fig9-m1.json"), pts)
+print("wheel vs scenes/hsu2006-fig9-m1.json: max |df| %.3e" % np.abs(fa - fb).max())
+check(np.abs(fa - fb).max() < 1e-6, "same field as the paper's scene file")
+
+# ---------------------------------------------------------------- change one m
+cx.libblend.arg_override = True
+cx.libblend.arg_r, cx.libblend.arg_p, cx.libblend.arg_m = 0.3, 2.0, 0.3
+ok, msg = live.update_now(out)
+check(ok, msg)
+V2, F2 = blender_mesh(out)
+info2 = meshcheck.check(V2, F2)
+check(info2["closed"] and info2["manifold"], "still closed and manifold after the change")
+
+
+def nearest(A, B):
+    d = np.empty(len(A))
+    for i in range(0, len(A), 512):
+        a = A[i:i + 512]
+        d[i:i + 512] = np.sqrt(((a[:, None, :] - B[None, :, :]) ** 2).sum(-1)).min(1)
+    return d
+
+
+moved = np.concatenate([V2[nearest(V2, V1) > 1e-4], V1[nearest(V1, V2) > 1e-4]])
+# m changes the inner blend's reach on the later blend with the torus only: the
+# surface may move only where the torus is within that blend's range
+# (distance to the torus circle < minor (1 + r)), widened by one cell diagonal
+cell = 3.8 / 64
+dist = np.sqrt((np.hypot(moved[:, 0], moved[:, 1]) - 1.4) ** 2 + moved[:, 2] ** 2)
+print("m 1 -> 0.3: %d of %d vertices moved; farthest from the torus circle %.3f (allowed %.3f)"
+      % (len(moved), len(V1) + len(V2), dist.max() if len(dist) else 0, 0.2 * 1.3 + cell * 3 ** 0.5))
+check(len(moved) > 20, "changing m changed the mesh")
+check(dist.max() <= 0.2 * 1.3 + cell * 3 ** 0.5, "only the region the later blend reaches moved")
+inner = np.hypot(V2[:, 0], V2[:, 1]) < 0.9
+check(inner.sum() > 500 and nearest(V2[inner], V1).max() < 1e-4, "the hub is unchanged")
+fa = field(tree.to_json(out)[0], pts)
+fb = field(os.path.join(SRC, "scenes", "hsu2006-fig9-m0.3.json"), pts)
+check(np.abs(fa - fb).max() < 1e-6, "m1 = 0.3 is the paper's second wheel")
+
+# ---------------------------------------------------------------- export / import round trips
+def roundtrip(path, what):
+    n0 = len(bpy.data.objects)
+    check(bpy.ops.libblend.import_scene(filepath=path) == {"FINISHED"}, "import " + what)
+    imp = active()
+    check(imp.libblend.kind == "OUTPUT" and len(bpy.data.objects) > n0, "import built objects")
+    again = os.path.join(WORK, "again-" + os.path.basename(path))
+    activate(imp)
+    check(bpy.ops.libblend.export_scene(filepath=again) == {"FINISHED"}, "re-export " + what)
+    return imp, again
+
+
+imp, again = roundtrip(wheel, "wheel")
+with open(wheel) as f1, open(again) as f2:
+    check(json.load(f1) == json.load(f2), "export -> import -> export gives the same tree")
+Vi, Fi = blender_mesh(imp)
+check(len(Fi) == len(F1) and np.array_equal(Vi, V1), "the imported wheel meshes like the built one")
+for path in sorted(glob.glob(os.path.join(SRC, "scenes", "*.json"))):
+    sc = json.load(open(path))
+    imp, again = roundtrip(path, os.path.basename(path))
+    lo, hi = sc["bounds"]["min"], sc["bounds"]["max"]
+    P = rng.uniform(lo, hi, size=(1000, 3))
+    d = np.abs(field(path, P) - field(again, P))
+    scale = np.maximum(1.0, np.abs(field(path, P)))
+    print("round trip %-36s %3d objects, max |df| %.2e" % (os.path.basename(path),
+                                                          len(imp.children_recursive), (d / scale).max()))
+    check((d / scale).max() < 1e-6, "round trip keeps the field of " + path)
+    again2 = again + ".2.json"
+    activate(imp)
+    bpy.ops.libblend.import_scene(filepath=again)
+    activate(active())
+    bpy.ops.libblend.export_scene(filepath=again2)
+    check(json.load(open(again)) == json.load(open(again2)), "stable second round trip " + path)
+
+# ---------------------------------------------------------------- POV-Ray export
+pov = os.path.join(WORK, "wheel.pov")
+activate(out)
+check(bpy.ops.libblend.export_pov(filepath=pov) == {"FINISHED"}, "export_pov")
+text = open(pov).read()
+check("isosurface" in text and "max_gradient" in text, "a POV-Ray isosurface scene")
+check(os.path.exists(os.path.join(WORK, "libblend.inc")), "libblend.inc copied next to it")
+r = subprocess.run(["povray", "+I" + pov, "+O" + pov + ".png", "+W64", "+H48", "-D", "-V", "-GA"],
+                   capture_output=True, text=True, cwd=WORK)
+check(r.returncode == 0 and os.path.exists(pov + ".png"), "POV-Ray renders the export: " + r.stderr[-500:])
+
+# ---------------------------------------------------------------- errors are reports
+bad = os.path.join(WORK, "bad.json")
+with open(bad, "w") as f:
+    f.write('{"format": "libblend-scene", "version": 1,\n "convention": "zero", "root": {"type": }}')
+n0 = len(bpy.data.objects)
+try:
+    bpy.ops.libblend.import_scene(filepath=bad)
+    check(False, "a bad scene must fail")
+except RuntimeError as e:
+    print("bad scene:", e)
+    check("bad.json:2:" in str(e) and "invalid JSON" in str(e), "message names file:line:col")
+check(len(bpy.data.objects) == n0, "a failed import creates nothing")
+missing = os.path.join(WORK, "nope.json")
+try:
+    bpy.ops.libblend.import_scene(filepath=missing)
+    check(False, "a missing file must fail")
+except RuntimeError as e:
+    check("nope.json" in str(e), "message names the missing file")
+
+# a tree the library rejects: a conic blend takes two arguments
+activate(b1)
+bpy.ops.libblend.add_blend(blend_type="conic", wrap_selected=False)
+conic = active()
+for i in range(3):
+    activate(conic)
+    bpy.ops.libblend.add_primitive(prim_type="sphere", location=(0, 0, 0.1 * i))
+activate(out)
+try:
+    bpy.ops.libblend.update_mesh()
+    check(False, "a 3-argument conic must fail")
+except RuntimeError as e:
+    print("bad tree:", e)
+    check("object '%s'" % conic.name in str(e) and "$.root.args[2]" in str(e),
+          "the message names the object and the JSON path")
+# an empty blend: the tree itself is refused, before the library
+for c in list(conic.children):
+    bpy.data.objects.remove(c)
+ok, msg = live.update_now(out)
+print("empty blend:", msg)
+check(not ok and conic.name in msg and "no arguments" in msg, "empty blend reported")
+bpy.data.objects.remove(conic)
+check(live.update_now(out)[0], "the wheel meshes again once the bad node is gone")
+
+# a broken library path: reported by the UI status and the operators, no crash
+os.environ["LIBBLEND_LIBRARY"] = os.path.join(WORK, "no-such", "libblend.so")
+ok, msg = live.reload_library()
+print("missing library:", msg)
+check(not ok and "not found" in msg and "no-such" in msg and "LIBBLEND_LIBRARY" in msg,
+      "missing library message")
+try:
+    bpy.ops.libblend.update_mesh()
+    check(False, "meshing without a library must fail")
+except RuntimeError as e:
+    check("not found" in str(e), "update_mesh reports the missing library")
+libm = [p for p in glob.glob("/usr/lib/x86_64-linux-gnu/libm.so.6") + glob.glob("/lib/*/libm.so.6")][0]
+os.environ["LIBBLEND_LIBRARY"] = libm
+ok, msg = live.reload_library()
+print("wrong library:", msg)
+check(not ok and "is not libblend" in msg, "a library that is not libblend is named")
+del os.environ["LIBBLEND_LIBRARY"]
+check(live.reload_library()[0], "the library loads again")
+
+# live path: mark dirty + the timer function, as Blender's main loop would run it
+live.DEBOUNCE = 0.0
+b1.libblend.r = 0.25  # the update callback marks the field dirty
+check(live.state_of(out).dirty, "a setting change marks the field dirty")
+import time  # noqa: E402
+t0 = time.perf_counter()
+while live.tick() is not None and time.perf_counter() - t0 < 30:
+    time.sleep(0.002)
+st = live.state_of(out)
+check(not st.error and not st.dirty and st.job is None, "the live job finished: " + st.status)
+V3, F3 = blender_mesh(out)
+check(not np.array_equal(V3, V2), "the live update changed the mesh")
+
+# a primitive's transform (what G / R / S in the viewport do): the depsgraph handler sees it
+st.status = ""
+tor.location.z += 0.05
+bpy.context.view_layer.update()
+check(live.state_of(out).dirty, "moving a primitive marks its field dirty")
+while live.tick() is not None:
+    time.sleep(0.002)
+V4, _ = blender_mesh(out)
+check(V4[:, 2].max() > V3[:, 2].max() + 0.04 or V4[:, 2].max() >= 0.6 - 1e-6,
+      "the mesh followed the torus")
+# a deleted primitive changes the tree's structure: remeshed too
+check(not live.state_of(out).dirty, "idle")
+bpy.data.objects.remove(tor)
+bpy.context.view_layer.update()
+check(live.state_of(out).dirty, "deleting a node marks its field dirty")
+while live.tick() is not None:
+    time.sleep(0.002)
+V5, F5 = blender_mesh(out)
+check(np.hypot(V5[:, 0], V5[:, 1]).max() < 1.45 + 1e-6, "without the torus the rim is the cut cylinder")
+
+addon_utils.disable("libblend_blender")
+print("test_addon: %d checks passed" % checks)
