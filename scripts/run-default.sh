@@ -15,3 +15,5 @@ echo "# value gx gy gz along the y axis, through the cube and the blended super-
 for y in -1.2 -0.9 0 0.9 1.0 1.1 1.35 1.9 2.1; do echo "0 $y 0"; done |
   "$blendtool" eval scenes/default.json
 "$blendtool" mesh scenes/default.json -o build-release/default.ply --resolution 256
+echo "# the Blender add-on, ready to install (Preferences > Add-ons > Install):"
+ls build-release/blender_addon/libblend_blender-*.zip

@@ -3,13 +3,17 @@ and on demand (synchronously).
 
 Flow of a live update: a setting's update callback or a transform change
 seen by the depsgraph handler calls mark_dirty(); a timer on Blender's main
-loop waits DEBOUNCE seconds after the last edit, reads the tree into scene
-JSON (main thread: bpy data is only touched there), and starts a worker
-thread that parses, compiles and meshes it in libblend (ctypes releases the
-GIL, so Blender stays responsive). An edit during a run cancels that run
+loop reads the tree into scene JSON (main thread: bpy data is only touched
+there) and starts a worker thread that parses, compiles and meshes it in
+libblend (ctypes releases the GIL, so Blender stays responsive). Edits made
+while a run is in flight are coalesced into one next run with the newest
+state (so dragging a slider remeshes at the mesher's pace, never queues);
+a run older than CANCEL_AFTER with newer edits waiting is cancelled
 (CancelToken, polled by the C mesher). The timer moves a finished mesh into
-the Blender mesh with foreach_set (no per-vertex Python). The library never
-calls back into Python.
+the Blender mesh with foreach_set (no per-vertex Python), with Blender's
+smooth normals; libblend's analytic normals (custom split normals, the
+costly part) follow once the field has been idle for NORMALS_IDLE. The
+library never calls back into Python.
 """
 import os
 import threading
@@ -19,8 +23,9 @@ import bpy
 
 from . import binding, tree
 
-DEBOUNCE = 0.03       # seconds of quiet after an edit before a live remesh starts
-TICK = 0.01           # timer period while work is pending
+TICK = 0.005          # timer period while work is pending
+CANCEL_AFTER = 0.2    # a run this old is cancelled when newer edits wait
+NORMALS_IDLE = 0.3    # seconds without edits before analytic normals are set
 AUTO_ANALYTIC = 250000  # "Auto" normals: analytic below this many triangles
 
 _lib = None
@@ -37,6 +42,8 @@ class _State:
         self.status = ""
         self.error = False
         self.last = {}  # timings of the last update (seconds)
+        self.normals = None  # analytic normals waiting to be set (live updates)
+        self.t_applied = 0.0
 
 
 class _Job:
@@ -118,8 +125,21 @@ def mesh_text(text, name, bmin, bmax, resolution, open_boundary=False, nthreads=
 
 # --------------------------------------------------------------------------- mesh data
 
+def wants_analytic(normals, ntriangles):
+    return normals == "ANALYTIC" or (normals == "AUTO" and ntriangles < AUTO_ANALYTIC)
+
+
+def set_normals(me, normals):
+    """libblend's normals (one per vertex) as custom split normals."""
+    if hasattr(me, "use_auto_smooth"):  # Blender < 4.1
+        me.use_auto_smooth = True
+        me.auto_smooth_angle = 3.14159
+    me.normals_split_custom_set_from_vertices(normals)
+
+
 def set_mesh_data(me, mesh, normals="AUTO"):
-    """Replace me's geometry by the libblend mesh (numpy arrays, foreach_set)."""
+    """Replace me's geometry by the libblend mesh (numpy arrays, foreach_set).
+    normals: AUTO / ANALYTIC / FACES (props.LB_ObjectSettings.normals)."""
     import numpy as np
     nv, nt = len(mesh.positions), len(mesh.triangles)
     me.clear_geometry()
@@ -136,11 +156,10 @@ def set_mesh_data(me, mesh, normals="AUTO"):
             pass
         me.update(calc_edges=True)
         me.polygons.foreach_set("use_smooth", np.ones(nt, dtype=bool))
-        if normals == "ANALYTIC" or (normals == "AUTO" and nt < AUTO_ANALYTIC):
-            if hasattr(me, "use_auto_smooth"):  # Blender < 4.1
-                me.use_auto_smooth = True
-                me.auto_smooth_angle = 3.14159
-            me.normals_split_custom_set_from_vertices(mesh.normals)
+        if wants_analytic(normals, nt):
+            set_normals(me, mesh.normals)
+        elif hasattr(me, "use_auto_smooth"):
+            me.use_auto_smooth = False
     me.update()
 
 
@@ -170,12 +189,18 @@ def prepare(output, resolution):
                 output.libblend.open_boundary, threads(), paths)
 
 
-def _finish(output, st, job, t_start):
+def _finish(output, st, job, t_start, defer_normals=False):
     if job.error:
         st.status, st.error = job.error, True
         return False
     t0 = time.perf_counter()
-    set_mesh_data(output.data, job.mesh, output.libblend.normals)
+    mode = output.libblend.normals
+    st.normals = None
+    if defer_normals and wants_analytic(mode, len(job.mesh.triangles)):
+        st.normals = job.mesh.normals
+        mode = "FACES"
+    set_mesh_data(output.data, job.mesh, mode)
+    st.t_applied = time.perf_counter()
     st.last = {"mesh": job.seconds, "apply": time.perf_counter() - t0,
                "total": time.perf_counter() - t_start}
     st.status = "%d triangles, %d cells, %.0f ms (libblend %.0f ms)" % (
@@ -210,8 +235,6 @@ def mark_dirty(obj):
     st = _state(out.name)
     st.dirty = True
     st.t_edit = time.perf_counter()
-    if st.job:
-        st.job.cancel.cancel()  # obsolete: start again after the debounce
     _ensure_timer()
 
 
@@ -223,10 +246,10 @@ def _ensure_timer():
 
 
 def tick():
-    """The timer: start debounced jobs, move finished meshes in. Returns the
-    next interval, or None when nothing is pending (timer stops)."""
+    """The timer: start coalesced jobs, move finished meshes in, set analytic
+    normals once idle. Returns the next interval, or None when nothing is
+    pending (the timer stops)."""
     global _timer_on
-    now = time.perf_counter()
     pending = False
     for name in list(_states):
         st = _states[name]
@@ -236,18 +259,18 @@ def tick():
                 st.job.cancel.cancel()
             del _states[name]
             continue
+        now = time.perf_counter()
         if st.job is not None:
             if st.job.done.is_set():
                 job, st.job = st.job, None
                 if not job.cancel.cancelled:
-                    _finish(out, st, job, job.t_start)
+                    _finish(out, st, job, job.t_start, defer_normals=True)
             else:
+                if st.dirty and now - st.job.t_start > CANCEL_AFTER:
+                    st.job.cancel.cancel()  # obsolete and slow: the newest state goes next
                 pending = True
                 continue
         if st.dirty:
-            if now - st.t_edit < DEBOUNCE:
-                pending = True
-                continue
             st.dirty = False
             try:
                 job = prepare(out, out.libblend.preview_resolution)
@@ -258,6 +281,13 @@ def tick():
             st.job = job
             threading.Thread(target=job.run, name="libblend-mesh", daemon=True).start()
             pending = True
+        elif st.normals is not None:
+            if now - st.t_applied >= NORMALS_IDLE:
+                set_normals(out.data, st.normals)
+                out.data.update()
+                st.normals = None
+            else:
+                pending = True
     if not pending:
         _timer_on = False
         return None

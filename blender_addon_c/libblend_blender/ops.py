@@ -140,6 +140,8 @@ class LIBBLEND_OT_add_blend(bpy.types.Operator):
             self.report({"ERROR"}, "select a libblend field or one of its nodes first")
             return {"CANCELLED"}
         sel = [o for o in _selected(context) if tree.is_node(o)] if self.wrap_selected else []
+        if sel == [a] and a.libblend.kind == "BLEND":
+            sel = []  # a lone active blend: the new blend becomes its argument
         if sel:
             parent = sel[0].parent
             if any(o.parent != parent for o in sel):
