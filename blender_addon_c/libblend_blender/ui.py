@@ -190,6 +190,30 @@ class LIBBLEND_MT_add(bpy.types.Menu):
         layout.operator_menu_enum("libblend.add_blend", "blend_type", text="Blend")
 
 
+class LIBBLEND_MT_object(bpy.types.Menu):
+    """Object > libblend: every libblend command, so F3 menu search finds them all."""
+    bl_label = "libblend"
+    bl_idname = "LIBBLEND_MT_object"
+
+    def draw(self, context):
+        layout = self.layout
+        layout.operator("libblend.update_mesh", text="Update Mesh").final = False
+        layout.operator("libblend.update_mesh", text="Update Mesh at Render Resolution").final = True
+        layout.operator_menu_enum("libblend.add_blend", "blend_type", text="Blend Selected")
+        layout.operator("libblend.add_bound")
+        layout.operator("libblend.move_argument", text="Move Argument Up").direction = "UP"
+        layout.operator("libblend.move_argument", text="Move Argument Down").direction = "DOWN"
+        layout.separator()
+        layout.operator("libblend.import_scene")
+        layout.operator("libblend.export_scene")
+        layout.operator("libblend.export_pov")
+        layout.operator("libblend.reload_library")
+
+
+def _menu_object(self, context):
+    self.layout.menu(LIBBLEND_MT_object.bl_idname)
+
+
 def _menu_add(self, context):
     self.layout.menu(LIBBLEND_MT_add.bl_idname, icon="META_BALL")
 
@@ -203,6 +227,6 @@ def _menu_export(self, context):
     self.layout.operator("libblend.export_pov", text="libblend POV-Ray Scene (.pov)")
 
 
-CLASSES = [LIBBLEND_AP_preferences, LIBBLEND_PT_panel, LIBBLEND_MT_add]
-MENUS = [("VIEW3D_MT_add", _menu_add), ("TOPBAR_MT_file_import", _menu_import),
+CLASSES = [LIBBLEND_AP_preferences, LIBBLEND_PT_panel, LIBBLEND_MT_add, LIBBLEND_MT_object]
+MENUS = [("VIEW3D_MT_add", _menu_add), ("VIEW3D_MT_object", _menu_object), ("TOPBAR_MT_file_import", _menu_import),
          ("TOPBAR_MT_file_export", _menu_export)]

@@ -362,5 +362,82 @@ while live.tick() is not None:
 V5, F5 = blender_mesh(out)
 check(np.hypot(V5[:, 0], V5[:, 1]).max() < 1.45 + 1e-6, "without the torus the rim is the cut cylinder")
 
+# ---------------------------------------------------------------- UI code, drawn into a recorder
+class Recorder:
+    """Stands in for bpy's UILayout: checks every property and operator a
+    draw function names exists (background Blender draws no UI)."""
+    drawn = []
+
+    def __init__(self):
+        self.alert = False
+
+    def _sub(self, *a, **k):
+        return Recorder()
+    row = column = box = split = _sub
+
+    def prop(self, data, attr, **k):
+        check(attr in data.bl_rna.properties, "UI draws an existing property: " + attr)
+        Recorder.drawn.append(attr)
+
+    def operator(self, idname, **k):
+        mod_, name = idname.split(".")
+        check(hasattr(getattr(bpy.ops, mod_), name), "UI names an existing operator: " + idname)
+        Recorder.drawn.append(idname)
+        return type("Props", (), {})()
+
+    def operator_menu_enum(self, idname, prop, **k):
+        self.operator(idname)
+        rna = getattr(bpy.ops.libblend, idname.split(".")[1]).get_rna_type()
+        check(prop in rna.properties, "menu enum property exists: " + prop)
+
+    def label(self, **k):
+        pass
+
+    def separator(self, **k):
+        pass
+
+    def menu(self, idname, **k):
+        check(hasattr(bpy.types, idname), "menu exists: " + idname)
+
+
+def draw(cls, obj):
+    activate(obj) if obj is not None else None
+    methods = {k: v for k, v in vars(cls).items() if callable(v)}
+    fake = type("Self", (), dict(methods, layout=Recorder()))()
+    fake.draw(bpy.context)
+
+
+out2 = bpy.data.objects.new("ui field", bpy.data.meshes.new("ui field"))
+bpy.context.collection.objects.link(out2)
+out2.libblend.kind = "OUTPUT"
+activate(out2)
+bpy.ops.libblend.add_blend(blend_type="bounded", wrap_selected=False)
+bb = active()
+bpy.ops.libblend.add_primitive(prim_type="sphere")
+sp = active()
+sp.libblend.arg_override = True
+bpy.ops.libblend.add_bound()
+bound = active()
+check(bound.libblend.role == "BOUND" and bound.parent == sp, "add_bound makes a bounding solid")
+activate(sp)
+bpy.ops.libblend.add_primitive(prim_type="capsule")
+cap = active()
+bpy.ops.libblend.add_bound()
+activate(cap)
+bpy.ops.libblend.move_argument(direction="UP")
+check(tree.children(bb) == [cap, sp], "move_argument reorders")
+ok, msg = live.update_now(out2)
+check(ok, "a bounded blend built in the UI meshes: " + msg)
+check('"bounds"' in tree.to_json(out2)[0], "bounding solids exported")
+for obj in (None, out2, bb, sp, bound, cap, out, cx, b1):
+    for cls in (lbb.ui.LIBBLEND_PT_panel, lbb.ui.LIBBLEND_MT_add, lbb.ui.LIBBLEND_MT_object):
+        draw(cls, obj)
+b2.libblend.bulge = True
+draw(lbb.ui.LIBBLEND_PT_panel, b2)
+fake = type("Prefs", (), {"layout": Recorder(), "bl_rna": live.prefs().bl_rna})()
+lbb.ui.LIBBLEND_AP_preferences.draw(fake, bpy.context)
+check({"bounds_min", "preview_resolution", "radius", "arg_r", "bulge_omega",
+       "libblend.update_mesh", "libblend.export_pov"} <= set(Recorder.drawn), "the panel shows them")
+
 addon_utils.disable("libblend_blender")
 print("test_addon: %d checks passed" % checks)
