@@ -1,5 +1,7 @@
 """The add-on zip installs the way a user installs it (Preferences > Add-ons >
-Install) and works from the installed copy, with its bundled library:
+Install) and works from the installed copy, with its bundled library; undo /
+redo restore settings and meshes; settings survive saving and reopening the
+.blend file:
 
     BLENDER_USER_SCRIPTS=DIR blender -b --factory-startup --python-exit-code 1 \
         --python test_install_zip.py -- ZIP
@@ -27,6 +29,47 @@ assert ok and live.library().path.startswith(installed), msg
 assert bpy.ops.libblend.add_field() == {"FINISHED"}
 out = bpy.context.view_layer.objects.active
 assert len(out.data.polygons) > 1000, "the default sphere is meshed"
+n_sphere = len(out.data.polygons)
+from libblend_blender import tree  # noqa: E402
+
+# undo / redo: an edit of a setting, then of the tree
+bpy.ops.ed.undo_push(message="field added")
+sph = out.children[0]
+sph.libblend.radius = 1.5
+ok, msg = live.update_now(out)
+assert ok and len(out.data.polygons) > n_sphere, msg
+bpy.ops.ed.undo_push(message="radius")
+out.select_set(False)
+sph.select_set(True)
+bpy.context.view_layer.objects.active = sph
+bpy.ops.libblend.add_blend(blend_type="displacement", op="union")  # wraps the selected sphere
+assert bpy.context.view_layer.objects.active.libblend.kind == "BLEND"
+bpy.ops.ed.undo_push(message="blend")  # what the UNDO flag does after an operator in the UI
+n_objects = len(bpy.data.objects)
+bpy.ops.ed.undo()
+assert len(bpy.data.objects) == n_objects - 1, "undo removes the blend"
+bpy.ops.ed.undo()
+out = bpy.data.objects["libblend field"]
+assert out.children[0].libblend.radius == 1.0, "undo restores the radius"
+assert len(out.data.polygons) == n_sphere, "undo restores the mesh with it"
+assert live.state_of(out).dirty, "undo marks the field for a remesh"
+bpy.ops.ed.redo()
+out = bpy.data.objects["libblend field"]
+assert out.children[0].libblend.radius == 1.5, "redo"
+
+# settings are saved in the .blend
+out.libblend.preview_resolution = 40
+out.children[0].libblend.prim_type = "torus"
+before = tree.to_json(out)[0]
+path = os.path.join(os.path.dirname(scripts), "saved.blend")
+bpy.ops.wm.save_as_mainfile(filepath=path)
+bpy.ops.wm.read_homefile(use_factory_startup=True)
+assert "libblend field" not in bpy.data.objects
+bpy.ops.wm.open_mainfile(filepath=path)
+out = bpy.data.objects["libblend field"]
+assert out.libblend.preview_resolution == 40 and tree.to_json(out)[0] == before, "saved tree"
+ok, msg = live.update_now(out)
+assert ok, msg
 addon_utils.disable("libblend_blender")
-print("test_install_zip: installed from %s, %d triangles" % (os.path.basename(zip_path),
-                                                          len(out.data.polygons)))
+print("test_install_zip: installed from %s; undo, redo, save and reopen hold"
+      % os.path.basename(zip_path))
