@@ -186,6 +186,15 @@ notlib = os.path.join(WORK, "garbage.so")
 with open(notlib, "wb") as f:
     f.write(b"not an ELF file")
 raises(lambda: binding.load(notlib), binding.LibraryError, "could not be loaded")
+# a libblend of another version: a stub library with only lb_version
+stub_dir = os.path.join(WORK, "stub")
+os.makedirs(stub_dir, exist_ok=True)
+with open(os.path.join(stub_dir, "v.c"), "w") as f:
+    f.write("int lb_version(void) { return 20304; }\n")
+subprocess.run(["cc", "-shared", "-fPIC", "-o", os.path.join(stub_dir, "libblend.so"),
+                os.path.join(stub_dir, "v.c")], check=True)
+raises(lambda: binding.load(os.path.join(stub_dir, "libblend.so")), binding.LibraryError,
+       "is libblend 2.3.4 but this add-on needs 0.1.x", "lb_scene_parse")
 os.environ[binding.ENV_LIBRARY] = os.path.join(WORK, "env", "libblend.so")
 raises(lambda: binding.load(), binding.LibraryError, "LIBBLEND_LIBRARY")
 del os.environ[binding.ENV_LIBRARY]

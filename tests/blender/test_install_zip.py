@@ -70,6 +70,24 @@ out = bpy.data.objects["libblend field"]
 assert out.libblend.preview_resolution == 40 and tree.to_json(out)[0] == before, "saved tree"
 ok, msg = live.update_now(out)
 assert ok, msg
+
+# a final render meshes at render resolution, then the preview comes back
+n_preview = len(out.data.polygons)
+out.libblend.render_resolution = 96
+seen = []
+bpy.app.handlers.render_post.append(lambda *a: seen.append(len(out.data.polygons)))
+scene = bpy.context.scene
+scene.render.engine = "BLENDER_WORKBENCH"
+scene.render.resolution_x, scene.render.resolution_y = 32, 24
+scene.render.filepath = os.path.join(os.path.dirname(scripts), "render.png")
+cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
+scene.collection.objects.link(cam)
+cam.location = (0, -6, 0)
+cam.rotation_euler = (1.5708, 0, 0)
+scene.camera = cam
+bpy.ops.render.render(write_still=True)
+assert seen and seen[0] > 2 * n_preview, "rendered at render resolution: %r vs %d" % (seen, n_preview)
+assert len(out.data.polygons) == n_preview, "preview mesh restored after the render"
 addon_utils.disable("libblend_blender")
 print("test_install_zip: installed from %s; undo, redo, save and reopen hold"
       % os.path.basename(zip_path))
