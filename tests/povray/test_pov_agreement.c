@@ -71,12 +71,19 @@ static void farray(const char *name, size_t k, const double *v) {
 }
 
 static void displacement_cases(rng *g) {
-    static const char *const fams[3] = {"displacement union", "displacement intersection",
-                                        "displacement difference"};
-    for (int set = 0; set < 600; ++set) {
-        const int op = set % 3;
-        const size_t k = 1 + (size_t)(unit(g) * 16);
-        double a[16], b[16], r[16], p[16], m[16];
+    /* three kinds of sets in turn: up to 16 arguments; p = 2 everywhere (the
+     * macro's exact active-set path); 17 to 48 arguments (the path that
+     * evaluates the arguments again at every step) */
+    static const char *const fams[3][3] = {
+        {"displacement union", "displacement intersection", "displacement difference"},
+        {"displacement union, all p = 2", "displacement intersection, all p = 2",
+         "displacement difference, all p = 2"},
+        {"displacement union, 17-48 args", "displacement intersection, 17-48 args",
+         "displacement difference, 17-48 args"}};
+    for (int set = 0; set < 1800; ++set) {
+        const int op = set % 3, kind = (set / 3) % 3, all2 = kind == 1;
+        const size_t k = kind == 2 ? 17 + (size_t)(unit(g) * 32) : 1 + (size_t)(unit(g) * 16);
+        double a[48], b[48], r[48], p[48], m[48];
         const double scale = logu(g, 0.01, 10.0);
         const int tie = set % 7 == 0, alone = set % 11 == 0;
         for (size_t i = 0; i < k; ++i) {
@@ -84,7 +91,7 @@ static void displacement_cases(rng *g) {
             b[i] = tie ? 0.0 : scale * range(g, -1.0, 1.0);
             if (alone && i > 0) b[i] += 50.0 * scale * (op == 1 ? -1 : 1); /* one active term */
             r[i] = scale * logu(g, 0.05, 1.0);
-            p[i] = rand_p(g);
+            p[i] = all2 ? 2.0 : rand_p(g);
             m[i] = logu(g, 0.05, 20.0);
         }
         args_array("A", k, a, b);
@@ -94,14 +101,14 @@ static void displacement_cases(rng *g) {
         fprintf(pov, "#declare G = LB_Displacement(%d, A, R, P, M)\n", op);
         for (int q = 0; q < 5; ++q) {
             const double x = scale * range(g, -1.0, 1.0);
-            double d[16], v;
+            double d[48], v;
             for (size_t i = 0; i < k; ++i) d[i] = x * a[i] + b[i];
             lb_error e;
             if (lb_displacement((lb_setop)op, k, d, r, p, m, &v, NULL, &e)) {
                 fprintf(stderr, "%s\n", e.message);
                 exit(1);
             }
-            record(fams[op], "G", x, 0, 0, v);
+            record(fams[kind][op], "G", x, 0, 0, v);
         }
         fprintf(pov, "#undef G\n#undef A\n");
     }

@@ -1061,6 +1061,113 @@ static void bulge(int steps) {
       "z - lbe)) / (2 * lbe)) }\n#end\n\n");
 }
 
+/* LB_Displacement beyond KMAX arguments: more values than a POV-Ray
+ * function takes parameters (56), so the solver carries only (h, x, y, z)
+ * and every step evaluates the argument functions again (#for inside the
+ * function bodies). The same Newton recurrence as the KMAX path; it costs
+ * about 2 K argument calls per step. */
+static void displacement_many(int steps) {
+    /* argument i's value, dualised: sign * F[i](x, y, z) */
+    static const char *const arg = "(#if (I = 0) lbSG #else lbSO #end * F[I](x, y, z))";
+    w("  #local lbSG = select(Op - 1, 1, -1, -1);\n"
+      "  #local lbSO = select(abs(Op - 1), -1, -1, 1);\n");
+    w("  #local lbFS = function(lbh, x, y, z) {\n    (-1 #for (I, 0, K - 1) #if (P[I] = 2) + "
+      "max(0, (R[I] - %s + M[I] * lbh) / R[I]) * max(0, (R[I] - %s + M[I] * lbh) / R[I]) #else + "
+      "pow(max(0, (R[I] - %s + M[I] * lbh) / R[I]), P[I]) #end #end)\n",
+      arg, arg, arg);
+    w("    / (0 #for (I, 0, K - 1) #if (P[I] = 2) + (2 * M[I] / R[I]) * max(0, (R[I] - %s + M[I] "
+      "* lbh) / R[I]) #else + (P[I] * M[I] / R[I]) * ((R[I] - %s + M[I] * lbh) / R[I] > 0) * "
+      "pow(max(0, (R[I] - %s + M[I] * lbh) / R[I]), P[I] - 1) #end #end) }\n",
+      arg, arg, arg);
+    w("  #local lbFE%d = function(lbh, lbs, lbl, x, y, z) { lbh }\n", steps);
+    for (int n = steps - 1; n >= 0; --n)
+        w("  #local lbFE%d = function(lbh, lbs, lbl, x, y, z) { select(abs(lbs) - %.17g * (1 + "
+          "abs(lbh)), lbh - lbs, lbh - lbs, lbFE%d(max(lbl, lbh - lbs), lbFS(max(lbl, lbh - lbs), "
+          "x, y, z), lbl, x, y, z)) }\n",
+          n, TOL, n + 1);
+    w("  #local lbFB = function(lbh, lbl, x, y, z) { lbFE0(lbh, lbFS(lbh, x, y, z), lbl, x, y, z) "
+      "}\n");
+    w("  function(x, y, z) { lbSG * lbFB(min(#for (I, 0, K - 1) #if (I > 0), #end %s / M[I] "
+      "#end), min(#for (I, 0, K - 1) #if (I > 0), #end (%s - R[I]) / M[I] #end), x, y, z) }\n",
+      arg, arg);
+}
+
+/* "lbb0, lbb1, ..." (the K in use) */
+static void blist(void) {
+    w("lbb0");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), lbb%d #end", i, i);
+}
+
+/* LB_Displacement with every p = 2, mirroring bt_two in
+ * libblend/src/operators/displacement.c: T is piecewise quadratic between
+ * the breakpoints b_i = (d_i - r_i)/m_i. From h = min d/m with the terms
+ * active there (b_i < h), the larger root hq of that active set's quadratic
+ * is the answer unless an active term has b_i > hq; then h moves to the
+ * largest such b_i (which drops it) and the next pass solves again. At most
+ * K + 1 passes, one or two in practice; exact, no tolerance. */
+static void displacement_p2(void) {
+    w("  #local lbC2 = array[%d]; #for (I, 0, %d) #local lbC2[I] = (lbM[I] / lbR[I]) * (lbM[I] / "
+      "lbR[I]); #end\n",
+      KMAX, KMAX - 1);
+    /* hq from the active set's sums A = sum c^2, B = sum c^2 (h - b), C = sum c^2 (h - b)^2 */
+    w("  #local lbQ2 = function(lbh, lbA, lbBs, lbC) { lbh + select(lbC - 1, 0, 0, "
+      "select(lbBs * lbBs - lbA * (lbC - 1), -1e300, -(lbC - 1) / (lbBs + sqrt(lbBs * lbBs - lbA "
+      "* (lbC - 1))), -(lbC - 1) / (lbBs + sqrt(lbBs * lbBs - lbA * (lbC - 1))))) }\n");
+    w("  #local lbQ = function(lbh, ");
+    blist();
+    w(") { lbQ2(lbh, 0");
+    for (int i = 0; i < KMAX; ++i) w(" #if (K > %d) + (lbb%d < lbh) * lbC2[%d] #end", i, i, i);
+    w(", 0");
+    for (int i = 0; i < KMAX; ++i)
+        w(" #if (K > %d) + (lbb%d < lbh) * lbC2[%d] * (lbh - lbb%d) #end", i, i, i, i);
+    w(", 0");
+    for (int i = 0; i < KMAX; ++i)
+        w(" #if (K > %d) + (lbb%d < lbh) * lbC2[%d] * (lbh - lbb%d) * (lbh - lbb%d) #end", i, i, i,
+          i, i);
+    w(") }\n");
+    w("  #local lbAP%d = function(lbh, ", KMAX + 1);
+    blist();
+    w(") { lbh }\n");
+    for (int n = KMAX; n >= 0; --n) {
+        /* X: hq is the answer when no active term lies right of it (bd = -1e300) */
+        w("  #local lbAX%d = function(lbhq, lbbd, ", n);
+        blist();
+        w(") { select(lbbd + 1e299, lbhq, lbhq, lbAP%d(lbbd, ", n + 1);
+        blist();
+        w(")) }\n");
+        w("  #local lbAN%d = function(lbhq, lbh, ", n);
+        blist();
+        w(") { lbAX%d(lbhq, max(-1e300", n);
+        for (int i = 0; i < KMAX; ++i)
+            w(" #if (K > %d), select((lbb%d > lbhq) * (lbb%d < lbh) - 0.5, -1e300, lbb%d) #end", i,
+              i, i, i);
+        w("), ");
+        blist();
+        w(") }\n");
+        w("  #local lbAP%d = function(lbh, ", n);
+        blist();
+        w(") { lbAN%d(lbQ(lbh, ", n);
+        blist();
+        w("), lbh, ");
+        blist();
+        w(") }\n");
+    }
+    w("  #local lbAC = function(lbhi, lbl, ");
+    blist();
+    w(") { max(lbl, min(lbhi, lbAP0(lbhi, ");
+    blist();
+    w("))) }\n");
+    w("  #local lbB = function(");
+    dlist();
+    w(") { lbAC(min(lbd0 / lbM[0], 1e300");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), lbd%d / lbM[%d] #end", i, i, i);
+    w("), min((lbd0 - lbR[0]) / lbM[0], 1e300");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), (lbd%d - lbR[%d]) / lbM[%d] #end", i, i, i, i);
+    w("), (lbd0 - lbR[0]) / lbM[0]");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), (lbd%d - lbR[%d]) / lbM[%d] #end", i, i, i, i);
+    w(") }\n");
+}
+
 /* LB_Displacement(Op, F, R, P, M): BT_k by unrolled CPS Newton. */
 static void displacement(int steps) {
     w("// ---- displacement blends BT_k (hsu2006; m = 1 everywhere is Rockwood's) ----\n"
@@ -1074,14 +1181,19 @@ static void displacement(int steps) {
       "  #local K = dimension_size(F, 1);\n"
       "  #if (K < 1 | K > %d) #error \"LB_Displacement: 1 to %d functions\" #end\n"
       "  #if (dimension_size(R, 1) != K | dimension_size(P, 1) != K | dimension_size(M, 1) != K)\n"
-      "    #error \"LB_Displacement: R, P and M need one value per function\"\n  #end\n",
-      KMAX, KMAX);
+      "    #error \"LB_Displacement: R, P and M need one value per function\"\n  #end\n"
+      "  #if (K > %d)\n",
+      LB_MAX_ARITY, LB_MAX_ARITY, KMAX);
+    displacement_many(steps);
+    w("  #else\n");
     /* per-slot constants: unused slots get r = 1, p = 2, m = 1 and d = 1e30 (never active) */
     w("  #local lbR = array[%d]; #local lbP = array[%d]; #local lbM = array[%d];\n", KMAX, KMAX,
       KMAX);
     w("  #for (I, 0, %d) #if (I < K) #local lbR[I] = R[I]; #local lbP[I] = P[I]; #local lbM[I] = "
       "M[I]; #else #local lbR[I] = 1; #local lbP[I] = 2; #local lbM[I] = 1; #end #end\n",
       KMAX - 1);
+    w("  #local lbAll2 = true; #for (I, 0, K - 1) #if (lbP[I] != 2) #local lbAll2 = false; #end "
+      "#end\n");
     /* the Newton step T / T' */
     w("  #local lbS = function(lbh, ");
     dlist();
@@ -1126,6 +1238,9 @@ static void displacement(int steps) {
     w("), lbl, ");
     dlist();
     w(") }\n");
+    w("  #if (lbAll2)\n");
+    displacement_p2();
+    w("  #else\n");
     w("  #local lbB = function(");
     dlist();
     w(") { lbB2(min(lbd0 / lbM[0], 1e300");
@@ -1134,7 +1249,7 @@ static void displacement(int steps) {
     for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), (lbd%d - lbR[%d]) / lbM[%d] #end", i, i, i, i);
     w("), ");
     dlist();
-    w(") }\n");
+    w(") }\n  #end\n");
     /* the argument values, dualised for intersection and difference */
     w("  #local lbSG = select(Op - 1, 1, -1, -1);\n"
       "  #local lbSO = select(abs(Op - 1), -1, -1, 1);\n"
@@ -1145,7 +1260,7 @@ static void displacement(int steps) {
         else
             w(" #if (K > %d), lbSO * F[%d](x, y, z) #end", i, i);
     }
-    w(") }\n#end\n\n");
+    w(") }\n  #end\n#end\n\n");
 }
 
 int main(int argc, char **argv) {

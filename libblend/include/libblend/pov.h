@@ -11,8 +11,11 @@
  * LBn1, ...) and user text appears only in comments, stripped of anything
  * but printable ASCII.
  *
- * Limits of the include: a k-ary blend takes at most 16 arguments; a scene
- * with a larger one is refused with a message naming the node. */
+ * Limits of the include: displacement blends take any number of arguments
+ * (past LB_POV_MAX_ARITY each solver step evaluates the arguments again, so
+ * they render slower); scale, bounded and soft hyper blends take at most
+ * LB_POV_MAX_ARITY, and a scene with a larger one is refused with a message
+ * naming the node. */
 #ifndef LIBBLEND_POV_H
 #define LIBBLEND_POV_H
 

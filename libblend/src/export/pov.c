@@ -101,8 +101,10 @@ static lb_status emit(pctx *c, const lb__node *n, int *out) {
     sbuf *b = c->b;
     const int id = c->next++;
     const char *name = n->has_transform ? "LBl" : "LBn";
-    const int k16 = n->family == LB__F_DISPLACEMENT || n->family == LB__F_SCALE ||
-                    n->family == LB__F_BOUNDED || n->family == LB__F_SOFT_HYPER;
+    /* LB_Displacement takes any k (past 16 it re-evaluates its arguments per
+     * step); these three are limited to the include's 16 */
+    const int k16 =
+        n->family == LB__F_SCALE || n->family == LB__F_BOUNDED || n->family == LB__F_SOFT_HYPER;
     if (k16 && n->k > LB_POV_MAX_ARITY)
         return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
                         "%s: %s: a %s blend of %zu arguments; allowed in POV-Ray: at most %d "
