@@ -198,4 +198,21 @@ raises(lambda: binding.load(os.path.join(stub_dir, "libblend.so")), binding.Libr
 os.environ[binding.ENV_LIBRARY] = os.path.join(WORK, "env", "libblend.so")
 raises(lambda: binding.load(), binding.LibraryError, "LIBBLEND_LIBRARY")
 del os.environ[binding.ENV_LIBRARY]
+# ---- the add-on's metadata: Blender 4.2+ reads the manifest, 3.4 reads bl_info
+import ast  # noqa: E402
+import tomllib  # noqa: E402
+
+with open(os.path.join(ADDON, "blender_manifest.toml"), "rb") as f:
+    man = tomllib.load(f)
+for key in ("schema_version", "id", "version", "name", "tagline", "maintainer", "type",
+            "blender_version_min", "license"):
+    check(key in man, "manifest has " + key)
+check(man["type"] == "add-on" and man["schema_version"] == "1.0.0", "manifest kind")
+tree_ = ast.parse(open(os.path.join(ADDON, "__init__.py")).read())
+bl_info = next(ast.literal_eval(n.value) for n in tree_.body if isinstance(n, ast.Assign)
+               and getattr(n.targets[0], "id", "") == "bl_info")
+check(man["version"] == "%d.%d.%d" % bl_info["version"], "manifest and bl_info versions agree")
+check("%d.%d" % tuple(lib.version[:2]) == man["version"].rsplit(".", 1)[0],
+      "the add-on's version is the library's")
+check(bl_info["blender"] <= (3, 4, 0), "bl_info admits Blender 3.4")
 print("test_binding: %d checks passed" % checks)
