@@ -390,8 +390,8 @@ class Recorder:
         rna = getattr(bpy.ops.libblend, idname.split(".")[1]).get_rna_type()
         check(prop in rna.properties, "menu enum property exists: " + prop)
 
-    def label(self, **k):
-        pass
+    def label(self, text="", **k):
+        Recorder.drawn.append("label:" + text)
 
     def separator(self, **k):
         pass
@@ -438,6 +438,18 @@ fake = type("Prefs", (), {"layout": Recorder(), "bl_rna": live.prefs().bl_rna})(
 lbb.ui.LIBBLEND_AP_preferences.draw(fake, bpy.context)
 check({"bounds_min", "preview_resolution", "radius", "arg_r", "bulge_omega",
        "libblend.update_mesh", "libblend.export_pov"} <= set(Recorder.drawn), "the panel shows them")
+
+# without a library the panel shows the reason and the reload button, nothing else
+os.environ["LIBBLEND_LIBRARY"] = os.path.join(WORK, "gone", "libblend.so")
+live.reload_library()
+Recorder.drawn = []
+draw(lbb.ui.LIBBLEND_PT_panel, out)
+text = " ".join(d for d in Recorder.drawn if d.startswith("label:"))
+check("libblend.reload_library" in Recorder.drawn and "not found" in text and "gone" in text,
+      "the panel explains a missing library: " + text[:200])
+check("libblend.update_mesh" not in Recorder.drawn, "no meshing buttons without a library")
+del os.environ["LIBBLEND_LIBRARY"]
+check(live.reload_library()[0], "library back")
 
 addon_utils.disable("libblend_blender")
 print("test_addon: %d checks passed" % checks)
