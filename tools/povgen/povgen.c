@@ -1069,8 +1069,6 @@ static void bulge(int steps) {
 static void displacement_many(int steps) {
     /* argument i's value, dualised: sign * F[i](x, y, z) */
     static const char *const arg = "(#if (I = 0) lbSG #else lbSO #end * F[I](x, y, z))";
-    w("  #local lbSG = select(Op - 1, 1, -1, -1);\n"
-      "  #local lbSO = select(abs(Op - 1), -1, -1, 1);\n");
     w("  #local lbFS = function(lbh, x, y, z) {\n    (-1 #for (I, 0, K - 1) #if (P[I] = 2) + "
       "max(0, (R[I] - %s + M[I] * lbh) / R[I]) * max(0, (R[I] - %s + M[I] * lbh) / R[I]) #else + "
       "pow(max(0, (R[I] - %s + M[I] * lbh) / R[I]), P[I]) #end #end)\n",
@@ -1090,6 +1088,16 @@ static void displacement_many(int steps) {
     w("  function(x, y, z) { lbSG * lbFB(min(#for (I, 0, K - 1) #if (I > 0), #end %s / M[I] "
       "#end), min(#for (I, 0, K - 1) #if (I > 0), #end (%s - R[I]) / M[I] #end), x, y, z) }\n",
       arg, arg);
+}
+
+/* the displacement root's bracket from the argument values lbd_i:
+ * "min(d_i / m_i), min((d_i - r_i) / m_i)" (the K in use) */
+static void bracket_args(void) {
+    w("min(lbd0 / lbM[0], 1e300");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), lbd%d / lbM[%d] #end", i, i, i);
+    w("), min((lbd0 - lbR[0]) / lbM[0], 1e300");
+    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), (lbd%d - lbR[%d]) / lbM[%d] #end", i, i, i, i);
+    w(")");
 }
 
 /* "lbb0, lbb1, ..." (the K in use) */
@@ -1159,11 +1167,9 @@ static void displacement_p2(void) {
     w("))) }\n");
     w("  #local lbB = function(");
     dlist();
-    w(") { lbAC(min(lbd0 / lbM[0], 1e300");
-    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), lbd%d / lbM[%d] #end", i, i, i);
-    w("), min((lbd0 - lbR[0]) / lbM[0], 1e300");
-    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), (lbd%d - lbR[%d]) / lbM[%d] #end", i, i, i, i);
-    w("), (lbd0 - lbR[0]) / lbM[0]");
+    w(") { lbAC(");
+    bracket_args();
+    w(", (lbd0 - lbR[0]) / lbM[0]");
     for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), (lbd%d - lbR[%d]) / lbM[%d] #end", i, i, i, i);
     w(") }\n");
 }
@@ -1182,6 +1188,9 @@ static void displacement(int steps) {
       "  #if (K < 1 | K > %d) #error \"LB_Displacement: 1 to %d functions\" #end\n"
       "  #if (dimension_size(R, 1) != K | dimension_size(P, 1) != K | dimension_size(M, 1) != K)\n"
       "    #error \"LB_Displacement: R, P and M need one value per function\"\n  #end\n"
+      /* the argument values are dualised for intersection and difference */
+      "  #local lbSG = select(Op - 1, 1, -1, -1);\n"
+      "  #local lbSO = select(abs(Op - 1), -1, -1, 1);\n"
       "  #if (K > %d)\n",
       LB_MAX_ARITY, LB_MAX_ARITY, KMAX);
     displacement_many(steps);
@@ -1243,17 +1252,12 @@ static void displacement(int steps) {
     w("  #else\n");
     w("  #local lbB = function(");
     dlist();
-    w(") { lbB2(min(lbd0 / lbM[0], 1e300");
-    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), lbd%d / lbM[%d] #end", i, i, i);
-    w("), min((lbd0 - lbR[0]) / lbM[0], 1e300");
-    for (int i = 1; i < KMAX; ++i) w(" #if (K > %d), (lbd%d - lbR[%d]) / lbM[%d] #end", i, i, i, i);
-    w("), ");
+    w(") { lbB2(");
+    bracket_args();
+    w(", ");
     dlist();
     w(") }\n  #end\n");
-    /* the argument values, dualised for intersection and difference */
-    w("  #local lbSG = select(Op - 1, 1, -1, -1);\n"
-      "  #local lbSO = select(abs(Op - 1), -1, -1, 1);\n"
-      "  function(x, y, z) { lbSG * lbB(");
+    w("  function(x, y, z) { lbSG * lbB(");
     for (int i = 0; i < KMAX; ++i) {
         if (i == 0)
             w("lbSG * F[0](x, y, z)");
