@@ -4,6 +4,7 @@
  * count. */
 #include "tape.h"
 #include "../primitives/rho.h"
+#include "../operators/bt_two.h"
 
 #include <pthread.h>
 #include <stdatomic.h>
@@ -69,8 +70,36 @@ LB__INLINE void prim_loop(lb_primitive_kind kind, const lb__instr *in, size_t n,
     }
 }
 
+/* Zero-convention slab or half-space: |n . (M X + t - c)| / w - 1 is one
+ * affine function of X, a . X + b, so the map and 1/w fold into a and b once
+ * per chunk and the loop is branch-free (the compiler vectorises it). */
+static void run_plane(const lb__instr *in, size_t n, const double *x, const double *y,
+                      const double *z, double *v, double *gx, double *gy, double *gz) {
+    const lb_primitive *P = &in->prim;
+    const double iw = 1.0 / P->s0, *M = in->A.M, *t = in->A.t;
+    double a[3], b = 0.0;
+    for (int j = 0; j < 3; ++j)
+        a[j] = in->identity ? P->n[j] * iw
+                            : (P->n[0] * M[j] + P->n[1] * M[3 + j] + P->n[2] * M[6 + j]) * iw;
+    for (int i = 0; i < 3; ++i) b += P->n[i] * ((in->identity ? 0.0 : t[i]) - P->c[i]) * iw;
+    const double neg = P->kind == LB_PRIM_SLAB ? -1.0 : 0.0;
+    for (size_t j = 0; j < n; ++j) {
+        const double d = a[0] * x[j] + a[1] * y[j] + a[2] * z[j] + b;
+        const double sg = d < 0.0 ? neg : 1.0;
+        v[j] = sg * d - 1.0;
+        gx[j] = sg * a[0];
+        gy[j] = sg * a[1];
+        gz[j] = sg * a[2];
+    }
+}
+
 static void run_prim(const lb__instr *in, size_t n, const double *x, const double *y,
                      const double *z, double *v, double *gx, double *gy, double *gz) {
+    if ((in->prim.kind == LB_PRIM_SLAB || in->prim.kind == LB_PRIM_HALFSPACE) &&
+        in->prim.kernel == LB_KERNEL_NONE) {
+        run_plane(in, n, x, y, z, v, gx, gy, gz);
+        return;
+    }
     switch (in->prim.kind) {
     case LB_PRIM_ELLIPSOID:
         prim_loop(LB_PRIM_ELLIPSOID, in, n, x, y, z, v, gx, gy, gz);
@@ -154,6 +183,51 @@ static int point_ok(const double *x, size_t k) {
     return ok;
 }
 
+/* A displacement blend of K (small, a constant after inlining) arguments,
+ * every p = 2, over a chunk: fast_op's arithmetic (duals, lb__bt_two_union)
+ * and run_op's gradient sum, one loop with fixed-size arrays, so each K
+ * gets its own specialised code. Same operations, same results. */
+LB__INLINE void bt_two_loop(const size_t K, const lb__instr *in, const uint16_t *act, size_t n,
+                            const double *const *vs, const double *const *gxs,
+                            const double *const *gys, const double *const *gzs, const double *r,
+                            const double *m, double *ov, double *ox, double *oy, double *oz) {
+    const lb_setop op = in->op.op;
+    double sg[4];
+    for (size_t i = 0; i < K; ++i)
+        sg[i] = op == LB_UNION ? 1.0 : op == LB_INTERSECTION || act[i] == 0 ? -1.0 : 1.0;
+    for (size_t j = 0; j < n; ++j) {
+        double u[4], dx[4];
+        for (size_t i = 0; i < K; ++i) u[i] = op == LB_UNION ? vs[i][j] : sg[i] * vs[i][j];
+        double v = lb__bt_two_union(K, u, r, m, dx);
+        if (op != LB_UNION) {
+            for (size_t i = 0; i < K; ++i) dx[i] *= -sg[i];
+            v = -v;
+        }
+        double g0 = 0.0, g1 = 0.0, g2 = 0.0;
+        for (size_t i = 0; i < K; ++i) {
+            g0 += dx[i] * gxs[i][j];
+            g1 += dx[i] * gys[i][j];
+            g2 += dx[i] * gzs[i][j];
+        }
+        ov[j] = v;
+        ox[j] = g0;
+        oy[j] = g1;
+        oz[j] = g2;
+    }
+}
+
+/* 1 when the chunk can take bt_two_loop: p = 2, 2 to 4 arguments in use,
+ * every argument value within the fast kernels' range */
+static int bt_two_chunk(const lb__instr *in, size_t k, size_t n, const double *const *vs) {
+    if (in->fast != LB__FAST_DISPLACEMENT || in->mode != LB__P_TWO || k < 2 || k > 4 ||
+        in->op.bulge)
+        return 0;
+    int ok = 1;
+    for (size_t i = 0; i < k; ++i)
+        for (size_t j = 0; j < n; ++j) ok &= fabs(vs[i][j]) <= LB_MAX_ABS_ARG;
+    return ok;
+}
+
 static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
                            const double *y, const double *z, const double *dg, double *G,
                            lb_error *err);
@@ -202,6 +276,15 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
             oy[j] = w * gys[0][j];
             oz[j] = w * gzs[0][j];
         }
+        return LB_OK;
+    }
+    if (bt_two_chunk(in, k, n, vs)) {
+        if (k == 2)
+            bt_two_loop(2, in, act, n, vs, gxs, gys, gzs, r, m, ov, ox, oy, oz);
+        else if (k == 3)
+            bt_two_loop(3, in, act, n, vs, gxs, gys, gzs, r, m, ov, ox, oy, oz);
+        else
+            bt_two_loop(4, in, act, n, vs, gxs, gys, gzs, r, m, ov, ox, oy, oz);
         return LB_OK;
     }
     double ga[6], dg[6];
@@ -361,17 +444,17 @@ typedef struct job {
     lb_error err;
 } job;
 
-static uint32_t spread3(uint32_t v) { /* 8 bits -> every third bit */
-    v &= 0xffu;
-    v = (v | (v << 16)) & 0x030000ffu;
-    v = (v | (v << 8)) & 0x0300f00fu;
-    v = (v | (v << 4)) & 0x030c30c3u;
-    v = (v | (v << 2)) & 0x09249249u;
+static uint32_t spread3(uint32_t v) { /* 6 bits -> every third bit */
+    v &= 0x3fu;
+    v = (v | (v << 8)) & 0x0000f00fu;
+    v = (v | (v << 4)) & 0x000c30c3u;
+    v = (v | (v << 2)) & 0x00249249u;
     return v;
 }
 
-/* Morton order of the points (a stable LSD radix sort on 24-bit codes:
- * 256 cells per axis is finer than any chunk of a batch worth sorting).
+/* Morton order of the points (a stable LSD radix sort on 18-bit codes, two
+ * passes of 9 bits: 64 cells per axis already make chunks of 64 points
+ * compact for any batch worth sorting, and each pass is a full scatter).
  * Returns NULL when memory is short: the input order is then used. */
 static uint32_t *morton_order(size_t n, const double *x, const double *y, const double *z) {
     if (n > UINT32_MAX) return NULL;
@@ -389,7 +472,7 @@ static uint32_t *morton_order(size_t n, const double *x, const double *y, const 
             if (P[d][i] > hi[d]) hi[d] = P[d][i];
         }
     double sc[3];
-    for (int d = 0; d < 3; ++d) sc[d] = hi[d] > lo[d] ? 255.999 / (hi[d] - lo[d]) : 0.0;
+    for (int d = 0; d < 3; ++d) sc[d] = hi[d] > lo[d] ? 63.999 / (hi[d] - lo[d]) : 0.0;
     for (size_t i = 0; i < n; ++i) {
         key[i] = spread3((uint32_t)((x[i] - lo[0]) * sc[0])) |
                  spread3((uint32_t)((y[i] - lo[1]) * sc[1])) << 1 |
@@ -397,12 +480,12 @@ static uint32_t *morton_order(size_t n, const double *x, const double *y, const 
         idx[i] = (uint32_t)i;
     }
     uint32_t *k0 = key, *k1 = key + n, *i0 = idx, *i1 = idx + n;
-    for (int shift = 0; shift < 24; shift += 8) {
-        size_t count[257] = {0};
-        for (size_t i = 0; i < n; ++i) count[((k0[i] >> shift) & 0xffu) + 1]++;
-        for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
+    for (int shift = 0; shift < 18; shift += 9) {
+        size_t count[513] = {0};
+        for (size_t i = 0; i < n; ++i) count[((k0[i] >> shift) & 0x1ffu) + 1]++;
+        for (int b = 0; b < 512; ++b) count[b + 1] += count[b];
         for (size_t i = 0; i < n; ++i) {
-            const size_t dst = count[(k0[i] >> shift) & 0xffu]++;
+            const size_t dst = count[(k0[i] >> shift) & 0x1ffu]++;
             k1[dst] = k0[i];
             i1[dst] = i0[i];
         }
@@ -413,8 +496,8 @@ static uint32_t *morton_order(size_t n, const double *x, const double *y, const 
         i0 = i1;
         i1 = t;
     }
-    /* three passes: the sorted order is in the second half */
-    memmove(idx, i0, n * sizeof *idx);
+    /* two passes: the sorted order is back in the first half */
+    if (i0 != idx) memmove(idx, i0, n * sizeof *idx);
     free(key);
     return idx;
 }
@@ -463,15 +546,16 @@ static void run_blocks(job *J) {
         for (size_t o = 0; o < nb && !s; o += LB__CHUNK) {
             const size_t m = nb - o < LB__CHUNK ? nb - o : LB__CHUNK;
             const double *cx = bx + o, *cy = by + o, *cz = bz + o;
-            double lo[3] = {INFINITY, INFINITY, INFINITY},
-                   hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-            for (size_t j = 0; j < m; ++j) {
-                const double P[3] = {cx[j], cy[j], cz[j]};
-                for (int d = 0; d < 3; ++d) {
-                    if (P[d] < lo[d]) lo[d] = P[d];
-                    if (P[d] > hi[d]) hi[d] = P[d];
+            /* the chunk's box: branch-free min / max (the coordinates were
+             * checked finite), which the compiler turns into minsd / maxsd */
+            double lo[3] = {cx[0], cy[0], cz[0]}, hi[3] = {cx[0], cy[0], cz[0]};
+            const double *C[3] = {cx, cy, cz};
+            for (int d = 0; d < 3; ++d)
+                for (size_t j = 1; j < m; ++j) {
+                    const double q = C[d][j];
+                    lo[d] = q < lo[d] ? q : lo[d];
+                    hi[d] = q > hi[d] ? q : hi[d];
                 }
-            }
             double bc[3], br[3];
             lb__box_centre(lo, hi, bc, br);
             lb__bounds_pass(ev, bc, br, R, &plan);
@@ -486,13 +570,23 @@ static void run_blocks(job *J) {
         }
         if (J->order && ok && !s) {
             const uint32_t *ord = J->order + begin;
-            for (size_t j = 0; j < nb; ++j) J->v[ord[j]] = ov[j];
-            if (ogx)
-                for (size_t j = 0; j < nb; ++j) J->gx[ord[j]] = ogx[j];
-            if (ogy)
-                for (size_t j = 0; j < nb; ++j) J->gy[ord[j]] = ogy[j];
-            if (ogz)
-                for (size_t j = 0; j < nb; ++j) J->gz[ord[j]] = ogz[j];
+            if (ogx && ogy && ogz) /* one pass: four stores per index in flight */
+                for (size_t j = 0; j < nb; ++j) {
+                    const uint32_t q = ord[j];
+                    J->v[q] = ov[j];
+                    J->gx[q] = ogx[j];
+                    J->gy[q] = ogy[j];
+                    J->gz[q] = ogz[j];
+                }
+            else {
+                for (size_t j = 0; j < nb; ++j) J->v[ord[j]] = ov[j];
+                if (ogx)
+                    for (size_t j = 0; j < nb; ++j) J->gx[ord[j]] = ogx[j];
+                if (ogy)
+                    for (size_t j = 0; j < nb; ++j) J->gy[ord[j]] = ogy[j];
+                if (ogz)
+                    for (size_t j = 0; j < nb; ++j) J->gz[ord[j]] = ogz[j];
+            }
         }
         if (s) {
             pthread_mutex_lock(&J->lock);

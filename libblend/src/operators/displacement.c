@@ -15,6 +15,7 @@
  * D = sum_j m_j w_j. */
 #include "../common/internal.h"
 #include "../solver/root.h"
+#include "bt_two.h"
 
 typedef struct {
     size_t k;
@@ -54,42 +55,6 @@ static LB__ALWAYS_INLINE void bt_T(double h, const void *vctx, double *T, double
     *smooth = 0.5 * rad;
 }
 
-/* Reciprocals, the bracket [min (x-r)/m, min x/m] and its argmin. */
-static void bt_setup(size_t k, const double *x, const double *r, const double *m, double *ir,
-                     double *im, double *b, double *lo, double *hi, size_t *argmin) {
-    double a = INFINITY, c = INFINITY;
-    size_t j = 0;
-    for (size_t i = 0; i < k; ++i) {
-        const double inv = 1.0 / (r[i] * m[i]); /* one division for both reciprocals */
-        ir[i] = m[i] * inv;
-        im[i] = r[i] * inv;
-        b[i] = (x[i] - r[i]) * im[i];
-        const double hi_i = x[i] * im[i];
-        if (b[i] < a) a = b[i];
-        if (hi_i < c) {
-            c = hi_i;
-            j = i;
-        }
-    }
-    *lo = a;
-    *hi = c;
-    *argmin = j;
-}
-
-/* Non-blending region: no argument but the argmin j is within its range at
- * h = x_j/m_j (every other breakpoint b_i >= hi). Then BT = x_j/m_j exactly. */
-static int bt_alone(size_t k, const double *x, const double *m, const double *b, double hi,
-                    size_t j, double *dx, double *dr, double *dm) {
-    for (size_t i = 0; i < k; ++i)
-        if (i != j && b[i] < hi) return 0;
-    for (size_t i = 0; i < k; ++i) {
-        if (dx) dx[i] = i == j ? 1.0 / m[j] : 0.0;
-        if (dr) dr[i] = 0.0;
-        if (dm) dm[i] = i == j ? -x[j] / (m[j] * m[j]) : 0.0;
-    }
-    return 1;
-}
-
 /* Derivatives at the root h from w_i (or recomputed when w is NULL). */
 static void bt_grads(size_t k, const double *x, const double *r, const double *p, const double *m,
                      const double *ir, int mode, double h, size_t argmin, const double *wl,
@@ -120,63 +85,13 @@ static void bt_grads(size_t k, const double *x, const double *r, const double *p
     }
 }
 
-/* Closed form for all p_i = 2, given the breakpoints b_i = (x_i - r_i)/m_i.
- * T is convex and piecewise quadratic. Start at h = hi with S = the terms
- * active there; with d_i = h - b_i >= 0 and c_i = m_i/r_i,
- *   Q_S(h + s) = sum_S c_i^2 (s + d_i)^2 - 1 = A s^2 + 2 B s + C - 1
- * equals T on [max_S b_i, h]. Its larger root (cancellation-free form, s <= 0)
- * is the answer when every term of S is still active there; otherwise
- * T > 0 at the largest breakpoint of S to the right of that root, so move h
- * there and drop that term. Each pass drops a term: no sorting. */
-static double bt_two(size_t k, const double *b, const double *m, const double *ir, double lo,
-                     double hi) {
-    unsigned char act[LB_MAX_ARITY];
-    double h = hi;
-    for (size_t i = 0; i < k; ++i) act[i] = b[i] < hi;
-    for (size_t pass = 0; pass <= k; ++pass) {
-        double A = 0.0, B = 0.0, C = 0.0;
-        for (size_t i = 0; i < k; ++i) {
-            if (!act[i]) continue;
-            const double c = m[i] * ir[i], c2 = c * c, d = h - b[i];
-            A += c2;
-            B += c2 * d;
-            C += c2 * d * d;
-        }
-        const double e = C - 1.0; /* T(h) >= 0 */
-        const double D = B * B - A * e;
-        double s = -INFINITY;
-        if (e <= 0.0)
-            s = 0.0;
-        else if (D >= 0.0)
-            s = -e / (B + sqrt(D));
-        const double hq = h + s;
-        /* the largest breakpoint of S right of hq: it is inactive at hq */
-        size_t drop = k;
-        double bd = -INFINITY;
-        for (size_t i = 0; i < k; ++i)
-            if (act[i] && b[i] > hq && b[i] > bd) {
-                bd = b[i];
-                drop = i;
-            }
-        if (drop == k) {
-            h = hq;
-            break;
-        }
-        act[drop] = 0;
-        h = bd;
-    }
-    if (h < lo) h = lo;
-    if (h > hi) h = hi;
-    return h;
-}
-
 double lb__bt_union_newton(size_t k, const double *x, const double *r, const double *p,
                            const double *m, int mode, double *dx, double *dr, double *dm) {
     double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY], w[LB_MAX_ARITY];
     double lo, hi;
     size_t j;
-    bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
-    if (bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
+    lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
+    if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
     bt_ctx ctx = {k, x, r, p, m, ir, im, mode == LB__P_TWO ? LB__P_INTEGER : mode, w, NAN};
     const double h = lb__root_solve(bt_T, &ctx, lo, hi, hi);
     /* w at h: the last evaluation's, moved to h to first order when the solver
@@ -206,9 +121,9 @@ double lb__bt_union(size_t k, const double *x, const double *r, const double *p,
     double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY];
     double lo, hi;
     size_t j;
-    bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
-    if (bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
-    const double h = bt_two(k, b, m, ir, lo, hi);
+    lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
+    if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
+    const double h = lb__bt_two(k, b, m, ir, lo, hi);
     bt_grads(k, x, r, p, m, ir, LB__P_INTEGER, h, j, NULL, dx, dr, dm);
     return h;
 }

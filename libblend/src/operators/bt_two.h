@@ -1,0 +1,128 @@
+/* The displacement blend's pieces that need no root solver (displacement.c
+ * has the rest): the bracket, the non-blending test and the closed form
+ * for all p_i = 2. Inline, so the compiled evaluator's batch loop
+ * (evaluation/eval_points.c) gets them specialised for a small, constant k
+ * and computes exactly what lb__bt_union computes. */
+#ifndef LIBBLEND_BT_TWO_H
+#define LIBBLEND_BT_TWO_H
+
+#include "../common/internal.h"
+
+/* Reciprocals, the bracket [min (x-r)/m, min x/m] and its argmin. */
+static inline void lb__bt_setup(size_t k, const double *x, const double *r, const double *m,
+                                double *ir, double *im, double *b, double *lo, double *hi,
+                                size_t *argmin) {
+    double a = INFINITY, c = INFINITY;
+    size_t j = 0;
+    for (size_t i = 0; i < k; ++i) {
+        const double inv = 1.0 / (r[i] * m[i]); /* one division for both reciprocals */
+        ir[i] = m[i] * inv;
+        im[i] = r[i] * inv;
+        b[i] = (x[i] - r[i]) * im[i];
+        const double hi_i = x[i] * im[i];
+        if (b[i] < a) a = b[i];
+        if (hi_i < c) {
+            c = hi_i;
+            j = i;
+        }
+    }
+    *lo = a;
+    *hi = c;
+    *argmin = j;
+}
+
+/* Non-blending region: no argument but the argmin j is within its range at
+ * h = x_j/m_j (every other breakpoint b_i >= hi). Then BT = x_j/m_j exactly. */
+static inline int lb__bt_alone(size_t k, const double *x, const double *m, const double *b,
+                               double hi, size_t j, double *dx, double *dr, double *dm) {
+    for (size_t i = 0; i < k; ++i)
+        if (i != j && b[i] < hi) return 0;
+    for (size_t i = 0; i < k; ++i) {
+        if (dx) dx[i] = i == j ? 1.0 / m[j] : 0.0;
+        if (dr) dr[i] = 0.0;
+        if (dm) dm[i] = i == j ? -x[j] / (m[j] * m[j]) : 0.0;
+    }
+    return 1;
+}
+
+/* Closed form for all p_i = 2, given the breakpoints b_i = (x_i - r_i)/m_i.
+ * T is convex and piecewise quadratic. Start at h = hi with S = the terms
+ * active there; with d_i = h - b_i >= 0 and c_i = m_i/r_i,
+ *   Q_S(h + s) = sum_S c_i^2 (s + d_i)^2 - 1 = A s^2 + 2 B s + C - 1
+ * equals T on [max_S b_i, h]. Its larger root (cancellation-free form, s <= 0)
+ * is the answer when every term of S is still active there; otherwise
+ * T > 0 at the largest breakpoint of S to the right of that root, so move h
+ * there and drop that term. Each pass drops a term: no sorting. */
+static inline double lb__bt_two(size_t k, const double *b, const double *m, const double *ir,
+                                double lo, double hi) {
+    unsigned char act[LB_MAX_ARITY];
+    double h = hi;
+    for (size_t i = 0; i < k; ++i) act[i] = b[i] < hi;
+    for (size_t pass = 0; pass <= k; ++pass) {
+        double A = 0.0, B = 0.0, C = 0.0;
+        for (size_t i = 0; i < k; ++i) {
+            if (!act[i]) continue;
+            const double c = m[i] * ir[i], c2 = c * c, d = h - b[i];
+            A += c2;
+            B += c2 * d;
+            C += c2 * d * d;
+        }
+        const double e = C - 1.0; /* T(h) >= 0 */
+        const double D = B * B - A * e;
+        double s = -INFINITY;
+        if (e <= 0.0)
+            s = 0.0;
+        else if (D >= 0.0)
+            s = -e / (B + sqrt(D));
+        const double hq = h + s;
+        /* the largest breakpoint of S right of hq: it is inactive at hq */
+        size_t drop = k;
+        double bd = -INFINITY;
+        for (size_t i = 0; i < k; ++i)
+            if (act[i] && b[i] > hq && b[i] > bd) {
+                bd = b[i];
+                drop = i;
+            }
+        if (drop == k) {
+            h = hq;
+            break;
+        }
+        act[drop] = 0;
+        h = bd;
+    }
+    if (h < lo) h = lo;
+    if (h > hi) h = hi;
+    return h;
+}
+
+/* BT_k union with every p_i = 2: the value, and dx (may be NULL) the
+ * derivatives by the arguments: lb__bt_union's LB__P_TWO path, written
+ * once for it and for the batch loop. */
+static inline double lb__bt_two_union(size_t k, const double *x, const double *r, const double *m,
+                                      double *dx) {
+    double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY];
+    double lo, hi;
+    size_t j;
+    lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
+    if (lb__bt_alone(k, x, m, b, hi, j, dx, NULL, NULL)) return x[j] / m[j];
+    const double h = lb__bt_two(k, b, m, ir, lo, hi);
+    if (dx) {
+        /* bt_grads with w_i = p_i / r_i t_i^(p_i - 1), p_i = 2 */
+        double w[LB_MAX_ARITY], D = 0.0;
+        for (size_t i = 0; i < k; ++i) {
+            const double t = (r[i] - (x[i] - m[i] * h)) * ir[i];
+            w[i] = t > 0.0 ? 2.0 * ir[i] * lb__ipow(t, 1u) : 0.0;
+            D += m[i] * w[i];
+        }
+        if (!(D > 0.0)) { /* rounding left no active term: the Min branch */
+            for (size_t i = 0; i < k; ++i) w[i] = 0.0;
+            w[j] = 1.0;
+            D = m[j];
+        }
+        const double iD = 1.0 / D;
+        for (size_t i = 0; i < k; ++i) dx[i] = w[i] * iD;
+    }
+    return h;
+}
+
+#endif
