@@ -47,8 +47,12 @@ class _State:
 
 
 class _Job:
-    def __init__(self, text, name, bmin, bmax, resolution, open_boundary, threads, paths):
-        self.text, self.name = text, name
+    """One mesh run. Everything it needs is read on the main thread when it
+    is made (the library included: loading it reads the preferences), so
+    run() touches no Blender data and may run on a worker thread."""
+
+    def __init__(self, lib, text, name, bmin, bmax, resolution, open_boundary, threads, paths):
+        self.lib, self.text, self.name = lib, text, name
         self.bmin, self.bmax, self.resolution = bmin, bmax, resolution
         self.open_boundary, self.threads, self.paths = open_boundary, threads, paths
         self.cancel = binding.CancelToken()
@@ -61,8 +65,10 @@ class _Job:
     def run(self):
         t0 = time.perf_counter()
         try:
-            self.mesh = mesh_text(self.text, self.name, self.bmin, self.bmax, self.resolution,
-                                  self.open_boundary, self.threads, self.cancel)
+            with self.lib.parse_scene(self.text, self.name) as scene, scene.compile() as ev:
+                self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
+                                    open_boundary=self.open_boundary, threads=self.threads,
+                                    cancel=self.cancel)
         except binding.Cancelled:
             self.error = None
         except binding.LibblendError as e:
@@ -114,13 +120,6 @@ def reload_library():
 def threads():
     p = prefs()
     return p.threads if p else 0
-
-
-def mesh_text(text, name, bmin, bmax, resolution, open_boundary=False, nthreads=0, cancel=None):
-    lib = library()
-    with lib.parse_scene(text, name) as scene, scene.compile() as ev:
-        return ev.mesh(bmin, bmax, resolution=resolution, open_boundary=open_boundary,
-                       threads=nthreads, cancel=cancel)
 
 
 # --------------------------------------------------------------------------- mesh data
@@ -182,10 +181,12 @@ def _region(output):
 
 
 def prepare(output, resolution):
-    """Read the tree (main thread) into a _Job; raises tree.TreeError."""
+    """Read the tree (main thread) into a _Job; raises tree.TreeError or
+    binding.LibraryError."""
+    lib = library()
     text, paths = tree.to_json(output)
     bmin, bmax = _region(output)
-    return _Job(text, output.name + ".json", bmin, bmax, resolution,
+    return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
                 output.libblend.open_boundary, threads(), paths)
 
 
