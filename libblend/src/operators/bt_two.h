@@ -1,6 +1,6 @@
 /* The displacement blend's pieces that need no root solver (displacement.c
- * has the rest): the bracket, the non-blending test and the closed form
- * for all p_i = 2. Inline, so the compiled evaluator's batch loop
+ * has the rest): the bracket, the non-blending test, the closed form for
+ * all p_i = 2 and the gradient at the root. Inline, so the compiled evaluator's batch loop
  * (evaluation/eval_points.c) gets them specialised for a small, constant k
  * and computes exactly what lb__bt_union computes. */
 #ifndef LIBBLEND_BT_TWO_H
@@ -95,9 +95,42 @@ static inline double lb__bt_two(size_t k, const double *b, const double *m, cons
     return h;
 }
 
+/* Derivatives at the root h from w_i (or recomputed when w is NULL; p NULL
+ * means every p_i = 2). */
+static inline void lb__bt_grads(size_t k, const double *x, const double *r, const double *p,
+                                const double *m, const double *ir, int mode, double h,
+                                size_t argmin, const double *wl, double *dx, double *dr,
+                                double *dm) {
+    if (!dx && !dr && !dm) return;
+    double w[LB_MAX_ARITY];
+    double D = 0.0;
+    for (size_t i = 0; i < k; ++i) {
+        if (wl) {
+            w[i] = wl[i];
+        } else {
+            const double t = (r[i] - (x[i] - m[i] * h)) * ir[i];
+            const double pi = p ? p[i] : 2.0;
+            w[i] = t > 0.0 ? pi * ir[i] * lb__pow_m1(t, pi, mode) : 0.0;
+        }
+        D += m[i] * w[i];
+    }
+    if (!(D > 0.0)) { /* rounding left no active term: the Min branch */
+        for (size_t i = 0; i < k; ++i) w[i] = 0.0;
+        w[argmin] = 1.0;
+        D = m[argmin];
+    }
+    const double iD = 1.0 / D;
+    for (size_t i = 0; i < k; ++i) {
+        const double wi = w[i] * iD;
+        if (dx) dx[i] = wi;
+        if (dr) dr[i] = -wi * (x[i] - m[i] * h) * ir[i];
+        if (dm) dm[i] = -wi * h;
+    }
+}
+
 /* BT_k union with every p_i = 2: the value, and dx (may be NULL) the
- * derivatives by the arguments: lb__bt_union's LB__P_TWO path, written
- * once for it and for the batch loop. */
+ * derivatives by the arguments: lb__bt_union's LB__P_TWO path without dr
+ * and dm, for the batch loop. */
 static inline double lb__bt_two_union(size_t k, const double *x, const double *r, const double *m,
                                       double *dx) {
     double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY];
@@ -106,22 +139,7 @@ static inline double lb__bt_two_union(size_t k, const double *x, const double *r
     lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
     if (lb__bt_alone(k, x, m, b, hi, j, dx, NULL, NULL)) return x[j] / m[j];
     const double h = lb__bt_two(k, b, m, ir, lo, hi);
-    if (dx) {
-        /* bt_grads with w_i = p_i / r_i t_i^(p_i - 1), p_i = 2 */
-        double w[LB_MAX_ARITY], D = 0.0;
-        for (size_t i = 0; i < k; ++i) {
-            const double t = (r[i] - (x[i] - m[i] * h)) * ir[i];
-            w[i] = t > 0.0 ? 2.0 * ir[i] * lb__ipow(t, 1u) : 0.0;
-            D += m[i] * w[i];
-        }
-        if (!(D > 0.0)) { /* rounding left no active term: the Min branch */
-            for (size_t i = 0; i < k; ++i) w[i] = 0.0;
-            w[j] = 1.0;
-            D = m[j];
-        }
-        const double iD = 1.0 / D;
-        for (size_t i = 0; i < k; ++i) dx[i] = w[i] * iD;
-    }
+    lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, dx, NULL, NULL);
     return h;
 }
 

@@ -55,36 +55,6 @@ static LB__ALWAYS_INLINE void bt_T(double h, const void *vctx, double *T, double
     *smooth = 0.5 * rad;
 }
 
-/* Derivatives at the root h from w_i (or recomputed when w is NULL). */
-static void bt_grads(size_t k, const double *x, const double *r, const double *p, const double *m,
-                     const double *ir, int mode, double h, size_t argmin, const double *wl,
-                     double *dx, double *dr, double *dm) {
-    if (!dx && !dr && !dm) return;
-    double w[LB_MAX_ARITY];
-    double D = 0.0;
-    for (size_t i = 0; i < k; ++i) {
-        if (wl) {
-            w[i] = wl[i];
-        } else {
-            const double t = (r[i] - (x[i] - m[i] * h)) * ir[i];
-            w[i] = t > 0.0 ? p[i] * ir[i] * lb__pow_m1(t, p[i], mode) : 0.0;
-        }
-        D += m[i] * w[i];
-    }
-    if (!(D > 0.0)) { /* rounding left no active term: the Min branch */
-        for (size_t i = 0; i < k; ++i) w[i] = 0.0;
-        w[argmin] = 1.0;
-        D = m[argmin];
-    }
-    const double iD = 1.0 / D;
-    for (size_t i = 0; i < k; ++i) {
-        const double wi = w[i] * iD;
-        if (dx) dx[i] = wi;
-        if (dr) dr[i] = -wi * (x[i] - m[i] * h) * ir[i];
-        if (dm) dm[i] = -wi * h;
-    }
-}
-
 double lb__bt_union_newton(size_t k, const double *x, const double *r, const double *p,
                            const double *m, int mode, double *dx, double *dr, double *dm) {
     double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY], w[LB_MAX_ARITY];
@@ -111,7 +81,7 @@ double lb__bt_union_newton(size_t k, const double *x, const double *r, const dou
         if (fabs(pm * u) > 1e-4) reuse = 0;
         w[i] *= 1.0 + pm * u * (1.0 + 0.5 * (pm - 1.0) * u);
     }
-    bt_grads(k, x, r, p, m, ir, ctx.mode, h, j, reuse ? w : NULL, dx, dr, dm);
+    lb__bt_grads(k, x, r, p, m, ir, ctx.mode, h, j, reuse ? w : NULL, dx, dr, dm);
     return h;
 }
 
@@ -124,7 +94,7 @@ double lb__bt_union(size_t k, const double *x, const double *r, const double *p,
     lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
     if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
     const double h = lb__bt_two(k, b, m, ir, lo, hi);
-    bt_grads(k, x, r, p, m, ir, LB__P_INTEGER, h, j, NULL, dx, dr, dm);
+    lb__bt_grads(k, x, r, p, m, ir, LB__P_INTEGER, h, j, NULL, dx, dr, dm);
     return h;
 }
 
