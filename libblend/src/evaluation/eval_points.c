@@ -198,7 +198,7 @@ LB__INLINE void bt_two_loop(const size_t K, const lb__instr *in, const uint16_t 
     for (size_t j = 0; j < n; ++j) {
         double u[4], dx[4];
         for (size_t i = 0; i < K; ++i) u[i] = op == LB_UNION ? vs[i][j] : sg[i] * vs[i][j];
-        double v = lb__bt_two_union(K, u, r, m, dx);
+        double v = lb__bt_two_union(K, u, r, m, dx, NULL, NULL);
         if (op != LB_UNION) {
             for (size_t i = 0; i < K; ++i) dx[i] *= -sg[i];
             v = -v;

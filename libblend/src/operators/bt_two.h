@@ -128,18 +128,18 @@ static inline void lb__bt_grads(size_t k, const double *x, const double *r, cons
     }
 }
 
-/* BT_k union with every p_i = 2: the value, and dx (may be NULL) the
- * derivatives by the arguments: lb__bt_union's LB__P_TWO path without dr
- * and dm, for the batch loop. */
+/* BT_k union with every p_i = 2 (lb__bt_union's LB__P_TWO path, also the
+ * compiled evaluator's batch loop): the value, and the derivatives by the
+ * arguments, ranges and slopes (each of dx, dr, dm may be NULL). */
 static inline double lb__bt_two_union(size_t k, const double *x, const double *r, const double *m,
-                                      double *dx) {
+                                      double *dx, double *dr, double *dm) {
     double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY];
     double lo, hi;
     size_t j;
     lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
-    if (lb__bt_alone(k, x, m, b, hi, j, dx, NULL, NULL)) return x[j] / m[j];
+    if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
     const double h = lb__bt_two(k, b, m, ir, lo, hi);
-    lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, dx, NULL, NULL);
+    lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, dx, dr, dm);
     return h;
 }
 

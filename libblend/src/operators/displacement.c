@@ -88,14 +88,7 @@ double lb__bt_union_newton(size_t k, const double *x, const double *r, const dou
 double lb__bt_union(size_t k, const double *x, const double *r, const double *p, const double *m,
                     int mode, double *dx, double *dr, double *dm) {
     if (mode != LB__P_TWO) return lb__bt_union_newton(k, x, r, p, m, mode, dx, dr, dm);
-    double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY];
-    double lo, hi;
-    size_t j;
-    lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
-    if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
-    const double h = lb__bt_two(k, b, m, ir, lo, hi);
-    lb__bt_grads(k, x, r, p, m, ir, LB__P_INTEGER, h, j, NULL, dx, dr, dm);
-    return h;
+    return lb__bt_two_union(k, x, r, m, dx, dr, dm); /* every p_i is 2 in this mode */
 }
 
 lb_status lb__check_blend_params(const char *fn, size_t k, const double *r, const double *p,
