@@ -45,6 +45,15 @@ def _target_parent(context, op):
     return a.parent
 
 
+def _root_taken(op, parent, fix):
+    """A field holds one root node: report (with the fix) when parent is a
+    field that already has it."""
+    if parent.libblend.kind == "OUTPUT" and tree.children(parent):
+        op.report({"ERROR"}, "field '%s' already has its root node; %s" % (parent.name, fix))
+        return True
+    return False
+
+
 def _new_node(context, parent, name, display):
     obj = bpy.data.objects.new(name, None)
     obj.empty_display_type = display
@@ -110,9 +119,7 @@ class LIBBLEND_OT_add_primitive(bpy.types.Operator):
         parent = _target_parent(context, self)
         if parent is None:
             return {"CANCELLED"}
-        if parent.libblend.kind == "OUTPUT" and tree.children(parent):
-            self.report({"ERROR"}, "field '%s' already has its root node; select a blend node "
-                                   "to add the primitive to" % parent.name)
+        if _root_taken(self, parent, "select a blend node to add the primitive to"):
             return {"CANCELLED"}
         obj = _new_node(context, parent, self.prim_type, tree.EMPTY_DISPLAY[self.prim_type])
         obj.location, obj.rotation_euler = self.location, self.rotation
@@ -151,9 +158,7 @@ class LIBBLEND_OT_add_blend(bpy.types.Operator):
             order = min(o.libblend.order for o in sel)
         else:
             parent = a if a.libblend.kind in ("OUTPUT", "BLEND") else a.parent
-            if parent.libblend.kind == "OUTPUT" and tree.children(parent):
-                self.report({"ERROR"}, "field '%s' already has its root node; select it to "
-                                       "blend it with new nodes" % parent.name)
+            if _root_taken(self, parent, "select it to blend it with new nodes"):
                 return {"CANCELLED"}
             order = _next_order(parent)
         obj = _new_node(context, parent, self.blend_type, "PLAIN_AXES")
