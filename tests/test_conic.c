@@ -19,7 +19,14 @@ static void sample(rng_t *g, cc_case *c, int wide) {
     }
     const double u = rng_unit(g);
     const double rp = c->r[0] * c->r[1];
-    c->p = u < 0.2 ? 0.0 : u < 0.6 ? rng_range(g, -3.0, 0.95) * rp : -rng_log(g, 3.0, 1e3) * rp;
+    if (u < 0.2)
+        c->p = 0.0;
+    else if (u < 0.3) /* nearly degenerate: within 1e-2 .. 1e-6 of r1 r2 */
+        c->p = (1.0 - pow(10.0, -rng_range(g, 2.0, 6.0))) * rp;
+    else if (u < 0.6)
+        c->p = rng_range(g, -3.0, 0.95) * rp;
+    else
+        c->p = -rng_log(g, 3.0, 1e3) * rp;
     const double mag = pow(10.0, rng_range(g, -3.0, wide ? 6.0 : 3.0));
     const double h0 = (rng_unit(g) < 0.5 ? -mag : mag) / fmax(c->m[0], c->m[1]);
     for (int i = 0; i < 2; ++i)

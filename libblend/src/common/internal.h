@@ -8,13 +8,17 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
+#include <string.h>
 
 #if defined(__GNUC__)
 #define LB_INTERNAL __attribute__((visibility("hidden")))
 #define LB_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#define LB_NOINLINE __attribute__((noinline))
 #else
 #define LB_INTERNAL
 #define LB_PRINTF(a, b)
+#define LB_NOINLINE
 #endif
 /* Tells GCC that a kernel reads only the first k (parameter n) elements of
  * array parameter ptr, so stack scratch arrays of LB_MAX_ARITY that are
@@ -61,15 +65,29 @@ LB_INTERNAL lb_status lb__check_conic(const char *fn, const double x[2], const d
  * 0 < r_i <= rmax, 1 < p_i <= LB_MAX_EXPONENT (p may be NULL when the family
  * has none), m_i > 0 finite or m NULL. Callers run the detailed checks only
  * when this fails, to produce the message. */
+/* The bits of a double. For doubles >= +0 the bit patterns are ordered like
+ * the values, and NaN patterns lie above +inf; negatives have the top bit. */
+static inline uint64_t lb__bits(double v) {
+    uint64_t u;
+    memcpy(&u, &v, sizeof u);
+    return u;
+}
+/* lo <= v <= hi for 0 < lo <= hi, false for NaN: two integer operations. */
+static inline int lb__in_range(double v, double lo, double hi) {
+    return lb__bits(v) - lb__bits(lo) <= lb__bits(hi) - lb__bits(lo);
+}
+
 static inline int lb__fast_ok(size_t k, const double *x, const double *r, const double *p,
                               const double *m, double rmax) {
     if (!x || !r || k == 0 || k > LB_MAX_ARITY) return 0;
+    const double rhi = rmax < LB_MAX_RANGE ? rmax : LB_MAX_RANGE;
+    const uint64_t xmax = lb__bits(LB_MAX_ABS_ARG) << 1;
     int ok = 1;
     for (size_t i = 0; i < k; ++i) {
-        ok &= fabs(x[i]) <= LB_MAX_ABS_ARG; /* finite and in range (false for NaN) */
-        ok &= (r[i] >= LB_MIN_RANGE) & (r[i] <= rmax) & (r[i] <= LB_MAX_RANGE);
-        if (p) ok &= (p[i] > 1.0) & (p[i] <= LB_MAX_EXPONENT);
-        if (m) ok &= (m[i] >= LB_MIN_SLOPE) & (m[i] <= LB_MAX_SLOPE);
+        ok &= lb__bits(x[i]) << 1 <= xmax; /* |x| in range (false for NaN) */
+        ok &= lb__in_range(r[i], LB_MIN_RANGE, rhi);
+        if (p) ok &= lb__in_range(p[i], 0x1.0000000000001p0, LB_MAX_EXPONENT); /* 1 < p */
+        if (m) ok &= lb__in_range(m[i], LB_MIN_SLOPE, LB_MAX_SLOPE);
     }
     return ok;
 }

@@ -9,7 +9,15 @@
  * coefficients of the size of r even when |x| is huge, and take the root
  * with the cancellation-free formula q = -(b + sign(b) sqrt(D))/2.
  * Gradients by the implicit function theorem with E = m1 H_u1 + m2 H_u2:
- * dh/dx_i = H_ui / E, dh/dm_i = -h H_ui / E, dh/dr_i = H_ri / E. */
+ * dh/dx_i = H_ui / E, dh/dm_i = -h H_ui / E, dh/dr_i = H_ri / E.
+ *
+ * Two paths compute that root. conic_fast (value and d/dx, the calls that
+ * scenes, POV-Ray export and the public scalar entry make) scales the same
+ * quadratic so that one division serves the value and the gradient; it
+ * declines the rare cases where that loses digits (nearly degenerate conics,
+ * the root outside [h2, h1] by rounding). conic_union_general (those cases,
+ * and every call that asks for d/dr or d/dm) is the shifted form above.
+ * Both agree with a long-double reference to 1e-12 (tests/test_conic.c). */
 #include "../common/internal.h"
 #include "../solver/root.h"
 
@@ -67,8 +75,71 @@ static double outside_grads(size_t j, const double m[2], double h1, double dx[2]
     return h1;
 }
 
+/* Region II for the value and d/dx only, with one division and no division
+ * before the square root (a call's cost is its instruction count and the
+ * sqrt -> division chain). Let j attain min(x_i/m_i), o the other argument,
+ * N = x_o m_j - m_o x_j = m_j v_o >= 0 and g = r_o m_j - N (> 0 inside).
+ * m_j^2 H as a quadratic in u = u_j = x_j - m_j h is
+ *     A u^2 + B u + C,  A = a,  B = 2 (p m_j N - r_j^2 m_o g - r_j r_o^2 m_j^2),
+ *     C = r_j^2 g^2,
+ * whose coefficients are of the size of r and m however large |x| is. The
+ * root in range is C/q (q = -(B + sign(B) sqrt(D))/2, D = B^2 - 4AC), and
+ * there E = m1 H1 + m2 H2 = sign(B) sqrt(D) / m_j, so R = 1/(q m_j sqrt(D))
+ * gives h = (x_j q - C) sqrt(D) R, u = C m_j sqrt(D) R and 1/E. With
+ * G_i = m_j H_ui (written with m_j u_o = N + m_o u): dh/dx_i = G_i sign(B)/sqrt(D).
+ * Returns 0, writing nothing, when the root is not in [0, u_max] or D is
+ * ill-conditioned (E would lose digits): conic_union_general decides those. */
+static inline int conic_fast(const double x[2], const double r[2], double p, const double m[2],
+                             size_t j, double *h, double dx[2]) {
+    const size_t o = 1 - j;
+    const double xj = x[j], rj = r[j], ro = r[o], mj = m[j], mo = m[o];
+    const double N = x[o] * mj - mo * xj, romj = ro * mj, g = romj - N, rrj = rj * rj;
+    const double A = r[1] * r[1] * m[0] * m[0] + r[0] * r[0] * m[1] * m[1] + 2.0 * p * m[0] * m[1];
+    const double B = 2.0 * (p * mj * N - rrj * mo * g - rj * ro * romj * mj);
+    const double C = rrj * g * g, f4 = 4.0 * A * C, D = B * B - f4;
+    const double sD = sqrt(D > 0.0 ? D : 0.0);
+    const double q = -0.5 * (B + copysign(sD, B)), Z = q * mj, den = Z * sD;
+    const double R = 1.0 / den, iZ = sD * R, u = C * mj * iZ;
+    const double w = rj * mo + romj; /* u_max w = r_j g: the chord value */
+    if (!((u >= 0.0) & (u * w <= rj * g) & (D > 1e-4 * (B * B + fabs(f4))) & (fabs(den) > 1e-290) &
+          (fabs(den) < 1e290)))
+        return 0;
+    *h = (xj * q - C) * iZ;
+    if (dx) {
+        const double mu_o = N + mo * u, iE = copysign(Z * R, B);
+        dx[j] = 2.0 * (ro * ro * mj * (u - rj) + p * mu_o) * iE;
+        dx[o] = 2.0 * (rrj * (mu_o - romj) + p * mj * u) * iE;
+    }
+    return 1;
+}
+
+static double conic_union_general(const double x[2], const double r[2], double p, const double m[2],
+                                  double dx[2], double dr[2], double dm[2]);
+
+/* lb__conic_union's body, inlined into lb_conic's union call */
+static inline double conic_union(const double x[2], const double r[2], double p, const double m[2],
+                                 double dx[2], double dr[2], double dm[2]) {
+    const size_t j = x[1] * m[0] < x[0] * m[1];
+    const size_t o = 1 - j;
+    if (!(x[o] * m[j] - m[o] * x[j] < r[o] * m[j])) { /* outside region II */
+        const double h1 = x[j] / m[j];
+        return outside_grads(j, m, h1, dx, dr, dm);
+    }
+    double h;
+    if (!dr && !dm && conic_fast(x, r, p, m, j, &h, dx)) return h;
+    return conic_union_general(x, r, p, m, dx, dr, dm);
+}
+
 double lb__conic_union(const double x[2], const double r[2], double p, const double m[2],
                        double dx[2], double dr[2], double dm[2]) {
+    return conic_union(x, r, p, m, dx, dr, dm);
+}
+
+/* The shifted quadratic in s = h - h1, with dr and dm, and the careful choice
+ * of root when the obvious one is out of range. */
+LB_NOINLINE static double conic_union_general(const double x[2], const double r[2], double p,
+                                              const double m[2], double dx[2], double dr[2],
+                                              double dm[2]) {
     conic_ctx c;
     double h1;
     size_t j;
@@ -153,7 +224,7 @@ lb_status lb_conic(lb_setop op, const double x[2], const double r[2], double p, 
     }
     static const double ones[2] = {1.0, 1.0};
     if (op == LB_UNION) {
-        *value = lb__conic_union(x, r, p, m ? m : ones, grad, NULL, NULL);
+        *value = conic_union(x, r, p, m ? m : ones, grad, NULL, NULL);
         return LB_OK;
     }
     double xt[2], sg[2];
