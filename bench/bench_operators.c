@@ -119,7 +119,10 @@ typedef enum {
     F_MIN_API,
     F_SCALE,
     F_SOFT,
-    F_BULGE
+    F_BULGE,
+    F_BOUNDED,
+    F_SOFT_CONIC,
+    F_RFUNC
 } fam;
 
 static volatile double sink;
@@ -168,6 +171,21 @@ PASS(pass_bulge, {
     lb_bulge(LB_BULGE_DISPLACEMENT, LB_UNION, &bp, x, g1, g2, &v, dx, d1, d2, NULL);
 })
 
+PASS(pass_bounded, {
+    double c[8], gc[8];
+    for (size_t i = 0; i < w->k; ++i) c[i] = x[i] - w->r[i]; /* a bounding solid around f_i */
+    lb_bounded(LB_UNION, w->k, x, c, w->p, &v, g, gc, NULL);
+})
+PASS(pass_soft_conic, {
+    double y[2], r1[2];
+    for (size_t i = 0; i < 2; ++i) {
+        y[i] = 0.5 - 0.25 * tanh(x[i]);
+        r1[i] = fmin(w->r[i], 1.0);
+    }
+    lb_soft_conic(LB_UNION, y, r1, 0.0, w->m, &v, g, NULL);
+})
+PASS(pass_rfunc, lb_classic(LB_RFUNC_UNION, 2, x, 0.0, &v, g, NULL))
+
 static double run_once(fam f, const workload *w) {
     static double (*const pass[])(const workload *) = {
         [F_RF] = pass_rf,
@@ -180,6 +198,9 @@ static double run_once(fam f, const workload *w) {
         [F_SCALE] = pass_scale,
         [F_SOFT] = pass_soft,
         [F_BULGE] = pass_bulge,
+        [F_BOUNDED] = pass_bounded,
+        [F_SOFT_CONIC] = pass_soft_conic,
+        [F_RFUNC] = pass_rfunc,
     };
     const double t0 = cpu_now();
     sink = pass[f](w);
@@ -259,6 +280,10 @@ int main(int argc, char **argv) {
         {"soft union B_Sk, p = 2.5", F_SOFT, 2.5, 2, F_RF},
         {"soft union B_Sk, p = 2.5", F_SOFT, 2.5, 6, F_RF},
         {"bulge BT_2 (range + slope), p = 2", F_BULGE, 2.0, 2, F_RF},
+        {"bounded union, p = 2.5", F_BOUNDED, 2.5, 2, F_RF},
+        {"bounded union, p = 2.5", F_BOUNDED, 2.5, 6, F_RF},
+        {"soft conic union (solved)", F_SOFT_CONIC, 2.0, 2, F_RF},
+        {"R-function union vs min() call", F_RFUNC, 2.0, 2, F_MIN_CALL},
     };
     double ratio_k6_general = 0, ratio_k6_two = 0, conic_vs_min = 0, conic_vs_api = 0,
            arith_vs_min = 0;
