@@ -61,10 +61,6 @@ LB_INTERNAL lb_status lb__check_conic(const char *fn, const double x[2], const d
                                       double p, const double m[2], const void *value,
                                       lb_error *err);
 
-/* Cheap validity pre-check for the hot path (no messages): every x_i finite,
- * 0 < r_i <= rmax, 1 < p_i <= LB_MAX_EXPONENT (p may be NULL when the family
- * has none), m_i > 0 finite or m NULL. Callers run the detailed checks only
- * when this fails, to produce the message. */
 /* The bits of a double. For doubles >= +0 the bit patterns are ordered like
  * the values, and NaN patterns lie above +inf; negatives have the top bit. */
 static inline uint64_t lb__bits(double v) {
@@ -77,6 +73,10 @@ static inline int lb__in_range(double v, double lo, double hi) {
     return lb__bits(v) - lb__bits(lo) <= lb__bits(hi) - lb__bits(lo);
 }
 
+/* Cheap validity pre-check for the hot path (no messages): every x_i finite,
+ * 0 < r_i <= rmax, 1 < p_i <= LB_MAX_EXPONENT (p may be NULL when the family
+ * has none), m_i > 0 finite or m NULL. Callers run the detailed checks only
+ * when this fails, to produce the message. */
 static inline int lb__fast_ok(size_t k, const double *x, const double *r, const double *p,
                               const double *m, double rmax) {
     if (!x || !r || k == 0 || k > LB_MAX_ARITY) return 0;

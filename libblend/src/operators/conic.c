@@ -25,11 +25,15 @@ typedef struct {
     double v1, v2, r1, r2, p, m1, m2;
 } conic_ctx;
 
+/* The argument attaining min(x0/m0, x1/m1), compared cross-multiplied */
+static inline size_t conic_argmin(const double x[2], const double m[2]) {
+    return x[1] * m[0] < x[0] * m[1];
+}
+
 /* Region II test; fills the shifted context and h1. Returns 0 outside. */
 static int conic_setup(const double x[2], const double r[2], double p, const double m[2],
                        conic_ctx *c, double *h1, size_t *argmin) {
-    /* min(x0/m0, x1/m1) with one division: compare cross-multiplied */
-    *argmin = x[1] * m[0] < x[0] * m[1];
+    *argmin = conic_argmin(x, m);
     *h1 = x[*argmin] / m[*argmin];
     c->r1 = r[0];
     c->r2 = r[1];
@@ -119,8 +123,7 @@ static double conic_union_general(const double x[2], const double r[2], double p
 /* lb__conic_union's body, inlined into lb_conic's union call */
 static inline double conic_union(const double x[2], const double r[2], double p, const double m[2],
                                  double dx[2], double dr[2], double dm[2]) {
-    const size_t j = x[1] * m[0] < x[0] * m[1];
-    const size_t o = 1 - j;
+    const size_t j = conic_argmin(x, m), o = 1 - j;
     if (!(x[o] * m[j] - m[o] * x[j] < r[o] * m[j])) { /* outside region II */
         const double h1 = x[j] / m[j];
         return outside_grads(j, m, h1, dx, dr, dm);
