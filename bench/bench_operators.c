@@ -153,6 +153,14 @@ typedef enum {
 
 static volatile double sink;
 
+/* The soft families' arguments: field values in [0, 1] and ranges <= 1 */
+static void soft_args(const workload *w, const double *x, double y[8], double r1[8]) {
+    for (size_t i = 0; i < w->k; ++i) {
+        y[i] = 0.5 - 0.25 * tanh(x[i]);
+        r1[i] = fmin(w->r[i], 1.0);
+    }
+}
+
 /* One pass over the workload. Each family has its own loop: with one loop
  * around a switch, a min() call's cost followed the code layout (1.4 ns or
  * 3.4 ns per call after an unrelated edit), which moved every ratio to it. */
@@ -179,10 +187,7 @@ PASS(pass_min_api, lb_classic(LB_MIN, 2, x, 0.0, &v, g, NULL))
 PASS(pass_scale, lb_scale(LB_UNION, w->k, x, w->r, w->p, &v, g, NULL))
 PASS(pass_soft, {
     double y[8], r1[8];
-    for (size_t i = 0; i < w->k; ++i) {
-        y[i] = 0.5 - 0.25 * tanh(x[i]); /* a soft field value in [0, 1] */
-        r1[i] = fmin(w->r[i], 1.0);
-    }
+    soft_args(w, x, y, r1);
     lb_soft_hyper(LB_UNION, w->k, y, r1, w->p, w->m, &v, g, NULL);
 })
 PASS(pass_bulge, {
@@ -203,11 +208,8 @@ PASS(pass_bounded, {
     lb_bounded(LB_UNION, w->k, x, c, w->p, &v, g, gc, NULL);
 })
 PASS(pass_soft_conic, {
-    double y[2], r1[2];
-    for (size_t i = 0; i < 2; ++i) {
-        y[i] = 0.5 - 0.25 * tanh(x[i]);
-        r1[i] = fmin(w->r[i], 1.0);
-    }
+    double y[8], r1[8];
+    soft_args(w, x, y, r1); /* k = 2 for this row */
     lb_soft_conic(LB_UNION, y, r1, 0.0, w->m, &v, g, NULL);
 })
 PASS(pass_rfunc, lb_classic(LB_RFUNC_UNION, 2, x, 0.0, &v, g, NULL))
