@@ -47,9 +47,9 @@ static int run_validate(int argc, char **argv) {
         lb_scene_stats st;
         lb_scene_stats_get(sc, &st);
         if (!quiet)
-            printf("%s: ok (%s convention, %zu nodes, %zu instructions)\n", argv[i],
-                   lb_scene_convention(sc) == LB_CONVENTION_ZERO ? "zero" : "soft", st.nodes,
-                   lb_evaluator_size(ev));
+            printf("%s: ok (%s convention, %zu nodes, %zu instructions, cost %.0f per point)\n",
+                   argv[i], lb_scene_convention(sc) == LB_CONVENTION_ZERO ? "zero" : "soft",
+                   st.nodes, lb_evaluator_size(ev), lb_evaluator_cost(ev));
         lb_evaluator_free(ev);
         lb_scene_free(sc);
     }
@@ -112,6 +112,7 @@ static int run_info(int argc, char **argv) {
         cJSON_AddNumberToObject(o, "operators", (double)st.operators);
         cJSON_AddNumberToObject(o, "depth", (double)st.depth);
         cJSON_AddNumberToObject(o, "instructions", (double)lb_evaluator_size(ev));
+        cJSON_AddNumberToObject(o, "cost_per_point", lb_evaluator_cost(ev));
         cJSON_AddStringToObject(o, "tree", tree);
         char *txt = o ? cJSON_Print(o) : NULL;
         cJSON_Delete(o);
@@ -131,7 +132,9 @@ static int run_info(int argc, char **argv) {
             printf("bounds: none declared (mesh and render commands need --bounds)\n");
         printf("nodes: %zu (%zu primitives, %zu operators), depth %zu\n", st.nodes, st.primitives,
                st.operators, st.depth);
-        printf("instructions: %zu\ntree:\n%s", lb_evaluator_size(ev), tree);
+        printf("instructions: %zu\ncost: %.0f instruction runs per point (at most %d x the "
+               "instructions)\ntree:\n%s",
+               lb_evaluator_size(ev), lb_evaluator_cost(ev), LB_SCENE_MAX_COST_FACTOR, tree);
     }
     free(tree);
 done:

@@ -33,6 +33,17 @@ extern "C" {
 /* Bulge-eliminated blends nested inside each other's arguments: each level
  * re-evaluates its arguments 4 times for the Hessian terms of its gradient. */
 #define LB_SCENE_MAX_BULGE_NESTING 4
+/* The cost model (docs/scene-format.md, "Cost"): a point costs one run of
+ * every instruction of the compiled tape, and each bulge-eliminated blend
+ * re-runs the instructions each of its two arguments depends on twice more.
+ * lb_evaluator_create refuses (LB_ERR_INVALID_ARGUMENT, naming the costliest
+ * node) a scene whose cost per point exceeds LB_SCENE_MAX_COST_FACTOR times
+ * its instruction count or LB_SCENE_MAX_COST, so evaluation time per point
+ * is at most a fixed multiple of the tape size (lb_evaluator_cost). */
+#define LB_SCENE_MAX_INSTRUCTIONS 200000 /* compiled tape (a def under N transforms is N copies)   \
+                                          */
+#define LB_SCENE_MAX_COST_FACTOR 64
+#define LB_SCENE_MAX_COST 1000000
 /* Largest |coordinate| anywhere in a scene (centres, translations, bounds)
  * and of evaluation points. */
 #define LB_SCENE_MAX_COORD 1e9
@@ -100,7 +111,9 @@ LB_API size_t lb_scene_describe(const lb_scene *scene, char *buf, size_t size);
 
 /* Reference evaluator: a plain recursive walk over the scene tree, one
  * point, calling the public per-family functions. Slow on purpose; tests and
- * benchmarks compare the compiled evaluator against it. grad may be NULL. */
+ * benchmarks compare the compiled evaluator against it. grad may be NULL.
+ * The walk visits a shared def once per use, so it refuses a scene whose
+ * walk would visit more than LB_SCENE_MAX_COST nodes per point. */
 LB_API lb_status lb_scene_eval_reference(const lb_scene *scene, const double X[3], double *value,
                                          double grad[3], lb_error *err);
 
@@ -120,6 +133,10 @@ LB_API lb_convention lb_evaluator_convention(const lb_evaluator *ev);
 
 /* Number of instructions on the tape. */
 LB_API size_t lb_evaluator_size(const lb_evaluator *ev);
+
+/* Instruction runs one point costs (the cost model above): at least
+ * lb_evaluator_size, at most LB_SCENE_MAX_COST_FACTOR times it. 0 for NULL. */
+LB_API double lb_evaluator_cost(const lb_evaluator *ev);
 
 /* Values and gradients at n points given as three coordinate arrays
  * (structure of arrays). value must be non-NULL; gx, gy, gz may each be NULL.

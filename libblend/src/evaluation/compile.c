@@ -14,6 +14,10 @@ typedef struct memo_entry {
 typedef struct cctx {
     lb_evaluator *ev;
     size_t cap;
+    uint32_t *mark, *stack; /* cone search: a stamp per instruction, the DFS stack */
+    size_t markcap;
+    uint32_t stamp;
+    size_t costliest; /* the instruction with the largest cost so far */
     memo_entry *memo;
     size_t mcap, mcount;
     lb_convention conv;
@@ -53,14 +57,15 @@ static lb_status memo_grow(cctx *c) {
     return LB_OK;
 }
 
-static lb_status push(cctx *c, lb__instr **out) {
+static lb_status push(cctx *c, const lb__node *n, lb__instr **out) {
     lb_evaluator *ev = c->ev;
-    if (ev->n >= LB__MAX_INSTRUCTIONS)
-        return lb__fail(c->err, LB_ERR_NO_MEMORY,
-                        "lb_evaluator_create: the scene expands to more than %u instructions "
-                        "(shared defs under many different transforms); allowed: fewer "
-                        "distinct transformed copies",
-                        LB__MAX_INSTRUCTIONS);
+    if (ev->n >= LB_SCENE_MAX_INSTRUCTIONS)
+        return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: the scene expands to more than %d instructions here (shared defs "
+                        "under many different transforms each compile once per transform); "
+                        "allowed: at most %d (docs/scene-format.md, \"Cost\"): fewer distinct "
+                        "transformed copies",
+                        n->path, LB_SCENE_MAX_INSTRUCTIONS, LB_SCENE_MAX_INSTRUCTIONS);
     if (ev->n == c->cap) {
         const size_t ncap = c->cap ? 2 * c->cap : 64;
         lb__instr *ni = realloc(ev->ins, ncap * sizeof *ni);
@@ -71,6 +76,25 @@ static lb_status push(cctx *c, lb__instr **out) {
     *out = &ev->ins[ev->n++];
     memset(*out, 0, sizeof **out);
     return LB_OK;
+}
+
+static int cmp_u32(const void *a, const void *b) {
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The scene costs too much per point: name the node that makes it so. */
+static lb_status cost_error(cctx *c) {
+    const lb_evaluator *ev = c->ev;
+    const lb__instr *in = &ev->ins[c->costliest];
+    return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
+                    "%s: the scene costs %.0f instruction runs per point on its %zu-instruction "
+                    "tape, %.0f of them for this bulge-eliminated blend (it re-runs its "
+                    "arguments' %u instructions twice each); allowed: at most %d times the "
+                    "tape size and %d in all (docs/scene-format.md, \"Cost\"): bulge fewer "
+                    "blends, or blend fewer or smaller arguments",
+                    in->code == LB__I_OP ? in->op.path : "$.root", ev->cost, ev->n, in->cost,
+                    in->ncone[0] + in->ncone[1], LB_SCENE_MAX_COST_FACTOR, LB_SCENE_MAX_COST);
 }
 
 static double *dup_array(const double *v, size_t k, int *fail) {
@@ -125,6 +149,89 @@ static lb_status precompute_op(cctx *c, lb__instr *in, const lb__node *n, const 
     return LB_OK;
 }
 
+/* The instructions that instruction `root` depends on, itself included, in
+ * tape order, appended to *list (grown as needed); returns their cost sum.
+ * The work is the cone's size, which the cost model already charges. */
+static lb_status cone_of(cctx *c, uint32_t root, uint32_t **list, size_t *len, size_t *cap,
+                         double *cost) {
+    lb_evaluator *ev = c->ev;
+    if (c->markcap < ev->n) {
+        size_t ncap = c->markcap ? c->markcap : 256;
+        while (ncap < ev->n) ncap *= 2;
+        uint32_t *m = realloc(c->mark, ncap * sizeof *m);
+        if (m) c->mark = m;
+        uint32_t *st = m ? realloc(c->stack, ncap * sizeof *st) : NULL;
+        if (st) c->stack = st;
+        if (!m || !st)
+            return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+        memset(c->mark + c->markcap, 0, (ncap - c->markcap) * sizeof *c->mark);
+        c->markcap = ncap;
+    }
+    if (++c->stamp == 0) { /* wrapped: clear the stamps */
+        memset(c->mark, 0, c->markcap * sizeof *c->mark);
+        c->stamp = 1;
+    }
+    const size_t start = *len;
+    size_t top = 0;
+    c->stack[top++] = root;
+    c->mark[root] = c->stamp;
+    *cost = 0.0;
+    while (top) {
+        const uint32_t i = c->stack[--top];
+        if (*len == *cap) {
+            const size_t ncap = *cap ? 2 * *cap : 64;
+            uint32_t *nl = realloc(*list, ncap * sizeof *nl);
+            if (!nl)
+                return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+            *list = nl;
+            *cap = ncap;
+        }
+        (*list)[(*len)++] = i;
+        const lb__instr *in = &ev->ins[i];
+        *cost += in->cost;
+        if (in->code != LB__I_OP) continue;
+        for (size_t a = 0; a < in->op.k; ++a)
+            for (int b = 0; b < 2; ++b) {
+                const uint32_t *from = b ? in->srcb : in->srci;
+                if (!from || c->mark[from[a]] == c->stamp) continue;
+                c->mark[from[a]] = c->stamp;
+                c->stack[top++] = from[a];
+            }
+    }
+    qsort(*list + start, *len - start, sizeof **list, cmp_u32);
+    return LB_OK;
+}
+
+/* The cost model (scene.h, docs/scene-format.md "Cost"): one run per
+ * instruction; a bulge-eliminated blend also re-runs each argument's cone
+ * twice (central differences of its gradient). Checked as the tape grows,
+ * so compiling a scene that is refused costs no more than the limit. */
+static lb_status charge(cctx *c, uint32_t idx) {
+    lb_evaluator *ev = c->ev;
+    lb__instr *in = &ev->ins[idx];
+    in->cost = 1.0;
+    if (in->code == LB__I_OP && in->op.bulge) {
+        size_t len = 0, cap = 0;
+        uint32_t *list = NULL;
+        double w[2] = {0.0, 0.0};
+        for (int a = 0; a < 2; ++a) {
+            const size_t before = len;
+            lb_status s = cone_of(c, in->srci[a], &list, &len, &cap, &w[a]);
+            if (s) {
+                free(list);
+                return s;
+            }
+            in->ncone[a] = (uint32_t)(len - before);
+        }
+        in = &ev->ins[idx];
+        in->cone = list;
+        in->cost += 2.0 * (w[0] + w[1]);
+    }
+    if (in->cost > ev->ins[c->costliest].cost) c->costliest = idx;
+    ev->cost += in->cost;
+    return ev->cost > LB_SCENE_MAX_COST ? cost_error(c) : LB_OK;
+}
+
 static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, uint32_t *out) {
     lb__affine A = *Ap;
     if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
@@ -164,7 +271,7 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         }
     }
     lb__instr *in = NULL;
-    if ((s = push(c, &in))) {
+    if ((s = push(c, n, &in))) {
         free(src);
         free(srci);
         free(srcb);
@@ -206,6 +313,7 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         if (fail) return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
         if ((s = precompute_op(c, in, n, &A))) return s;
     }
+    if ((s = charge(c, idx))) return s;
     e = memo_find(c, n, &A); /* the table may have grown during recursion */
     e->node = n;
     e->A = A;
@@ -276,6 +384,7 @@ void lb_evaluator_free(lb_evaluator *ev) {
         free(in->src);
         free(in->srci);
         free(in->srcb);
+        free(in->cone);
         free(in->op.r);
         free(in->op.p);
         free(in->op.m);
@@ -306,7 +415,10 @@ lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_erro
     lb__affine_identity(&id);
     uint32_t root = 0;
     lb_status s = compile_node(&c, scene->root, &id, &root);
+    if (!s && ev->cost > (double)LB_SCENE_MAX_COST_FACTOR * (double)ev->n) s = cost_error(&c);
     free(c.memo);
+    free(c.mark);
+    free(c.stack);
     if (!s) s = allocate_registers(ev, root, err);
     if (s) {
         lb_evaluator_free(ev);
@@ -318,4 +430,8 @@ lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_erro
 
 lb_convention lb_evaluator_convention(const lb_evaluator *ev) {
     return ev ? ev->conv : LB_CONVENTION_ZERO;
+}
+
+double lb_evaluator_cost(const lb_evaluator *ev) {
+    return ev ? ev->cost : 0.0;
 }

@@ -230,11 +230,11 @@ static int bt_two_chunk(const lb__instr *in, size_t k, size_t n, const double *c
 
 static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
                            const double *y, const double *z, const double *dg, double *G,
-                           lb_error *err);
+                           size_t *count, lb_error *err);
 
 static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__plan *plan, size_t n,
                         const double *px, const double *py, const double *pz, double *regs,
-                        lb_error *err) {
+                        size_t *count, lb_error *err) {
     const lb__node *nd = &in->op;
     const size_t kf = nd->k;
     const int bounded = nd->family == LB__F_BOUNDED;
@@ -338,7 +338,7 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
     lb_status s = LB_OK;
     if (nd->bulge) {
         double G[3 * LB__CHUNK];
-        s = bulge_hvp(ev, in, n, px, py, pz, dgall, G, err);
+        s = bulge_hvp(ev, in, n, px, py, pz, dgall, G, count, err);
         for (size_t j = 0; j < n && !s; ++j) {
             ox[j] += G[3 * j];
             oy[j] += G[3 * j + 1];
@@ -351,17 +351,24 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
 
 /* The Hessian-vector terms of bulge elimination (the operator depends on the
  * argument gradients): each argument's analytic gradient is differenced
- * along d value / d g_i, re-running the tape prefix that computes it. */
+ * along d value / d g_i, re-running only the instructions that argument
+ * depends on (its cone, listed at compile time), so the work is the cost
+ * model's (tape.h) and never compounds across siblings. */
+static lb_status run_list(const lb_evaluator *ev, const lb__plan *plan, const uint32_t *list,
+                          size_t upto, size_t n, const double *x, const double *y, const double *z,
+                          double *regs, size_t *count, lb_error *err);
+
 static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
                            const double *y, const double *z, const double *dg, double *G,
-                           lb_error *err) {
+                           size_t *count, lb_error *err) {
     memset(G, 0, 3 * n * sizeof *G);
     double *regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
     if (!regs) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
     double sx[LB__CHUNK], sy[LB__CHUNK], sz[LB__CHUNK], eps[LB__CHUNK], len[LB__CHUNK];
     lb_status s = LB_OK;
     for (int i = 0; i < 2 && !s; ++i) {
-        const uint32_t child = in->srci[i], reg = in->src[i];
+        const uint32_t reg = in->src[i];
+        const uint32_t *cone = in->cone + (i ? in->ncone[0] : 0);
         double gp[3][LB__CHUNK];
         for (int sign = 1; sign >= -1 && !s; sign -= 2) {
             for (size_t j = 0; j < n; ++j) {
@@ -373,7 +380,7 @@ static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n
                 sy[j] = y[j] + f * d[1];
                 sz[j] = z[j] + f * d[2];
             }
-            s = lb__tape_run(ev, child, n, sx, sy, sz, regs, err);
+            s = run_list(ev, NULL, cone, in->ncone[i] - 1, n, sx, sy, sz, regs, count, err);
             for (size_t j = 0; j < n && !s; ++j)
                 for (int d = 0; d < 3; ++d) {
                     const double gv = lb__reg(regs, reg, 1 + d)[j];
@@ -388,12 +395,17 @@ static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n
     return s;
 }
 
-static lb_status run_range(const lb_evaluator *ev, const lb__plan *plan, size_t upto, size_t n,
-                           const double *x, const double *y, const double *z, double *regs,
-                           lb_error *err) {
-    for (size_t i = 0; i <= upto; ++i) {
+/* Instructions list[0..upto] (list NULL: 0..upto) in tape order, skipping
+ * what the plan does not need; count (may be NULL) adds one per
+ * instruction run. */
+static lb_status run_list(const lb_evaluator *ev, const lb__plan *plan, const uint32_t *list,
+                          size_t upto, size_t n, const double *x, const double *y, const double *z,
+                          double *regs, size_t *count, lb_error *err) {
+    for (size_t q = 0; q <= upto; ++q) {
+        const size_t i = list ? list[q] : q;
         if (plan && !plan->need[i]) continue;
         const lb__instr *in = &ev->ins[i];
+        if (count) ++*count;
         double *v = lb__reg(regs, in->dst, 0), *gx = lb__reg(regs, in->dst, 1),
                *gy = lb__reg(regs, in->dst, 2), *gz = lb__reg(regs, in->dst, 3);
         switch (in->code) {
@@ -404,7 +416,7 @@ static lb_status run_range(const lb_evaluator *ev, const lb__plan *plan, size_t 
             run_prim(in, n, x, y, z, v, gx, gy, gz);
             break;
         default: {
-            lb_status s = run_op(ev, in, plan, n, x, y, z, regs, err);
+            lb_status s = run_op(ev, in, plan, n, x, y, z, regs, count, err);
             if (s) return s;
         }
         }
@@ -412,14 +424,14 @@ static lb_status run_range(const lb_evaluator *ev, const lb__plan *plan, size_t 
     return LB_OK;
 }
 
-lb_status lb__tape_run(const lb_evaluator *ev, size_t upto, size_t n, const double *x,
-                       const double *y, const double *z, double *regs, lb_error *err) {
-    return run_range(ev, NULL, upto, n, x, y, z, regs, err);
+lb_status lb__tape_run_counted(const lb_evaluator *ev, size_t n, const double *x, const double *y,
+                               const double *z, double *regs, size_t *count, lb_error *err) {
+    return run_list(ev, NULL, NULL, ev->n - 1, n, x, y, z, regs, count, err);
 }
 
 lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *plan, size_t n, const double *x,
                             const double *y, const double *z, double *regs, lb_error *err) {
-    return run_range(ev, plan, ev->n - 1, n, x, y, z, regs, err);
+    return run_list(ev, plan, NULL, ev->n - 1, n, x, y, z, regs, NULL, err);
 }
 
 /* ---- batches and threads ----

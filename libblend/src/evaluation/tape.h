@@ -18,9 +18,6 @@
 #include <stdint.h>
 
 #define LB__CHUNK 64
-/* Largest tape a scene may compile to (shared defs under many different
- * transforms multiply). */
-#define LB__MAX_INSTRUCTIONS 200000u
 
 enum lb__code {
     LB__I_PRIM = 0,  /* general primitive with affine map */
@@ -40,10 +37,15 @@ typedef struct lb__instr {
     uint32_t *src;  /* k argument registers, then k bounding registers (bounded) */
     uint32_t *srci; /* k argument instruction indices (bulge: prefix re-evaluation) */
     uint32_t *srcb; /* k bounding-solid instruction indices (bounded), else NULL */
-    int fast;       /* LB__FAST_* */
-    int mode;       /* exponent mode for the fast kernels */
-    double lip;     /* primitives: Lipschitz factor of rho in the primitive frame */
-    size_t aoff;    /* operators: offset of this instruction's slots in a plan's act */
+    uint32_t *cone; /* bulge: the instructions each argument depends on, in tape order,
+                       argument 0's ncone[0] then argument 1's ncone[1] (re-run for the
+                       Hessian terms) */
+    uint32_t ncone[2];
+    double cost; /* instruction runs per point, reruns included (the cost model) */
+    int fast;    /* LB__FAST_* */
+    int mode;    /* exponent mode for the fast kernels */
+    double lip;  /* primitives: Lipschitz factor of rho in the primitive frame */
+    size_t aoff; /* operators: offset of this instruction's slots in a plan's act */
 } lb__instr;
 
 enum { LB__FAST_NONE = 0, LB__FAST_DISPLACEMENT, LB__FAST_CONIC, LB__FAST_SCALE, LB__FAST_MINMAX };
@@ -56,6 +58,7 @@ struct lb_evaluator {
     uint32_t out;   /* register of the root */
     size_t total_k; /* sum of operator arities */
     int cullable;   /* some operator can drop arguments per box (lb__bounds_pass) */
+    double cost;    /* instruction runs per point for the whole tape (the cost model) */
 };
 
 /* An interval. */
@@ -88,10 +91,13 @@ LB_INTERNAL void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *par
 LB_INTERNAL void lb__box_centre(const double bmin[3], const double bmax[3], double bc[3],
                                 double br[3]);
 
-/* Run instructions [0, upto] on n <= LB__CHUNK points into regs
- * (nregs * 4 * LB__CHUNK doubles). */
-LB_INTERNAL lb_status lb__tape_run(const lb_evaluator *ev, size_t upto, size_t n, const double *x,
-                                   const double *y, const double *z, double *regs, lb_error *err);
+/* Run the whole tape, without culling, on n <= LB__CHUNK points into regs
+ * (nregs * 4 * LB__CHUNK doubles), adding to *count (may be NULL) one per
+ * instruction run, bulge re-runs included: the tests hold the cost model to
+ * what the evaluator really does. */
+LB_INTERNAL lb_status lb__tape_run_counted(const lb_evaluator *ev, size_t n, const double *x,
+                                           const double *y, const double *z, double *regs,
+                                           size_t *count, lb_error *err);
 /* The same for the instructions a plan needs, with culled arguments skipped. */
 LB_INTERNAL lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *plan, size_t n,
                                         const double *x, const double *y, const double *z,

@@ -97,6 +97,7 @@ static lb__node *new_node(pctx *c, lb__family fam, const char *type) {
     }
     lb__node *n = calloc(1, sizeof *n);
     if (!n) return NULL;
+    n->walk_cost = 1.0;
     n->path = malloc(c->plen + 1);
     if (!n->path) {
         free(n);
@@ -572,6 +573,7 @@ static lb_status parse_ref(pctx *c, const cJSON *j, size_t depth, lb__node **out
     g->to_parent = tmp.to_parent;
     g->depth = target->depth + 1;
     g->bulge_depth = target->bulge_depth;
+    g->walk_cost = 1.0 + target->walk_cost;
     *out = g;
     return LB_OK;
 }
@@ -892,6 +894,10 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
         if (n->bounds && n->bounds[i]->depth + 1 > n->depth) n->depth = n->bounds[i]->depth + 1;
         if (n->bounds && n->bounds[i]->bulge_depth > n->bulge_depth)
             n->bulge_depth = n->bounds[i]->bulge_depth;
+        /* the reference walk visits a shared node once per use, and a
+         * bulge-eliminated blend walks each argument twice more */
+        n->walk_cost += (n->bulge ? 3.0 : 1.0) * a->walk_cost;
+        if (n->bounds) n->walk_cost += n->bounds[i]->walk_cost;
     }
     if (n->bulge && ++n->bulge_depth > LB_SCENE_MAX_BULGE_NESTING) {
         const size_t old = push_key(c, "bulge");

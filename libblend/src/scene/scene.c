@@ -245,6 +245,12 @@ lb_status lb_scene_eval_reference(const lb_scene *s, const double X[3], double *
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "lb_scene_eval_reference: X[%d] = %g; allowed: |X| <= %g", i, X[i],
                             LB_SCENE_MAX_COORD);
+    if (s->root->walk_cost > LB_SCENE_MAX_COST)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "lb_scene_eval_reference: the plain walk would visit %.3g nodes per "
+                        "point (shared defs once per use); allowed: at most %d: use the compiled "
+                        "evaluator (lb_evaluator_eval), which shares them",
+                        s->root->walk_cost, LB_SCENE_MAX_COST);
     double g[3];
     lb__affine id;
     lb__affine_identity(&id);

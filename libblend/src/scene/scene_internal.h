@@ -53,6 +53,7 @@ struct lb__node {
     char *def_name;     /* name when the node is a def, else NULL */
     size_t depth;       /* height: 1 for a leaf */
     size_t bulge_depth; /* bulge nodes on the longest path down (4 re-evaluations each) */
+    double walk_cost;   /* nodes the reference walk visits per point (shared nodes per use) */
 };
 
 struct lb_scene {
