@@ -40,8 +40,8 @@ extern "C" {
  * node) a scene whose cost per point exceeds LB_SCENE_MAX_COST_FACTOR times
  * its instruction count or LB_SCENE_MAX_COST, so evaluation time per point
  * is at most a fixed multiple of the tape size (lb_evaluator_cost). */
-#define LB_SCENE_MAX_INSTRUCTIONS 200000 /* compiled tape (a def under N transforms is N copies)   \
-                                          */
+/* compiled tape size (a def used under N transforms is N copies) */
+#define LB_SCENE_MAX_INSTRUCTIONS 200000
 #define LB_SCENE_MAX_COST_FACTOR 64
 #define LB_SCENE_MAX_COST 1000000
 /* Largest |coordinate| anywhere in a scene (centres, translations, bounds)
