@@ -8,6 +8,7 @@ PACKAGES=(
   clang libclang-rt-14-dev   # libFuzzer and sanitizer runtimes for clang
   libcmocka-dev              # unit-test framework used by tests/
   libcjson-dev               # JSON parser for scene files
+  libjansson-dev             # strict RFC 8259 check of scene files (line:column)
   python3-jsonschema         # tests: scene files against docs/libblend-scene.schema.json
   python3-numpy              # tests: independent mesh readers and checks (tests/mesh/)
   povray                     # tests: the generated POV-Ray include, run by POV-Ray itself

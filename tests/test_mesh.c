@@ -576,6 +576,68 @@ static void test_progress_and_cancel(void **state) {
     lb_scene_free(sc);
 }
 
+/* Over the memory cap, the message names the largest resolution that
+ * fits: following it works, one more does not. Also an empty region: a
+ * valid mesh with no triangles, written in every format. */
+static void test_memory_cap_and_empty(void **state) {
+    (void)state;
+    char path[1100];
+    snprintf(path, sizeof path, "%s/scenes/bench-s2-64-spheres.json", SOURCE_DIR);
+    lb_error e = {LB_OK, ""};
+    lb_scene *sc = NULL;
+    lb_evaluator *ev = NULL;
+    assert_int_equal(lb_scene_load(path, &sc, &e), LB_OK);
+    assert_int_equal(lb_evaluator_create(sc, &ev, &e), LB_OK);
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    lb_scene_bounds(sc, o.bmin, o.bmax);
+    o.threads = 1;
+    o.max_memory = (size_t)12 << 20; /* 96 blocks */
+    o.resolution = 4096;
+    lb_mesh *m = NULL;
+    assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_ERR_INVALID_ARGUMENT);
+    const char *at = strstr(e.message, "a resolution of at most ");
+    assert_non_null(at);
+    const unsigned fit = (unsigned)strtoul(at + strlen("a resolution of at most "), NULL, 10);
+    assert_true(fit >= 16 && fit < 4096);
+    o.resolution = fit;
+    if (lb_mesh_create(ev, &o, &m, &e) != LB_OK)
+        fail_msg("the suggested %u fails: %s", fit, e.message);
+    assert_true(m->ntriangles > 0);
+    lb_mesh_free(m);
+    m = NULL;
+    o.resolution = fit + 1;
+    assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_ERR_INVALID_ARGUMENT);
+    assert_null(m);
+    /* a region with no surface in it */
+    o.max_memory = 0;
+    o.resolution = 16;
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = 100.0;
+        o.bmax[d] = 101.0;
+    }
+    assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_OK);
+    assert_int_equal(m->nvertices, 0);
+    assert_int_equal(m->ntriangles, 0);
+    static const char *const ext[] = {"ply", "obj", "stl", "glb"};
+    for (int i = 0; i < 4; ++i) {
+        char out[64];
+        snprintf(out, sizeof out, "empty-mesh-test.%s", ext[i]);
+        if (lb_mesh_write(m, out, LB_MESH_FORMAT_AUTO, &e) != LB_OK)
+            fail_msg("%s: %s", out, e.message);
+        FILE *f = fopen(out, "rb");
+        assert_non_null(f);
+        fseek(f, 0, SEEK_END);
+        const long size = ftell(f);
+        fclose(f);
+        assert_true(ext[i][0] == 'o' || size > 0);
+        remove(out);
+    }
+    lb_mesh_free(m);
+    lb_evaluator_free(ev);
+    lb_scene_free(sc);
+}
+
 static void test_bad_options(void **state) {
     (void)state;
     static const char text[] =
@@ -601,11 +663,11 @@ static void test_bad_options(void **state) {
         {1, 0, LB_ERR_INVALID_ARGUMENT, "resolution = 0; allowed: 1 to 8192"},
         {1, 9000, LB_ERR_INVALID_ARGUMENT, "resolution = 9000; allowed: 1 to 8192"},
         {2, -1, LB_ERR_INVALID_ARGUMENT, "cell_size = -1; allowed: a positive number"},
-        {2, 1e-6, LB_ERR_NO_MEMORY, "allowed: at most 8192 cells per axis"},
+        {2, 1e-6, LB_ERR_INVALID_ARGUMENT, "allowed: at most 8192 cells per axis"},
         {3, -2, LB_ERR_INVALID_ARGUMENT, "threads = -2"},
         {4, 8, LB_ERR_INVALID_ARGUMENT, "flags = 0x8"},
         {5, 1e9, LB_ERR_INVALID_ARGUMENT, "|value| <= 1e+09"},
-        {6, 1 << 20, LB_ERR_NO_MEMORY, "over the memory cap of 1 MiB"},
+        {6, 1 << 20, LB_ERR_INVALID_ARGUMENT, "over the memory cap of 1 MiB"},
         {7, NAN, LB_ERR_INVALID_ARGUMENT, "allowed: finite"},
     };
     for (size_t i = 0; i < sizeof rows / sizeof rows[0]; ++i) {
@@ -669,6 +731,7 @@ int main(void) {
         cmocka_unit_test(test_no_self_intersections),
         cmocka_unit_test(test_progress_and_cancel),
         cmocka_unit_test(test_bad_options),
+        cmocka_unit_test(test_memory_cap_and_empty),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

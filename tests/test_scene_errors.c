@@ -393,8 +393,46 @@ static void test_limits(void **state) {
     /* text larger than LB_SCENE_MAX_BYTES: refused before it is read */
     static const char small[] = "{}";
     expect(
-        small, (size_t)LB_SCENE_MAX_BYTES + 1, LB_ERR_NO_MEMORY,
+        small, (size_t)LB_SCENE_MAX_BYTES + 1, LB_ERR_INVALID_ARGUMENT,
         (const char *const[3]){"big.json: the scene is 67108865 bytes", "at most 67108864 bytes"});
+}
+
+/* RFC 8259 exactly: what cJSON alone accepted is refused with line:column,
+ * and the message stays one line (control characters escaped). */
+static void test_strict_json(void **state) {
+    (void)state;
+    static const char head[] = "{\"format\":\"libblend-scene\",\"version\":1,\"convention\":";
+    struct {
+        const char *tail; /* after head */
+        size_t extra;     /* bytes of tail past its NUL that belong to the text */
+        const char *want;
+    } cases[] = {
+        {"\"zero\",\"root\":{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":01}}", 0,
+         "bad.json:1:110: invalid JSON: invalid token near '0'"},
+        {"\"zero\",\"root\":{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1.}}", 0,
+         "bad.json:1:111: invalid JSON: invalid token near '1.'"},
+        {"\"ze\nro\",\"root\":{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1}}", 0,
+         "bad.json:1:55: invalid JSON: unexpected newline near '\"ze'"},
+        {"\"zero\\u0000\",\"root\":{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1}}", 0,
+         "invalid JSON: \\u0000 is not allowed"},
+        {"\"zero\",\"root\":{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1}}\0x", 2,
+         "invalid JSON: end of file expected"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        char text[512];
+        const size_t hl = strlen(head), tl = strlen(cases[i].tail) + cases[i].extra;
+        memcpy(text, head, hl);
+        memcpy(text + hl, cases[i].tail, tl);
+        lb_scene *sc = NULL;
+        lb_error e = {LB_OK, ""};
+        const lb_status s = lb_scene_parse(text, hl + tl, "bad.json", &sc, &e);
+        if (s != LB_ERR_INVALID_ARGUMENT || !strstr(e.message, cases[i].want))
+            fail_msg("strict case %zu: status %d, message \"%s\", want \"%s\"", i, s, e.message,
+                     cases[i].want);
+        if (strchr(e.message, '\n') || strchr(e.message, '\0' + 1))
+            fail_msg("strict case %zu: control character in \"%s\"", i, e.message);
+        assert_null(sc);
+    }
 }
 
 /* Files: missing, a directory, too large (a sparse file), and a good one. */
@@ -412,9 +450,14 @@ static void test_files(void **state) {
     assert_true(fd >= 0);
     assert_int_equal(ftruncate(fd, (off_t)LB_SCENE_MAX_BYTES + 10), 0);
     close(fd);
-    assert_int_equal(lb_scene_load(path, &sc, &e), LB_ERR_NO_MEMORY);
+    assert_int_equal(lb_scene_load(path, &sc, &e), LB_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(e.message, "the scene file is 67108874 bytes"));
     unlink(path);
+    /* endless devices: read to the size limit, then bad input (not memory) */
+    assert_int_equal(lb_scene_load("/dev/zero", &sc, &e), LB_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(e.message, "/dev/zero: the scene file is larger than 67108864 bytes"));
+    assert_int_equal(lb_scene_load("/dev/urandom", &sc, &e), LB_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(e.message, "/dev/urandom: the scene file is larger than"));
     assert_null(sc);
 }
 
@@ -423,6 +466,7 @@ int main(void) {
         cmocka_unit_test(test_bad_scene_table),
         cmocka_unit_test(test_limits),
         cmocka_unit_test(test_files),
+        cmocka_unit_test(test_strict_json),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

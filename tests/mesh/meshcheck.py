@@ -81,6 +81,9 @@ def read_glb(path):
     jlen, jtype = struct.unpack_from("<I4s", data, 12)
     assert jtype == b"JSON"
     doc = json.loads(data[20:20 + jlen])
+    if "meshes" not in doc:  # a scene without nodes: the empty mesh
+        assert len(data) == 20 + jlen and "buffers" not in doc
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     blen, btype = struct.unpack_from("<I4s", data, 20 + jlen)
     assert btype == b"BIN\0"
     bin_ = data[28 + jlen:28 + jlen + blen]

@@ -4,6 +4,7 @@
 usage: test_mesh_files.py BLENDTOOL SOURCE_DIR WORK_DIR
 """
 import glob
+import json
 import os
 import shutil
 import subprocess
@@ -78,6 +79,22 @@ if len(data) == 4:
     if abs(c["volume"] - meshcheck.check(V, F)["volume"]) > 1e-4 * abs(c["volume"]):
         fail("STL volume %g differs from PLY %g" % (c["volume"], meshcheck.check(V, F)["volume"]))
 
+# a region without surface: a valid empty mesh in every format, read back
+for ext in ("ply", "obj", "stl", "glb"):
+    out = os.path.join(work, "empty." + ext)
+    r = run(default, "-o", out, "--bounds", "100,100,100,101,101,101", "--resolution", "8")
+    if r.returncode != 0 or "0 vertices, 0 triangles" not in r.stdout:
+        fail("empty %s: exit %d, %r %r" % (ext, r.returncode, r.stdout, r.stderr))
+        continue
+    V, N, F = meshcheck.read(out)
+    if len(V) or len(F):
+        fail("empty %s read back with %d vertices, %d triangles" % (ext, len(V), len(F)))
+    if ext == "glb":
+        raw = open(out, "rb").read()
+        doc = json.loads(raw[20:20 + int.from_bytes(raw[12:16], "little")])
+        if "accessors" in doc or "buffers" in doc or doc["scenes"] != [{}]:
+            fail("empty GLB is not a valid glTF scene without nodes: %s" % doc)
+
 # the same bytes for 1 and 2 threads
 outs = []
 for t in ("1", "2"):
@@ -104,7 +121,12 @@ bad = [
     ((os.path.join(work, "missing.json"), "-o", os.path.join(work, "x.ply")), "cannot open"),
     ((default, "-o", "/nonexistent-dir/x.ply"), "/nonexistent-dir/x.ply"),
     ((default, "-o", os.path.join(work, "x.ply"), "--frobnicate"), "unknown option"),
+    ((default, "-o", os.path.join(work, "x.ply"), "--resolution", "8", "--cell-size", "0.1"),
+     "--resolution and --cell-size both given"),
+    ((default, "-o", work), "unknown mesh format"),
+    ((default, "-o", os.path.join(work, "dir.ply")), "dir.ply: is a folder"),
 ]
+os.makedirs(os.path.join(work, "dir.ply"), exist_ok=True)
 for args, msg in bad:
     r = run(*args)
     if r.returncode != 2 or msg not in r.stderr or r.stderr.count("\n") != 1:

@@ -132,8 +132,7 @@ static int run_eval(int argc, char **argv) {
     lb_error e = {LB_OK, ""};
     lb_status s = lb_evaluator_create(sc, &ev, &e);
     if (s) {
-        bt_error(cmd, "%s: %s", scene_path, e.message);
-        rc = bt_exit_for(s);
+        rc = bt_fail(cmd, scene_path, s, &e);
         goto done;
     }
     if (points_path) {
@@ -163,8 +162,7 @@ static int run_eval(int argc, char **argv) {
     }
     s = lb_evaluator_eval(ev, P.n, P.x, P.y, P.z, val, gx, gy, gz, threads, &e);
     if (s) {
-        bt_error(cmd, "%s: %s", scene_path, e.message);
-        rc = bt_exit_for(s);
+        rc = bt_fail(cmd, scene_path, s, &e);
         goto done;
     }
     size_t len = 0;

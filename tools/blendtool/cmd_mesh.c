@@ -4,21 +4,12 @@
 
 #include <errno.h>
 #include <math.h>
-#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
 
 static const char CMD[] = "mesh";
-
-static volatile sig_atomic_t interrupted = 0;
-_Static_assert(sizeof(sig_atomic_t) == sizeof(int), "the cancel flag is an int");
-
-static void on_sigint(int sig) {
-    (void)sig;
-    interrupted = 1;
-}
 
 typedef struct bar {
     int shown;
@@ -64,7 +55,7 @@ static int run(int argc, char **argv) {
     const char *out = NULL, *scene_path = NULL, *val = NULL;
     lb_mesh_options o;
     lb_mesh_options_init(&o);
-    int have_bounds = 0, quiet = 0;
+    int have_bounds = 0, quiet = 0, have_res = 0;
     for (int i = 1; i < argc; ++i) {
         int r;
         if ((r = bt_option(CMD, argc, argv, &i, "-o", &val)) ||
@@ -84,6 +75,7 @@ static int run(int argc, char **argv) {
                 return BT_EXIT_BAD_INPUT;
             }
             o.resolution = (unsigned)n;
+            have_res = 1;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--cell-size", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
             char *end = NULL;
@@ -115,6 +107,11 @@ static int run(int argc, char **argv) {
             return BT_EXIT_BAD_INPUT;
         }
     }
+    if (have_res && o.cell_size > 0.0) {
+        bt_error(CMD, "--resolution and --cell-size both given; allowed: one of them (the cell "
+                      "size, or the cells along the longest side)");
+        return BT_EXIT_BAD_INPUT;
+    }
     if (!scene_path || !out) {
         bt_error(CMD, "%s; usage: blendtool mesh SCENE -o OUT.{ply,obj,stl,glb}",
                  !scene_path ? "no scene given" : "no output given (-o OUT)");
@@ -143,39 +140,44 @@ static int run(int argc, char **argv) {
     }
     lb_error e = {LB_OK, ""};
     lb_evaluator *ev = NULL;
-    lb_status s = lb_evaluator_create(scene, &ev, &e);
     lb_mesh *mesh = NULL;
-    bar b = {0, -1};
-    if (!s) {
-        if (!quiet && isatty(STDERR_FILENO)) {
-            o.progress = progress;
-            o.user = &b;
-        }
-        o.cancel = (const volatile int *)&interrupted;
-        struct sigaction sa, old;
-        memset(&sa, 0, sizeof sa);
-        sa.sa_handler = on_sigint;
-        sigaction(SIGINT, &sa, &old);
-        struct timespec t0, t1;
-        clock_gettime(CLOCK_MONOTONIC, &t0);
-        s = lb_mesh_create(ev, &o, &mesh, &e);
-        clock_gettime(CLOCK_MONOTONIC, &t1);
-        sigaction(SIGINT, &old, NULL);
-        if (b.shown) fputc('\n', stderr);
-        if (!s) s = lb_mesh_write(mesh, out, LB_MESH_FORMAT_AUTO, &e);
-        if (!s && !quiet)
-            printf("%s: %zu vertices, %zu triangles, %u x %u x %u cells, %.3f s\n", out,
-                   mesh->nvertices, mesh->ntriangles, mesh->cells[0], mesh->cells[1],
-                   mesh->cells[2],
-                   (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
-    }
+    bt_out w = {0};
+    lb_status s = lb_evaluator_create(scene, &ev, &e);
     if (s) {
-        bt_error(CMD, "%s%s%s", s == LB_ERR_INVALID_ARGUMENT ? scene_path : "",
-                 s == LB_ERR_INVALID_ARGUMENT ? ": " : "", e.message);
-        rc = s == LB_ERR_INVALID_ARGUMENT || s == LB_ERR_NO_MEMORY || s == LB_ERR_IO
-                 ? BT_EXIT_BAD_INPUT
-                 : BT_EXIT_INTERNAL;
+        rc = bt_fail(CMD, scene_path, s, &e);
+        goto done;
     }
+    /* the output path is checked before the work: a folder or a missing
+     * folder is reported at once, not after minutes of meshing */
+    if ((rc = bt_output_open(CMD, out, &w))) goto done;
+    bar b = {0, -1};
+    if (!quiet && isatty(STDERR_FILENO)) {
+        o.progress = progress;
+        o.user = &b;
+    }
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    s = lb_mesh_create(ev, &o, &mesh, &e);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (b.shown) fputc('\n', stderr);
+    if (s) {
+        rc = bt_fail(CMD, scene_path, s, &e);
+        goto done;
+    }
+    s = lb_mesh_write_stream(mesh, w.f, lb_mesh_format_of(out), &e);
+    if (s) {
+        bt_error(CMD, "%s: writing the mesh failed (%s); nothing was written", out,
+                 strerror(errno));
+        rc = BT_EXIT_INTERNAL;
+        goto done;
+    }
+    if ((rc = bt_output_commit(CMD, &w))) goto done;
+    if (!quiet)
+        printf("%s: %zu vertices, %zu triangles, %u x %u x %u cells, %.3f s\n", out,
+               mesh->nvertices, mesh->ntriangles, mesh->cells[0], mesh->cells[1], mesh->cells[2],
+               (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec));
+done:
+    bt_output_discard(&w);
     lb_mesh_free(mesh);
     lb_evaluator_free(ev);
     lb_scene_free(scene);
@@ -195,7 +197,11 @@ const bt_command bt_cmd_mesh = {
     "  --threads N     0 = one per CPU (default), 1 = single-threaded; the mesh is the\n"
     "                  same for every thread count\n"
     "  --quiet         no progress bar (shown only on a terminal) and no summary line\n"
-    "Ctrl-C cancels: nothing is written. The output appears only when complete.\n"
-    "Exit status: 0 success, 2 bad scene or options (or over the memory cap), 1 internal\n"
-    "failure.\n",
+    "OUT may be a symbolic link (its target is replaced), a device or a FIFO (written\n"
+    "directly); a new file gets mode 0666 less the umask, an existing one keeps its mode.\n"
+    "Ctrl-C (SIGINT), SIGTERM and SIGHUP cancel at any phase: nothing is written. The\n"
+    "output appears only when complete.\n"
+    "Exit status: 0 success, 2 bad scene or options (or over the memory cap, with the\n"
+    "largest resolution that fits), 1 internal failure or failure writing OUT, 130 / 143 /\n"
+    "129 ended by SIGINT / SIGTERM / SIGHUP.\n",
     run};

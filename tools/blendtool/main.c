@@ -66,42 +66,72 @@ int bt_load_scene(const char *cmd, const char *path, lb_scene **scene) {
     return BT_EXIT_OK;
 }
 
-int bt_write_file(const char *cmd, const char *path, const char *data, size_t len) {
+int bt_output_open(const char *cmd, const char *path, bt_out *out) {
+    memset(out, 0, sizeof *out);
+    out->slot = -1;
+    out->path = path;
     if (strcmp(path, "-") == 0) {
-        if (fwrite(data, 1, len, stdout) != len || fflush(stdout) != 0) {
+        out->f = stdout;
+        return BT_EXIT_OK;
+    }
+    lb_error e = {LB_OK, ""};
+    if (lb_output_open(path, &out->o, &e)) {
+        bt_error(cmd, "%s", e.message);
+        return BT_EXIT_BAD_INPUT;
+    }
+    out->f = lb_output_stream(out->o);
+    const char *t = lb_output_temp_name(out->o);
+    if (t) out->slot = bt_signals_temp(t);
+    return BT_EXIT_OK;
+}
+
+int bt_output_commit(const char *cmd, bt_out *out) {
+    bt_signals_commit();
+    if (!out->o) {
+        if (fflush(out->f) != 0 || ferror(out->f)) {
             bt_error(cmd, "writing to standard output failed: %s", strerror(errno));
             return BT_EXIT_INTERNAL;
         }
         return BT_EXIT_OK;
     }
-    const size_t pl = strlen(path);
-    char *tmp = malloc(pl + 32);
-    if (!tmp) {
-        bt_error(cmd, "out of memory");
+    lb_error e = {LB_OK, ""};
+    const lb_status s = lb_output_commit(out->o, &e);
+    out->o = NULL;
+    bt_signals_untemp(out->slot);
+    if (s) {
+        bt_error(cmd, "%s", e.message);
         return BT_EXIT_INTERNAL;
     }
-    snprintf(tmp, pl + 32, "%s.tmp.%ld", path, (long)getpid());
-    FILE *f = fopen(tmp, "wb");
-    if (!f) {
-        bt_error(cmd,
-                 "%s: cannot create the output file (%s); allowed: a path in a writable "
-                 "directory",
-                 path, strerror(errno));
-        free(tmp);
-        return BT_EXIT_BAD_INPUT;
-    }
-    int ok = fwrite(data, 1, len, f) == len;
-    ok &= fflush(f) == 0;
-    ok &= fclose(f) == 0;
-    if (!ok || rename(tmp, path) != 0) {
-        bt_error(cmd, "%s: writing the output failed (%s); nothing was written", path,
-                 strerror(errno));
-        remove(tmp);
-        free(tmp);
-        return BT_EXIT_INTERNAL;
-    }
-    free(tmp);
     return BT_EXIT_OK;
+}
+
+void bt_output_discard(bt_out *out) {
+    if (!out->o) return;
+    lb_output_discard(out->o);
+    out->o = NULL;
+    bt_signals_untemp(out->slot);
+}
+
+int bt_write_file(const char *cmd, const char *path, const char *data, size_t len) {
+    bt_out out;
+    int rc = bt_output_open(cmd, path, &out);
+    if (rc) return rc;
+    if (len && fwrite(data, 1, len, out.f) != len) {
+        bt_error(cmd, "%s: writing the output failed (%s); nothing was written",
+                 strcmp(path, "-") ? path : "standard output", strerror(errno));
+        bt_output_discard(&out);
+        return BT_EXIT_INTERNAL;
+    }
+    return bt_output_commit(cmd, &out);
+}
+
+int bt_fail(const char *cmd, const char *scene_path, lb_status s, const lb_error *e) {
+    const size_t n = scene_path ? strlen(scene_path) : 0;
+    if (n && strncmp(e->message, scene_path, n) != 0)
+        bt_error(cmd, "%s: %s", scene_path, e->message);
+    else
+        bt_error(cmd, "%s", e->message);
+    return bt_exit_for(s);
 }
 
 int bt_wants_help(int argc, char **argv) {
@@ -118,10 +148,24 @@ static void usage(FILE *out) {
     for (size_t i = 0; i < NCOMMANDS; ++i)
         fprintf(out, "  %-10s %s\n", COMMANDS[i]->name, COMMANDS[i]->summary);
     fprintf(out, "\n`blendtool COMMAND --help` describes one command.\n"
-                 "Exit status: 0 success, 2 bad input, 1 internal failure.\n");
+                 "Exit status (every command): 0 success; 2 bad input or arguments (the\n"
+                 "message names the file, the place and the fix); 1 internal failure or\n"
+                 "failure writing output; 130 / 143 / 129 ended by SIGINT / SIGTERM / SIGHUP\n"
+                 "(nothing is left at the output path).\n");
+}
+
+/* Standard output must have reached its destination (a full disk or a
+ * closed pipe is a failure, not success). */
+static int finish(int rc) {
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        bt_error("output", "writing to standard output failed: %s", strerror(errno));
+        return rc ? rc : BT_EXIT_INTERNAL;
+    }
+    return rc;
 }
 
 int main(int argc, char **argv) {
+    bt_signals_install();
     if (argc < 2) {
         usage(stderr);
         return BT_EXIT_BAD_INPUT;
@@ -129,20 +173,20 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0 ||
         strcmp(argv[1], "help") == 0) {
         usage(stdout);
-        return BT_EXIT_OK;
+        return finish(BT_EXIT_OK);
     }
     if (strcmp(argv[1], "--version") == 0) {
         printf("blendtool (libblend) %d.%d.%d\n", LB_VERSION_MAJOR, LB_VERSION_MINOR,
                LB_VERSION_PATCH);
-        return BT_EXIT_OK;
+        return finish(BT_EXIT_OK);
     }
     for (size_t i = 0; i < NCOMMANDS; ++i) {
         if (strcmp(argv[1], COMMANDS[i]->name) != 0) continue;
         if (bt_wants_help(argc - 1, argv + 1)) {
             fputs(COMMANDS[i]->usage, stdout);
-            return BT_EXIT_OK;
+            return finish(BT_EXIT_OK);
         }
-        return COMMANDS[i]->run(argc - 1, argv + 1);
+        return finish(COMMANDS[i]->run(argc - 1, argv + 1));
     }
     fprintf(stderr, "blendtool: unknown command \"%s\"; allowed:", argv[1]);
     for (size_t i = 0; i < NCOMMANDS; ++i) fprintf(stderr, " %s", COMMANDS[i]->name);

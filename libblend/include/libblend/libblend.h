@@ -8,5 +8,6 @@
 #include "scene.h"
 #include "mesh.h"
 #include "pov.h"
+#include "output.h"
 
 #endif

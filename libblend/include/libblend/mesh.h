@@ -36,6 +36,7 @@
 #include "scene.h"
 
 #include <stdint.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -96,11 +97,21 @@ typedef enum lb_mesh_format {
     LB_MESH_FORMAT_GLB = 4   /* glTF 2.0 binary: POSITION, NORMAL, indices */
 } lb_mesh_format;
 
-/* Write the mesh to path, atomically: a temporary file in the same folder
- * is renamed over path only when everything was written, so a failure
- * leaves no partial file. */
+/* Write the mesh to path through an lb_output (libblend/output.h): the file
+ * appears only when everything was written, so a failure leaves no partial
+ * file; symbolic links are followed, devices and FIFOs written directly,
+ * modes kept. An empty mesh is a valid file in every format. */
 LB_API lb_status lb_mesh_write(const lb_mesh *mesh, const char *path, lb_mesh_format format,
                                lb_error *err);
+
+/* The same bytes into an open binary stream (for example an lb_output's);
+ * format must not be LB_MESH_FORMAT_AUTO. The stream is flushed, not closed. */
+LB_API lb_status lb_mesh_write_stream(const lb_mesh *mesh, FILE *stream, lb_mesh_format format,
+                                      lb_error *err);
+
+/* The format a file name's extension names (.ply .obj .stl .glb, any case),
+ * LB_MESH_FORMAT_AUTO for none of them or NULL. */
+LB_API lb_mesh_format lb_mesh_format_of(const char *path);
 
 #ifdef __cplusplus
 }

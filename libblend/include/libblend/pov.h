@@ -21,6 +21,8 @@
 
 #include "scene.h"
 
+#include <stdio.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -43,12 +45,18 @@ typedef struct lb_pov_options {
 LB_API void lb_pov_camera(const lb_scene *scene, double aspect, double location[3],
                           double look_at[3], double *angle);
 
-/* Write the scene to path (atomically). ev must be compiled from scene. The
- * file includes "libblend.inc": render with povray +L<dir of libblend.inc>.
- * *max_gradient (may be NULL) receives the value written. */
+/* Write the scene to path (through an lb_output: libblend/output.h). ev must
+ * be compiled from scene. The file includes "libblend.inc": render with
+ * povray +L<dir of libblend.inc>. *max_gradient (may be NULL) receives the
+ * value written. */
 LB_API lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
                                     const lb_pov_options *opt, const char *path,
                                     double *max_gradient, lb_error *err);
+
+/* The same text into an open stream (flushed, not closed). */
+LB_API lb_status lb_scene_write_pov_stream(const lb_scene *scene, const lb_evaluator *ev,
+                                           const lb_pov_options *opt, FILE *stream,
+                                           double *max_gradient, lb_error *err);
 
 #ifdef __cplusplus
 }

@@ -3,6 +3,7 @@
 
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
 int lb_version(void) {
     return LB_VERSION_MAJOR * 10000 + LB_VERSION_MINOR * 100 + LB_VERSION_PATCH;
@@ -28,12 +29,30 @@ const char *lb_status_string(lb_status status) {
     return "unknown status";
 }
 
+/* Messages are one line of text whatever went into them (file names, JSON
+ * strings): control characters are written as \n, \t, \r or \xNN. */
 lb_status lb__fail(lb_error *err, lb_status status, const char *fmt, ...) {
     if (err) {
+        char raw[LB_ERROR_MESSAGE_SIZE];
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(err->message, sizeof err->message, fmt, ap);
+        vsnprintf(raw, sizeof raw, fmt, ap);
         va_end(ap);
+        size_t o = 0;
+        for (const unsigned char *c = (const unsigned char *)raw; *c; ++c) {
+            char esc[5] = {(char)*c, 0, 0, 0, 0};
+            if (*c < 0x20 || *c == 0x7f) {
+                if (*c == '\n' || *c == '\t' || *c == '\r')
+                    snprintf(esc, sizeof esc, "\\%c", *c == '\n' ? 'n' : *c == '\t' ? 't' : 'r');
+                else
+                    snprintf(esc, sizeof esc, "\\x%02x", *c);
+            }
+            const size_t l = strlen(esc);
+            if (o + l >= sizeof err->message) break;
+            memcpy(err->message + o, esc, l);
+            o += l;
+        }
+        err->message[o] = '\0';
         err->status = status;
     }
     return status;

@@ -1,14 +1,17 @@
 /* Mesh files: binary PLY, OBJ, binary STL, glTF binary (.glb).
- * Every writer streams into a temporary file next to the target, which is
- * renamed over it only when everything was written and closed: a failure
+ * Every writer streams into an lb_output (libblend/output.h), which puts the
+ * file in place only when everything was written and closed: a failure
  * never leaves a partial file. Binary formats are little-endian by spec and
  * are written byte by byte here, whatever the host. */
 #define _POSIX_C_SOURCE 200809L
-#include "atomic.h"
+#include "libblend/output.h"
+
+#include "../common/internal.h"
 
 #include <libblend/mesh.h>
 
 #include <cjson/cJSON.h>
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -130,7 +133,12 @@ static int write_glb(FILE *f, const lb_mesh *m) {
         cJSON *scenes = cJSON_AddArrayToObject(root, "scenes");
         cJSON *scene = cJSON_CreateObject();
         cJSON_AddItemToArray(scenes, scene);
+    }
+    /* an empty mesh is a scene without nodes: glTF allows no empty
+     * accessor, buffer view or buffer */
+    if (ok && m->ntriangles) {
         const int zero = 0;
+        cJSON *scene = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "scenes"), 0);
         cJSON_AddItemToObject(scene, "nodes", cJSON_CreateIntArray(&zero, 1));
         cJSON *nodes = cJSON_AddArrayToObject(root, "nodes");
         cJSON *node = cJSON_CreateObject();
@@ -174,6 +182,8 @@ static int write_glb(FILE *f, const lb_mesh *m) {
                 cJSON_AddItemToObject(a, "max", cJSON_CreateDoubleArray(hi, 3));
             }
         }
+    }
+    if (ok) {
         json = cJSON_PrintUnformatted(root);
         ok = json != NULL;
     }
@@ -183,13 +193,14 @@ static int write_glb(FILE *f, const lb_mesh *m) {
     unsigned char h[20];
     memcpy(h, "glTF", 4);
     put_u32(h + 4, 2);
-    put_u32(h + 8, (uint32_t)(12 + 8 + jlen + jpad + 8 + bin));
+    put_u32(h + 8, (uint32_t)(12 + 8 + jlen + jpad + (bin ? 8 + bin : 0)));
     put_u32(h + 12, (uint32_t)(jlen + jpad));
     memcpy(h + 16, "JSON", 4);
     ok = fwrite(h, 20, 1, f) == 1 && fwrite(json, 1, jlen, f) == jlen &&
          fwrite("   ", 1, jpad, f) == jpad;
     free(json);
     if (!ok) return 0;
+    if (!bin) return 1;
     put_u32(h, (uint32_t)bin);
     memcpy(h + 4, "BIN\0", 4);
     if (fwrite(h, 8, 1, f) != 1) return 0;
@@ -220,6 +231,40 @@ static lb_mesh_format format_of(const char *path) {
     return LB_MESH_FORMAT_AUTO;
 }
 
+static int write_format(FILE *f, const lb_mesh *mesh, lb_mesh_format format) {
+    switch (format) {
+    case LB_MESH_FORMAT_PLY:
+        return write_ply(f, mesh);
+    case LB_MESH_FORMAT_OBJ:
+        return write_obj(f, mesh);
+    case LB_MESH_FORMAT_STL:
+        return write_stl(f, mesh);
+    default:
+        return write_glb(f, mesh);
+    }
+}
+
+lb_status lb_mesh_write_stream(const lb_mesh *mesh, FILE *stream, lb_mesh_format format,
+                               lb_error *err) {
+    if (!mesh || !stream)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "lb_mesh_write_stream: mesh and stream must "
+                        "be given");
+    if (format < LB_MESH_FORMAT_PLY || format > LB_MESH_FORMAT_GLB)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "lb_mesh_write_stream: format %d; allowed: LB_MESH_FORMAT_PLY, _OBJ, "
+                        "_STL or _GLB",
+                        (int)format);
+    if (!write_format(stream, mesh, format) || fflush(stream) != 0 || ferror(stream))
+        return lb__fail(err, LB_ERR_IO, "lb_mesh_write_stream: writing failed (%s)",
+                        strerror(errno));
+    return LB_OK;
+}
+
+lb_mesh_format lb_mesh_format_of(const char *path) {
+    return path ? format_of(path) : LB_MESH_FORMAT_AUTO;
+}
+
 lb_status lb_mesh_write(const lb_mesh *mesh, const char *path, lb_mesh_format format,
                         lb_error *err) {
     if (!mesh || !path || !*path)
@@ -230,23 +275,14 @@ lb_status lb_mesh_write(const lb_mesh *mesh, const char *path, lb_mesh_format fo
                         "%s: %s: unknown mesh format; allowed: a name ending in .ply, .obj, "
                         ".stl or .glb",
                         FN, path);
-    lb__atomic a;
-    FILE *f = lb__atomic_open(FN, path, &a, err);
-    if (!f) return err ? err->status : LB_ERR_IO;
-    int ok;
-    switch (format) {
-    case LB_MESH_FORMAT_PLY:
-        ok = write_ply(f, mesh);
-        break;
-    case LB_MESH_FORMAT_OBJ:
-        ok = write_obj(f, mesh);
-        break;
-    case LB_MESH_FORMAT_STL:
-        ok = write_stl(f, mesh);
-        break;
-    default:
-        ok = write_glb(f, mesh);
-        break;
+    lb_output *o = NULL;
+    lb_status s = lb_output_open(path, &o, err);
+    if (s) return s;
+    if (!write_format(lb_output_stream(o), mesh, format)) {
+        const int e = errno;
+        lb_output_discard(o);
+        return lb__fail(err, LB_ERR_IO, "%s: %s: writing failed (%s); nothing was written", FN,
+                        path, e ? strerror(e) : "short write");
     }
-    return lb__atomic_close(FN, path, f, ok, &a, err);
+    return lb_output_commit(o, err);
 }

@@ -3,13 +3,14 @@
  * lights and material. */
 #define _POSIX_C_SOURCE 200809L
 #include "../scene/scene_internal.h"
-#include "atomic.h"
+#include "libblend/output.h"
 
 #include <libblend/pov.h>
 
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -310,11 +311,9 @@ static lb_status max_gradient(const lb_evaluator *ev, const double lo[3], const 
     return s;
 }
 
-lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
-                             const lb_pov_options *opt, const char *path, double *out_gradient,
-                             lb_error *err) {
-    if (!scene || !ev || !path || !*path)
-        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: scene, ev and path must be given", FN);
+/* The whole .pov text into b (freed by the caller). */
+static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const lb_pov_options *opt,
+                          sbuf *out, double *out_gradient, lb_error *err) {
     lb_pov_options o = {0, 0, 0.0, 0.0, 0};
     if (opt) o = *opt;
     if (!scene->has_bounds)
@@ -379,12 +378,38 @@ lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
         free(b.s);
         return s;
     }
-    lb__atomic a;
-    FILE *f = lb__atomic_open(FN, path, &a, err);
-    if (!f)
-        s = err ? err->status : LB_ERR_IO;
-    else
-        s = lb__atomic_close(FN, path, f, fwrite(b.s, 1, b.n, f) == b.n, &a, err);
+    *out = b;
+    if (out_gradient) *out_gradient = g;
+    return LB_OK;
+}
+
+lb_status lb_scene_write_pov_stream(const lb_scene *scene, const lb_evaluator *ev,
+                                    const lb_pov_options *opt, FILE *stream, double *out_gradient,
+                                    lb_error *err) {
+    if (!scene || !ev || !stream)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "lb_scene_write_pov_stream: scene, ev and stream must be given");
+    sbuf b = {NULL, 0, 0, 0};
+    double g = 0.0;
+    lb_status s = pov_text(scene, ev, opt, &b, &g, err);
+    if (s) return s;
+    if (fwrite(b.s, 1, b.n, stream) != b.n || fflush(stream) != 0)
+        s = lb__fail(err, LB_ERR_IO, "lb_scene_write_pov_stream: writing failed (%s)",
+                     strerror(errno));
+    free(b.s);
+    if (!s && out_gradient) *out_gradient = g;
+    return s;
+}
+
+lb_status lb_scene_write_pov(const lb_scene *scene, const lb_evaluator *ev,
+                             const lb_pov_options *opt, const char *path, double *out_gradient,
+                             lb_error *err) {
+    if (!scene || !ev || !path || !*path)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: scene, ev and path must be given", FN);
+    sbuf b = {NULL, 0, 0, 0};
+    double g = 0.0;
+    lb_status s = pov_text(scene, ev, opt, &b, &g, err);
+    if (!s) s = lb_output_write_file(path, b.s, b.n, err);
     free(b.s);
     if (!s && out_gradient) *out_gradient = g;
     return s;

@@ -85,7 +85,7 @@ static lb_status make_grid(const lb_evaluator *ev, const lb_mesh_options *o, lb_
     for (int d = 0; d < 3; ++d) {
         const double nf = ceil(ext[d] / h - 1e-9);
         if (!(nf <= LB_MESH_MAX_CELLS_PER_AXIS))
-            return lb__fail(err, LB_ERR_NO_MEMORY,
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "%s: %.0f cells along axis %d (cell size %g); allowed: at most %d "
                             "cells per axis (a cell size of at least %g)",
                             FN, nf, d, h, LB_MESH_MAX_CELLS_PER_AXIS,
@@ -547,6 +547,43 @@ done:
 /* Estimated bytes per kept block (node values, crossing edges, output). */
 #define BLOCK_BYTES ((size_t)128 * 1024)
 
+/* Does the surface at this resolution stay within max_blocks? (The block
+ * selection alone: interval passes, stopped as soon as it is over.) */
+static int fits(const lb_evaluator *ev, const lb_mesh_options *opt, unsigned res,
+                size_t max_blocks) {
+    lb_mesh_options o = *opt;
+    o.resolution = res;
+    o.cell_size = 0.0;
+    lb__grid g;
+    if (make_grid(ev, &o, &g, NULL)) return 0;
+    uint32_t nb[3];
+    for (int d = 0; d < 3; ++d) nb[d] = (g.cells[d] + LB__MB - 1) / LB__MB;
+    blist L = {NULL, 0, 0};
+    const uint32_t zero[3] = {0, 0, 0};
+    const lb_status s = select_blocks(ev, &g, zero, nb, nb, &L, max_blocks, NULL);
+    free(L.b);
+    return s == LB_OK;
+}
+
+/* The largest resolution whose surface fits the memory cap, by bisection
+ * on the block selection (about 13 selections, each stopped at the cap);
+ * then confirmed upward, since the count is not strictly monotone. 0 when
+ * even resolution 1 does not fit. */
+static unsigned largest_fit(const lb_evaluator *ev, const lb_mesh_options *opt, size_t max_blocks) {
+    if (!fits(ev, opt, 1, max_blocks)) return 0;
+    unsigned lo = 1, hi = LB_MESH_MAX_CELLS_PER_AXIS; /* fits(lo); hi is the bound */
+    while (lo < hi) {
+        const unsigned mid = lo + (hi - lo + 1) / 2;
+        if (fits(ev, opt, mid, max_blocks))
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    for (unsigned r = lo + 1; r <= lo + 8 && r <= LB_MESH_MAX_CELLS_PER_AXIS; ++r)
+        if (fits(ev, opt, r, max_blocks)) lo = r;
+    return lo;
+}
+
 lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_mesh **out,
                          lb_error *err) {
     if (out) *out = NULL;
@@ -576,19 +613,27 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     const uint32_t zero[3] = {0, 0, 0};
     s = select_blocks(ev, &g, zero, R.nb, R.nb, &L, max_blocks, err);
     if (s == LB_ERR_NO_MEMORY && L.n >= max_blocks) {
-        const double res = (double)g.cells[0] > g.cells[1] ? g.cells[0] : g.cells[1];
-        s = lb__fail(err, LB_ERR_NO_MEMORY,
-                     "%s: the surface crosses more than %zu blocks of %d^3 cells at %u x %u x %u "
-                     "cells, over the memory cap of %zu MiB; allowed: a coarser resolution "
-                     "(about %.0f along the longest side) or a larger max_memory",
-                     FN, max_blocks, LB__MB, g.cells[0], g.cells[1], g.cells[2], max_memory >> 20,
-                     0.7 * res * sqrt((double)max_blocks / (double)L.n));
+        const unsigned fit = largest_fit(ev, opt, max_blocks);
+        if (fit)
+            s = lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                         "%s: the surface crosses more than %zu blocks of %d^3 cells at %u x %u x "
+                         "%u cells, over the memory cap of %zu MiB; allowed: a resolution of at "
+                         "most %u (cells along the longest side; computed) or a larger max_memory",
+                         FN, max_blocks, LB__MB, g.cells[0], g.cells[1], g.cells[2],
+                         max_memory >> 20, fit);
+        else
+            s = lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                         "%s: the surface crosses more than %zu blocks of %d^3 cells at %u x %u x "
+                         "%u cells, over the memory cap of %zu MiB; allowed: a larger max_memory "
+                         "(no resolution fits)",
+                         FN, max_blocks, LB__MB, g.cells[0], g.cells[1], g.cells[2],
+                         max_memory >> 20);
     }
     if (s) {
         free(L.b);
         return s;
     }
-    qsort(L.b, L.n, sizeof *L.b, cmp_block);
+    if (L.n) qsort(L.b, L.n, sizeof *L.b, cmp_block); /* an empty mesh is valid output */
     R.blocks = L.b;
     R.nblocks = L.n;
     pthread_mutex_init(&R.lock, NULL);

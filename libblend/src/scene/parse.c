@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include <cjson/cJSON.h>
+#include <jansson.h>
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -1143,6 +1144,35 @@ static void line_col(const char *text, size_t len, size_t off, size_t *line, siz
     }
 }
 
+/* RFC 8259 exactly, after cJSON (whose messages the bad-scene tables pin)
+ * accepted the text: cJSON also takes leading zeros (01), a bare fraction
+ * point (1.), raw control characters in strings, text after a NUL byte and
+ * \u0000 (cutting the string there). Debian's libjansson is strict about all
+ * of them and names the line and column (duplicate keys are the
+ * validation's: it names the JSON path). */
+static lb_status strict_json(const char *text, size_t length, const char *file, lb_error *err) {
+    json_error_t je;
+    json_t *j = json_loadb(text, length, 0, &je);
+    if (j) {
+        json_decref(j);
+        return LB_OK;
+    }
+    /* 1e999 is valid RFC 8259 syntax: the validation names it as not finite */
+    if (json_error_code(&je) == json_error_numeric_overflow) return LB_OK;
+    size_t line = 1, col = 1;
+    if (je.position >= 0 && je.line >= 0) {
+        size_t off = (size_t)je.position;
+        if (off > length) off = length;
+        /* jansson's position is just past the offending character */
+        line_col(text, length, off ? off - 1 : 0, &line, &col);
+    }
+    return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                    "%s:%zu:%zu: invalid JSON: %s; allowed: a JSON document (RFC 8259: no "
+                    "leading zeros, digits after a decimal point, control characters in strings "
+                    "escaped, no \\u0000, nothing after the document)",
+                    file, line, col, je.text);
+}
+
 lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_scene **out,
                          lb_error *err) {
     const char *file = name ? name : "<scene>";
@@ -1150,7 +1180,7 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
     *out = NULL;
     if (!text) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "lb_scene_parse: text is NULL");
     if (length > LB_SCENE_MAX_BYTES)
-        return lb__fail(err, LB_ERR_NO_MEMORY,
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: the scene is %zu bytes; allowed: at most %u bytes", file, length,
                         LB_SCENE_MAX_BYTES);
     /* nesting pre-scan, outside strings */
@@ -1223,6 +1253,11 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
                             file, line, col);
         }
     }
+    lb_status strict = strict_json(text, length, file, err);
+    if (strict) {
+        cJSON_Delete(doc);
+        return strict;
+    }
     lb_scene *s = calloc(1, sizeof *s);
     if (!s) {
         cJSON_Delete(doc);
@@ -1266,7 +1301,7 @@ lb_status lb_scene_load(const char *path, lb_scene **out, lb_error *err) {
         }
         if (S_ISREG(sb.st_mode) && (unsigned long long)sb.st_size > LB_SCENE_MAX_BYTES) {
             fclose(f);
-            return lb__fail(err, LB_ERR_NO_MEMORY,
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "%s: the scene file is %lld bytes; allowed: at most %u bytes", path,
                             (long long)sb.st_size, LB_SCENE_MAX_BYTES);
         }
@@ -1276,14 +1311,15 @@ lb_status lb_scene_load(const char *path, lb_scene **out, lb_error *err) {
     lb_status st = LB_OK;
     for (;;) {
         if (len == cap) {
-            if (cap > LB_SCENE_MAX_BYTES) {
-                st = lb__fail(err, LB_ERR_NO_MEMORY,
-                              "%s: the scene file is larger than %u bytes; allowed: at most %u "
-                              "bytes",
+            if (len > LB_SCENE_MAX_BYTES) {
+                st = lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                              "%s: the scene file is larger than %u bytes (or endless: a device "
+                              "or FIFO is read to its end); allowed: at most %u bytes",
                               path, LB_SCENE_MAX_BYTES, LB_SCENE_MAX_BYTES);
                 break;
             }
             cap = cap ? 2 * cap : 65536;
+            if (cap > (size_t)LB_SCENE_MAX_BYTES + 1) cap = (size_t)LB_SCENE_MAX_BYTES + 1;
             char *nb = realloc(buf, cap + 1);
             if (!nb) {
                 st = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory reading the file", path);

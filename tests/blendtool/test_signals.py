@@ -1,0 +1,219 @@
+#!/usr/bin/python3
+"""Signals and kills on real blendtool processes (docs/blendtool.md, "Signals").
+
+SIGINT, SIGTERM and SIGHUP sent at random points of every phase (reading,
+meshing, writing, exporting, rendering, copying) must end the command with
+128 + the signal, leave nothing at the output path, no temporary file in the
+output folder, no render folder and no povray process. SIGKILL must leave
+nothing a rerun or a user would take for output: with unnamed temporary
+files nothing at all; on the named fallback only a hidden file, which the next
+run removes; a killed render's povray ends with it and its folder is removed
+by the next render.
+
+usage: test_signals.py BLENDTOOL SOURCE_DIR WORK_DIR
+"""
+import os
+import random
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+BLENDTOOL, SRC, WORK = sys.argv[1:4]
+S1 = os.path.join(SRC, "scenes", "bench-s1-three-spheres.json")
+S2 = os.path.join(SRC, "scenes", "bench-s2-64-spheres.json")
+rng = random.Random(20261201)
+failures = []
+checked = 0
+
+
+def fail(msg):
+    failures.append(msg)
+    print("FAIL:", msg)
+
+
+def povray_pids(tmp):
+    """povray processes rendering from our private TMPDIR"""
+    out = set()
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                cmd = f.read()
+        except OSError:
+            continue
+        if cmd.startswith(b"povray") and tmp.encode() in cmd:
+            out.add(int(pid))
+    return out
+
+
+def fresh(name):
+    d = os.path.join(WORK, name)
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(os.path.join(d, "out"))
+    os.makedirs(os.path.join(d, "tmp"))
+    return d
+
+
+def env_for(d, named):
+    e = dict(os.environ)
+    e["TMPDIR"] = os.path.join(d, "tmp")
+    e["LIBBLEND_POVRAY_INCLUDE"] = os.path.join(SRC, "povray_include")
+    e.pop("LIBBLEND_OUTPUT_NAMED", None)
+    if named:
+        e["LIBBLEND_OUTPUT_NAMED"] = "1"
+    return e
+
+
+def run(args, env, stdin=None, sig=None, delay=0.0):
+    """Start blendtool, send sig after delay; returns (rc, delivered, stderr)."""
+    p = subprocess.Popen([BLENDTOOL] + args, stdin=stdin or subprocess.DEVNULL,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    delivered = False
+    if sig is not None:
+        time.sleep(delay)
+        if p.poll() is None:
+            p.send_signal(sig)
+            delivered = True
+    _, err = p.communicate(timeout=300)
+    return p.returncode, delivered, err.decode(errors="replace")
+
+
+def timed(args, env, stdin_file=None):
+    t = time.monotonic()
+    with open(stdin_file) if stdin_file else open(os.devnull) as fin:
+        rc, _, err = run(args, env, stdin=fin)
+    if rc != 0:
+        fail(f"{args}: unsignalled run failed ({rc}): {err}")
+    return time.monotonic() - t
+
+
+def case(name, args_of, out_name, named, count_per_signal=4, stdin_file=None, need=8):
+    """Random signals over the whole run of one command."""
+    global checked
+    d = fresh(name + ("-named" if named else ""))
+    env = env_for(d, named)
+    outdir = os.path.join(d, "out")
+    out = os.path.join(outdir, out_name)
+    duration = timed(args_of(out), env, stdin_file)
+    if not os.path.exists(out):
+        fail(f"{name}: the unsignalled run wrote no {out}")
+    os.remove(out)
+    delivered_n = 0
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        for i in range(count_per_signal):
+            # stratified over the run: early, middle, late, any
+            lo, hi = [(0.0, 0.3), (0.3, 0.6), (0.6, 0.97), (0.0, 0.97)][i % 4]
+            delay = duration * rng.uniform(lo, hi)
+            with open(stdin_file) if stdin_file else open(os.devnull) as fin:
+                rc, delivered, err = run(args_of(out), env, stdin=fin, sig=sig, delay=delay)
+            label = f"{name}{' (named fallback)' if named else ''} {sig.name} at {delay:.3f} s"
+            if not delivered or rc == 0:
+                # finished first: then the output must be whole
+                if rc != 0:
+                    fail(f"{label}: rc {rc}: {err}")
+                if os.path.exists(out):
+                    os.remove(out)
+                continue
+            delivered_n += 1
+            checked += 1
+            if rc != 128 + sig:
+                fail(f"{label}: exit status {rc}, want {128 + sig}: {err}")
+            if os.path.lexists(out):
+                fail(f"{label}: {out} exists after the signal")
+                os.remove(out)
+            left = os.listdir(outdir)
+            if left:
+                fail(f"{label}: left in the output folder: {left}")
+            tmp_left = os.listdir(env["TMPDIR"])
+            if tmp_left:
+                fail(f"{label}: left in TMPDIR: {tmp_left}")
+            if povray_pids(env["TMPDIR"]):
+                fail(f"{label}: povray still running")
+    if delivered_n < need:
+        fail(f"{name}: only {delivered_n} signals arrived while it ran (want >= {need})")
+    print(f"{name}{' named' if named else ''}: {delivered_n} signals during a {duration:.2f} s run")
+
+
+def kill_case(name, args_of, out_name, named, trials=5):
+    """SIGKILL at random points; then a rerun succeeds and cleans up."""
+    global checked
+    d = fresh("kill-" + name + ("-named" if named else ""))
+    env = env_for(d, named)
+    outdir = os.path.join(d, "out")
+    out = os.path.join(outdir, out_name)
+    duration = timed(args_of(out), env)
+    os.remove(out)
+    for t in range(trials):
+        delay = duration * rng.uniform(0.05, 0.95)
+        rc, delivered, _ = run(args_of(out), env, sig=signal.SIGKILL, delay=delay)
+        if not delivered:
+            if os.path.exists(out):
+                os.remove(out)
+            continue
+        checked += 1
+        label = f"kill {name}{' (named)' if named else ''} at {delay:.3f} s"
+        if os.path.lexists(out):
+            fail(f"{label}: {out} exists after SIGKILL")
+        left = os.listdir(outdir)
+        if not named and left:
+            fail(f"{label}: left in the output folder: {left}")
+        for f in left:
+            if not (f.startswith("." + out_name + ".lbtmp.")):
+                fail(f"{label}: {f} could be taken for output")
+        time.sleep(0.3)
+        if povray_pids(env["TMPDIR"]):
+            fail(f"{label}: povray outlived blendtool")
+    # the next run succeeds and removes what killed runs left
+    rc, _, err = run(args_of(out), env)
+    if rc != 0 or not os.path.exists(out):
+        fail(f"kill {name}: rerun failed ({rc}) {err}")
+    left = [f for f in os.listdir(outdir) if f != out_name]
+    if left:
+        fail(f"kill {name}: the rerun left {left}")
+    if name == "render" and os.listdir(env["TMPDIR"]):
+        fail(f"kill render: stale render folders not removed: {os.listdir(env['TMPDIR'])}")
+
+
+def main():
+    os.makedirs(WORK, exist_ok=True)
+    points = os.path.join(WORK, "points.txt")
+    with open(points, "w") as f:
+        for i in range(400000):
+            f.write(f"{(i % 97) * 0.05 - 2.0} {(i % 89) * 0.05 - 2.0} {(i % 83) * 0.05 - 2.0}\n")
+    for named in (False, True):
+        case("mesh", lambda o: ["mesh", S2, "-o", o, "--resolution", "288", "--quiet"],
+             "mesh.obj", named)
+        case("eval", lambda o: ["eval", "--points", points, "-o", o, S2], "values.txt", named)
+        case("render", lambda o: ["render", S1, "-o", o, "--width", "160", "--height", "120",
+                                  "--threads", "1"], "image.png", named)
+    # reading standard input that never ends: every signal ends it
+    d = fresh("stdin")
+    env = env_for(d, False)
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        r, w = os.pipe()
+        rc, delivered, err = run(["eval", S1, "-o", os.path.join(d, "out", "v.txt")], env,
+                                 stdin=r, sig=sig, delay=0.3)
+        os.close(r)
+        os.close(w)
+        global checked
+        checked += 1
+        if not delivered or rc != 128 + sig or os.listdir(os.path.join(d, "out")):
+            fail(f"eval waiting on stdin, {sig.name}: rc {rc}, delivered {delivered}: {err}")
+    for named in (False, True):
+        kill_case("mesh", lambda o: ["mesh", S2, "-o", o, "--resolution", "288", "--quiet"],
+                  "mesh.obj", named)
+    kill_case("render", lambda o: ["render", S1, "-o", o, "--width", "160", "--height", "120",
+                                   "--threads", "1"], "image.png", False)
+    print(f"{checked} signalled runs checked")
+    if checked < 60:
+        fail(f"only {checked} signalled runs checked (want >= 60)")
+    if failures:
+        print(f"{len(failures)} failures")
+        sys.exit(1)
+    print("all signal checks passed")
+
+
+main()

@@ -1,0 +1,107 @@
+/* SIGINT, SIGTERM and SIGHUP end every blendtool command at any phase with
+ * exit status 128 + the signal (130, 143, 129) and nothing left behind:
+ * the handler ends a running child (povray) and waits for it, removes the
+ * named temporary files registered here, and exits. Outputs go through
+ * lb_output, whose unnamed temporary file vanishes with the process; from
+ * bt_signals_commit on the output is being put in place and the signals are
+ * held, so an output is either complete or absent. blendtool is a program,
+ * not the library: this state is its own. */
+#define _POSIX_C_SOURCE 200809L
+#include "blendtool.h"
+
+#include <signal.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#define MAX_TEMPS 4
+
+static volatile sig_atomic_t child_pid = 0;
+static char temps[MAX_TEMPS][4096 + 640];
+static volatile sig_atomic_t temp_used[MAX_TEMPS];
+static char temp_dir[4096];
+static volatile sig_atomic_t temp_dir_used = 0;
+
+static void say(const char *s) {
+    ssize_t w = write(STDERR_FILENO, s, strlen(s));
+    (void)w;
+}
+
+static void on_signal(int sig) {
+    const pid_t pid = (pid_t)child_pid;
+    if (pid > 0) {
+        kill(pid, SIGTERM);
+        waitpid(pid, NULL, 0);
+    }
+    for (int i = 0; i < MAX_TEMPS; ++i)
+        if (temp_used[i]) unlink(temps[i]);
+    if (temp_dir_used) rmdir(temp_dir);
+    say(sig == SIGINT    ? "\nblendtool: interrupted (SIGINT); no output was written\n"
+        : sig == SIGTERM ? "blendtool: terminated (SIGTERM); no output was written\n"
+                         : "blendtool: hung up (SIGHUP); no output was written\n");
+    _exit(128 + sig);
+}
+
+static void hold(int how) {
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    sigaddset(&set, SIGHUP);
+    sigprocmask(how, &set, NULL);
+}
+
+void bt_signals_install(void) {
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigfillset(&sa.sa_mask); /* one handler at a time */
+    const int sigs[] = {SIGINT, SIGTERM, SIGHUP};
+    for (int i = 0; i < 3; ++i) {
+        struct sigaction old;
+        sigaction(sigs[i], NULL, &old);
+        /* a signal the caller ignores (nohup, background jobs) stays ignored */
+        if (old.sa_handler != SIG_IGN) sigaction(sigs[i], &sa, NULL);
+    }
+}
+
+/* The registry is changed with the signals held, so the handler never sees
+ * a half-written name. */
+int bt_signals_temp(const char *path) {
+    if (!path) return -1;
+    hold(SIG_BLOCK);
+    int slot = -1;
+    for (int i = 0; i < MAX_TEMPS && slot < 0; ++i)
+        if (!temp_used[i] && strlen(path) < sizeof temps[i]) slot = i;
+    if (slot >= 0) {
+        strcpy(temps[slot], path);
+        temp_used[slot] = 1;
+    }
+    hold(SIG_UNBLOCK);
+    return slot;
+}
+
+void bt_signals_untemp(int slot) {
+    if (slot < 0 || slot >= MAX_TEMPS) return;
+    hold(SIG_BLOCK);
+    temp_used[slot] = 0;
+    hold(SIG_UNBLOCK);
+}
+
+void bt_signals_temp_dir(const char *dir) {
+    hold(SIG_BLOCK);
+    temp_dir_used = 0;
+    if (dir && strlen(dir) < sizeof temp_dir) {
+        strcpy(temp_dir, dir);
+        temp_dir_used = 1;
+    }
+    hold(SIG_UNBLOCK);
+}
+
+void bt_signals_child(pid_t pid) {
+    child_pid = pid;
+}
+
+void bt_signals_commit(void) {
+    hold(SIG_BLOCK);
+}
