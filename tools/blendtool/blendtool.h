@@ -66,6 +66,10 @@ int bt_output_open(const char *cmd, const char *path, bt_out *out);
 int bt_output_commit(const char *cmd, bt_out *out);
 void bt_output_discard(bt_out *out);
 
+/* Is path "-", or (after symbolic links) a device or FIFO? Those take any
+ * name, so the format cannot come from an extension. */
+int bt_is_stream(const char *path);
+
 /* Write len bytes to path through bt_output_*. Returns an exit code. */
 int bt_write_file(const char *cmd, const char *path, const char *data, size_t len);
 

@@ -3,6 +3,7 @@
 #include "blendtool.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,14 +28,54 @@ static int grow(points *p) {
     return 0;
 }
 
-/* Reads "x y z" lines; blank lines and lines starting with # are skipped. */
+/* The longest input line accepted, in bytes (three %.17g numbers need 75). */
+#define MAX_LINE 4096
+
+/* strtod, taking underflow (1e-400 is a valid input: it rounds to 0 or a
+ * subnormal) but not overflow */
+static int number(const char *s, char **end, double *v) {
+    errno = 0;
+    *v = strtod(s, end);
+    if (*end == s) return 0;
+    return !(errno == ERANGE && fabs(*v) > 1.0);
+}
+
+/* Reads "x y z" lines; blank lines, lines starting with # and a # comment
+ * after the numbers are skipped. Lines are read into a fixed buffer, so an
+ * endless line (/dev/zero) fails at MAX_LINE bytes instead of growing. */
+/* One line into buf (NUL-terminated, newline kept): 1 read, 0 at the end
+ * of input, -1 longer than MAX_LINE. *len counts every byte, NULs too. */
+static int read_line(FILE *f, char *buf, size_t *len) {
+    size_t n = 0;
+    int c = EOF;
+    while (n <= MAX_LINE && (c = getc_unlocked(f)) != EOF) {
+        buf[n++] = (char)c;
+        if (c == '\n') break;
+    }
+    buf[n] = '\0';
+    *len = n;
+    if (n > MAX_LINE) return -1;
+    return n > 0 || c != EOF;
+}
+
 static int read_points(const char *cmd, FILE *f, const char *name, points *p) {
-    char *line = NULL;
-    size_t lcap = 0, lineno = 0;
-    ssize_t len;
-    int rc = 0;
-    while ((len = getline(&line, &lcap, f)) >= 0) {
+    char line[MAX_LINE + 2];
+    size_t lineno = 0, len = 0;
+    int rc = 0, got;
+    while ((got = read_line(f, line, &len)) != 0) {
         ++lineno;
+        if (got < 0) {
+            bt_error(cmd,
+                     "%s:%zu: line longer than %d bytes; allowed: one point \"x y z\" per line",
+                     name, lineno, MAX_LINE);
+            rc = BT_EXIT_BAD_INPUT;
+            break;
+        }
+        if (strlen(line) != len) {
+            bt_error(cmd, "%s:%zu: a NUL byte; allowed: text lines \"x y z\"", name, lineno);
+            rc = BT_EXIT_BAD_INPUT;
+            break;
+        }
         char *s = line;
         while (*s == ' ' || *s == '\t') ++s;
         if (*s == '\n' || *s == '\r' || *s == '\0' || *s == '#') continue;
@@ -42,17 +83,17 @@ static int read_points(const char *cmd, FILE *f, const char *name, points *p) {
         char *end = s;
         int ok = 1;
         for (int d = 0; d < 3 && ok; ++d) {
-            errno = 0;
             char *e2;
-            v[d] = strtod(end, &e2);
-            ok = e2 != end && errno != ERANGE;
+            ok = number(end, &e2, &v[d]);
             end = e2;
         }
         while (ok && (*end == ' ' || *end == '\t' || *end == '\r' || *end == '\n')) ++end;
+        if (ok && *end == '#') end += strlen(end);
         if (!ok || *end) {
             char shown[48];
             size_t k = 0;
-            for (; s[k] && s[k] != '\n' && k < sizeof shown - 1; ++k) shown[k] = s[k];
+            for (; s[k] && s[k] != '\n' && k < sizeof shown - 1; ++k)
+                shown[k] = (unsigned char)s[k] < 32 || (unsigned char)s[k] > 126 ? '?' : s[k];
             shown[k] = '\0';
             bt_error(cmd, "%s:%zu: expected three numbers \"x y z\", found \"%s\"", name, lineno,
                      shown);
@@ -88,7 +129,6 @@ static int read_points(const char *cmd, FILE *f, const char *name, points *p) {
         bt_error(cmd, "%s: read error: %s", name, strerror(errno));
         rc = BT_EXIT_BAD_INPUT;
     }
-    free(line);
     return rc;
 }
 
@@ -187,13 +227,17 @@ done:
 const bt_command bt_cmd_eval = {
     "eval", "field value and gradient at points",
     "usage: blendtool eval [--points FILE] [--threads N] [-o OUT] SCENE\n\n"
-    "Reads points \"x y z\" (one per line; blank lines and # comments skipped)\n"
+    "Reads points \"x y z\" (one per line; blank lines, # comment lines and a #\n"
+    "comment after the numbers skipped; lines of at most 4096 bytes)\n"
     "from FILE or standard input and prints \"value gx gy gz\" per point with\n"
     "%.17g, in input order. All points are read and evaluated before anything is\n"
     "written, so bad input produces no output.\n"
     "  --points FILE   read points from FILE instead of standard input\n"
     "  --threads N     0 = one per CPU (default), 1 = single-threaded\n"
     "  -o, --output F  write to F (atomically) instead of standard output\n"
-    "Limits: at most 20,000,000 points per run, |coordinate| <= 1e9.\n"
-    "Exit status: 0 success, 2 bad scene or points, 1 internal failure.\n",
+    "Limits: at most 20,000,000 points per run, lines of at most 4096 bytes, |coordinate|\n"
+    "<= 1e9 (checked while reading: an endless input fails at the limit). A FIFO or\n"
+    "device as FILE is read to its end.\n"
+    "Exit status: 0 success, 2 bad scene or points, 1 internal failure or failure writing\n"
+    "the output, 130 / 143 / 129 ended by SIGINT / SIGTERM / SIGHUP (nothing written).\n",
     run_eval};

@@ -56,6 +56,7 @@ static int run(int argc, char **argv) {
     lb_mesh_options o;
     lb_mesh_options_init(&o);
     int have_bounds = 0, quiet = 0, have_res = 0;
+    lb_mesh_format format = LB_MESH_FORMAT_AUTO;
     for (int i = 1; i < argc; ++i) {
         int r;
         if ((r = bt_option(CMD, argc, argv, &i, "-o", &val)) ||
@@ -93,6 +94,16 @@ static int run(int argc, char **argv) {
             have_bounds = 1;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--threads", &val))) {
             if (r < 0 || bt_parse_threads(CMD, val, &o.threads)) return BT_EXIT_BAD_INPUT;
+        } else if ((r = bt_option(CMD, argc, argv, &i, "--format", &val))) {
+            if (r < 0) return BT_EXIT_BAD_INPUT;
+            static const char *const names[] = {"ply", "obj", "stl", "glb"};
+            format = LB_MESH_FORMAT_AUTO;
+            for (int f = 0; f < 4; ++f)
+                if (strcmp(val, names[f]) == 0) format = (lb_mesh_format)(LB_MESH_FORMAT_PLY + f);
+            if (format == LB_MESH_FORMAT_AUTO) {
+                bt_error(CMD, "--format %s; allowed: ply, obj, stl or glb", val);
+                return BT_EXIT_BAD_INPUT;
+            }
         } else if (strcmp(argv[i], "--open") == 0) {
             o.flags |= LB_MESH_OPEN_BOUNDARY;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
@@ -117,13 +128,11 @@ static int run(int argc, char **argv) {
                  !scene_path ? "no scene given" : "no output given (-o OUT)");
         return BT_EXIT_BAD_INPUT;
     }
-    const char *dot = strrchr(out, '.');
-    if (!dot || (strcmp(dot, ".ply") && strcmp(dot, ".obj") && strcmp(dot, ".stl") &&
-                 strcmp(dot, ".glb") && strcmp(dot, ".PLY") && strcmp(dot, ".OBJ") &&
-                 strcmp(dot, ".STL") && strcmp(dot, ".GLB"))) {
+    if (format == LB_MESH_FORMAT_AUTO) format = lb_mesh_format_of(out);
+    if (format == LB_MESH_FORMAT_AUTO) {
         bt_error(CMD,
                  "%s: unknown mesh format; allowed: a name ending in .ply, .obj, .stl or "
-                 ".glb",
+                 ".glb, or --format ply|obj|stl|glb",
                  out);
         return BT_EXIT_BAD_INPUT;
     }
@@ -164,7 +173,7 @@ static int run(int argc, char **argv) {
         rc = bt_fail(CMD, scene_path, s, &e);
         goto done;
     }
-    s = lb_mesh_write_stream(mesh, w.f, lb_mesh_format_of(out), &e);
+    s = lb_mesh_write_stream(mesh, w.f, format, &e);
     if (s) {
         bt_error(CMD, "%s: writing the mesh failed (%s); nothing was written", out,
                  strerror(errno));
@@ -187,11 +196,13 @@ done:
 const bt_command bt_cmd_mesh = {
     "mesh", "a closed triangle mesh of the scene (PLY, OBJ, STL, glTF binary)",
     "usage: blendtool mesh SCENE -o OUT.{ply,obj,stl,glb} [--resolution N | --cell-size H]\n"
-    "                      [--bounds x0,y0,z0,x1,y1,z1] [--open] [--threads N] [--quiet]\n\n"
+    "                      [--bounds x0,y0,z0,x1,y1,z1] [--open] [--threads N] [--quiet]\n"
+    "                      [--format ply|obj|stl|glb]\n\n"
     "Meshes the scene's surface inside the region (the scene's bounds, or --bounds):\n"
     "closed and manifold, vertices on the surface with normals from the analytic\n"
     "gradient. Where the region cuts the solid the mesh is closed on the region's\n"
-    "faces; --open leaves it open there. The format follows OUT's extension.\n"
+    "faces; --open leaves it open there. The format follows OUT's extension, or\n"
+    "--format (needed for a device or FIFO such as /dev/stdout).\n"
     "  --resolution N  cells along the region's longest side (default 128, at most 8192)\n"
     "  --cell-size H   the cell size instead of a resolution\n"
     "  --threads N     0 = one per CPU (default), 1 = single-threaded; the mesh is the\n"

@@ -79,7 +79,7 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
 }
 
 /* load, compile, write the .pov to an open output */
-static int export(const char *cmd, const povargs *a, FILE *f) {
+static int export(const char *cmd, const povargs *a, FILE *f, const char *out_name) {
     lb_scene *sc = NULL;
     int rc = bt_load_scene(cmd, a->scene, &sc);
     if (rc) return rc;
@@ -92,7 +92,8 @@ static int export(const char *cmd, const povargs *a, FILE *f) {
         s = lb_scene_write_pov_stream(sc, ev, &o, f, NULL, &e);
     }
     if (s == LB_ERR_IO) {
-        bt_error(cmd, "%s", e.message);
+        bt_error(cmd, "%s: writing the POV-Ray scene failed (%s); nothing was written", out_name,
+                 strerror(errno));
         rc = BT_EXIT_INTERNAL;
     } else if (s) {
         rc = bt_fail(cmd, a->scene, s, &e);
@@ -107,7 +108,7 @@ static int run_pov(int argc, char **argv) {
     if (parse("pov", argc, argv, &a, 0)) return BT_EXIT_BAD_INPUT;
     bt_out w;
     int rc = bt_output_open("pov", a.out, &w);
-    if (!rc) rc = export("pov", &a, w.f);
+    if (!rc) rc = export("pov", &a, w.f, a.out);
     if (!rc) rc = bt_output_commit("pov", &w);
     bt_output_discard(&w);
     return rc;
@@ -217,8 +218,9 @@ static int run_render(int argc, char **argv) {
     povargs a = {NULL, NULL, 0, 640, 480, 0, 9, 0};
     if (parse("render", argc, argv, &a, 1)) return BT_EXIT_BAD_INPUT;
     const size_t ol = strlen(a.out);
-    if (ol < 5 || strcmp(a.out + ol - 4, ".png") != 0) {
-        bt_error("render", "%s: allowed: an output name ending in .png", a.out);
+    if ((ol < 5 || strcmp(a.out + ol - 4, ".png") != 0) && !bt_is_stream(a.out)) {
+        bt_error("render", "%s: allowed: an output name ending in .png (or a device or FIFO)",
+                 a.out);
         return BT_EXIT_BAD_INPUT;
     }
     remove_stale_renders();
@@ -243,7 +245,7 @@ static int run_render(int argc, char **argv) {
             bt_error("render", "%s: cannot write the scene (%s)", pov, strerror(errno));
             rc = BT_EXIT_INTERNAL;
         } else {
-            rc = export("render", &a, f);
+            rc = export("render", &a, f, pov);
             if (fclose(f) != 0 && !rc) {
                 bt_error("render", "%s: cannot write the scene (%s)", pov, strerror(errno));
                 rc = BT_EXIT_INTERNAL;

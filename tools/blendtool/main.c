@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 static const bt_command *const COMMANDS[] = {&bt_cmd_validate, &bt_cmd_info, &bt_cmd_eval,
@@ -125,6 +126,13 @@ int bt_write_file(const char *cmd, const char *path, const char *data, size_t le
     return bt_output_commit(cmd, &out);
 }
 
+int bt_is_stream(const char *path) {
+    struct stat st;
+    if (strcmp(path, "-") == 0) return 1;
+    return stat(path, &st) == 0 &&
+           (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) || S_ISFIFO(st.st_mode));
+}
+
 int bt_fail(const char *cmd, const char *scene_path, lb_status s, const lb_error *e) {
     const size_t n = scene_path ? strlen(scene_path) : 0;
     if (n && strncmp(e->message, scene_path, n) != 0)
@@ -158,6 +166,7 @@ static void usage(FILE *out) {
  * closed pipe is a failure, not success). */
 static int finish(int rc) {
     if (fflush(stdout) != 0 || ferror(stdout)) {
+        if (rc) return rc; /* the command has said what failed */
         bt_error("output", "writing to standard output failed: %s", strerror(errno));
         return rc ? rc : BT_EXIT_INTERNAL;
     }

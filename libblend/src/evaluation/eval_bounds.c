@@ -428,12 +428,19 @@ lb_status lb_evaluator_bounds(const lb_evaluator *ev, const double bmin[3], cons
     static const char fn[] = "lb_evaluator_bounds";
     if (!ev || !bmin || !bmax || !lo || !hi)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: every pointer must be non-NULL", fn);
-    double bc[3], br[3];
-    for (int d = 0; d < 3; ++d) {
+    for (int d = 0; d < 3; ++d)
         if (!(fabs(bmin[d]) <= LB_SCENE_MAX_COORD) || !(fabs(bmax[d]) <= LB_SCENE_MAX_COORD))
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "%s: box %c range [%g, %g]; allowed: finite, |coordinate| <= %g", fn,
                             "xyz"[d], bmin[d], bmax[d], LB_SCENE_MAX_COORD);
+    return lb__bounds_box(ev, bmin, bmax, lo, hi, err);
+}
+
+lb_status lb__bounds_box(const lb_evaluator *ev, const double bmin[3], const double bmax[3],
+                         double *lo, double *hi, lb_error *err) {
+    static const char fn[] = "lb_evaluator_bounds";
+    double bc[3], br[3];
+    for (int d = 0; d < 3; ++d) {
         if (!(bmin[d] <= bmax[d]))
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "%s: box min %c = %g is above max %c = %g; allowed: min <= max", fn,

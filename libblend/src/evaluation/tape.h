@@ -87,6 +87,11 @@ LB_INTERNAL void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], con
 LB_INTERNAL void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent,
                                      const double bc[3], const double br[3], lb__iv *R);
 
+/* lb_evaluator_bounds without its coordinate limit: the mesher's closing
+ * layer lies half a cell beyond a region that may reach the limit. */
+LB_INTERNAL lb_status lb__bounds_box(const lb_evaluator *ev, const double bmin[3],
+                                     const double bmax[3], double *lo, double *hi, lb_error *err);
+
 /* Centre and half-size of a box, the half-size rounded up to cover it. */
 LB_INTERNAL void lb__box_centre(const double bmin[3], const double bmax[3], double bc[3],
                                 double br[3]);

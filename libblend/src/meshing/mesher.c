@@ -127,7 +127,7 @@ static lb_status box_phi(const lb_evaluator *ev, const lb__grid *g, const uint64
     lb__node_pos(g, n0[0], n0[1], n0[2], bl);
     lb__node_pos(g, n1[0], n1[1], n1[2], bh);
     double flo, fhi;
-    lb_status s = lb_evaluator_bounds(ev, bl, bh, &flo, &fhi, err);
+    lb_status s = lb__bounds_box(ev, bl, bh, &flo, &fhi, err);
     if (s) return s;
     phi_interval(g, bl, bh, flo, fhi, lo, hi);
     return LB_OK;

@@ -1,0 +1,215 @@
+#!/usr/bin/python3
+"""Every row of the exit-status table (docs/blendtool.md) for every command it
+applies to, and the output-path rules (symlinks, devices, FIFOs, folders,
+modes): exit status, one message line naming the file, and nothing written
+where nothing may be. Signals (130 / 143 / 129) are test_signals.py's.
+
+usage: test_exit_codes.py BLENDTOOL SOURCE_DIR WORK_DIR
+"""
+import json
+import os
+import shutil
+import stat
+import subprocess
+import sys
+import threading
+
+BT, SRC, WORK = sys.argv[1:4]
+shutil.rmtree(WORK, ignore_errors=True)
+os.makedirs(WORK)
+S1 = os.path.join(SRC, "scenes", "bench-s1-three-spheres.json")
+S2 = os.path.join(SRC, "scenes", "bench-s2-64-spheres.json")
+ENV = dict(os.environ, LIBBLEND_POVRAY_INCLUDE=os.path.join(SRC, "povray_include"))
+failures = []
+rows = 0
+
+
+def fail(msg):
+    failures.append(msg)
+    print("FAIL:", msg)
+
+
+def bt(*args, stdin=None, stdout=subprocess.PIPE):
+    return subprocess.run([BT, *args], stdin=stdin, stdout=stdout, stderr=subprocess.PIPE,
+                          env=ENV, timeout=300)
+
+
+def expect(label, args, code, msg=None, names=None, absent=(), stdout=subprocess.PIPE,
+           stdin=None):
+    global rows
+    rows += 1
+    r = bt(*args, stdin=stdin, stdout=stdout)
+    err = r.stderr.decode(errors="replace")
+    if r.returncode != code:
+        fail(f"{label}: exit {r.returncode}, want {code}: {err!r}")
+    if code != 0:
+        # povray's own progress streams to stderr too: count blendtool's lines
+        lines = [l for l in err.splitlines() if l.startswith("blendtool")]
+        if len(lines) != 1:
+            fail(f"{label}: {len(lines)} message lines, want 1: {err!r}")
+        if msg and msg not in err:
+            fail(f"{label}: message {err!r} lacks {msg!r}")
+        if names and names not in err:
+            fail(f"{label}: message {err!r} does not name {names!r}")
+    for p in absent:
+        if os.path.lexists(p):
+            fail(f"{label}: {p} was written")
+            os.remove(p)
+
+
+def write(name, text):
+    p = os.path.join(WORK, name)
+    with open(p, "w") as f:
+        f.write(text)
+    return p
+
+
+def main():
+    out = {ext: os.path.join(WORK, "out." + ext) for ext in ("ply", "pov", "png", "txt")}
+    outputs = [("mesh", ["mesh", S1, "--resolution", "16", "-q", "--format", "ply", "-o"],
+                out["ply"]),
+               ("pov", ["pov", S1, "-o"], out["pov"]),
+               ("render", ["render", S1, "--width", "32", "--height", "24", "-o"], out["png"]),
+               ("eval", ["eval", "--points", write("p.txt", "0 0 0\n"), S1, "-o"], out["txt"])]
+    bad = write("bad.json", '{"format": "libblend-scene", "version": 1, "convention": "zero",\n'
+                            ' "root": {"type": "sphere", "radius": -2}}\n')
+    # 0: success, every command
+    for name, args, o in outputs:
+        expect(f"{name} succeeds", args + [o], 0)
+        if not os.path.exists(o):
+            fail(f"{name}: no output")
+    expect("validate succeeds", ["validate", S1, S2], 0)
+    expect("info succeeds", ["info", "--json", S2], 0)
+    for o in out.values():
+        os.remove(o)
+
+    # 2: bad input or arguments, every command
+    for name, args, o in outputs:
+        cmd = args[0]
+        rest = [a for a in args[1:] if a != S1]
+        expect(f"{name}: bad scene", [cmd, *rest[:-1], bad, rest[-1], o], 2,
+               "$.root.radius: -2 is out of range", bad, [o])
+        expect(f"{name}: missing scene", [cmd, *rest[:-1], os.path.join(WORK, "none.json"),
+                                          rest[-1], o], 2, "cannot open the scene file",
+               "none.json", [o])
+        expect(f"{name}: unknown option", args + [o, "--frobnicate"], 2, "unknown option", None,
+               [o])
+        expect(f"{name}: output is a folder", args + [WORK], 2, None, WORK)
+        missing = os.path.join(WORK, "no", os.path.basename(o))
+        expect(f"{name}: output in a missing folder", args + [missing], 2,
+               "cannot create the output file there", missing)
+        expect(f"{name}: /dev/zero as the scene", [cmd, *rest[:-1], "/dev/zero", rest[-1], o], 2,
+               "larger than 67108864 bytes", "/dev/zero", [o])
+    expect("validate: bad scene", ["validate", S1, bad], 2, "$.root.radius", bad)
+    expect("info: bad scene", ["info", bad], 2, "$.root.radius", bad)
+    expect("validate: /dev/urandom", ["validate", "/dev/urandom"], 2, "larger than", "/dev/urandom")
+    big = os.path.join(WORK, "big.json")
+    with open(big, "wb") as f:
+        f.truncate(64 * 1024 * 1024 + 1)
+    expect("validate: a scene over 64 MiB", ["validate", big], 2, "67108865 bytes", big)
+    # the instruction limit: the same code and the file name from every command
+    defs = {"d0": {"type": "sphere", "center": [0, 0, 0], "radius": 1}}
+    for i in range(1, 19):
+        defs[f"d{i}"] = {"type": "min", "args": [{"ref": f"d{i - 1}"},
+                                                 {"ref": f"d{i - 1}", "translate": [2 ** i, 0, 0]}]}
+    huge = write("huge.json", json.dumps({"format": "libblend-scene", "version": 1,
+                                          "convention": "zero", "bounds": {"min": [-1] * 3,
+                                                                           "max": [1] * 3},
+                                          "defs": defs, "root": {"ref": "d18"}}))
+    for cmd, extra in (("validate", []), ("info", []), ("mesh", ["-o", out["ply"]]),
+                       ("pov", ["-o", out["pov"]]), ("eval", ["-o", out["txt"]])):
+        expect(f"{cmd}: the instruction limit", [cmd, huge, *extra], 2,
+               "more than 200000 instructions", huge, list(out.values()), stdin=subprocess.DEVNULL)
+    # the cost limit
+    def sph(x):
+        return {"type": "sphere", "center": [x, 0, 0], "radius": 0.5}
+    n = {"type": "min", "args": [sph(0.01 * i) for i in range(200)]}
+    for d in range(4):
+        n = {"type": "displacement", "op": "union", "r": 0.3, "p": 2, "bulge": {"range": True},
+             "args": [n, sph(1 + d)]}
+    costly = write("costly.json", json.dumps({"format": "libblend-scene", "version": 1,
+                                              "convention": "zero", "root": n}))
+    expect("validate: the cost limit", ["validate", costly], 2,
+           "allowed: at most 64 times the tape size", costly)
+    expect("mesh: the memory cap", ["mesh", S2, "-q", "--resolution", "8192", "-o", out["ply"]],
+           2, "a resolution of at most", S2, [out["ply"]])
+    expect("mesh: --resolution with --cell-size",
+           ["mesh", S1, "--resolution", "8", "--cell-size", "0.1", "-o", out["ply"]], 2,
+           "both given", None, [out["ply"]])
+    expect("eval: bad points", ["eval", S1, "-o", out["txt"]], 2, "<stdin>:1: expected three",
+           None, [out["txt"]], stdin=open(write("bp.txt", "1 2\n")))
+    expect("eval: an endless line", ["eval", "--points", "/dev/zero", S1, "-o", out["txt"]], 2,
+           "line longer than 4096 bytes", "/dev/zero", [out["txt"]])
+
+    # 1: failure writing output, every command (a full device, a full stdout)
+    for name, args, o in outputs:
+        expect(f"{name}: output on a full device", args + ["/dev/full"], 1,
+               "No space left on device", "/dev/full")
+    expect("eval: stdout full", ["eval", S1], 1, "No space left on device",
+           stdin=open(write("p1.txt", "0 0 0\n")), stdout=open("/dev/full", "w"))
+    for cmd, a in (("validate", [S1]), ("info", [S1]), ("info", ["--json", S1])):
+        expect(f"{cmd} {' '.join(a[:-1])}: stdout full", [cmd, *a], 1,
+               "writing to standard output failed", stdout=open("/dev/full", "w"))
+    env_noinc = dict(ENV, LIBBLEND_POVRAY_INCLUDE=os.path.join(WORK, "nowhere"))
+    r = subprocess.run([BT, "render", S1, "--width", "32", "--height", "24", "-o", out["png"]],
+                       capture_output=True, env=env_noinc)
+    global rows
+    rows += 1
+    if r.returncode != 1 or os.path.exists(out["png"]) or b"povray failed" not in r.stderr:
+        fail(f"render without libblend.inc: exit {r.returncode}: {r.stderr[-300:]!r}")
+    if not stat.S_ISCHR(os.stat("/dev/full").st_mode):
+        fail("/dev/full is no longer a character device")
+
+    # output paths: a symlink is followed (the link stays), devices and FIFOs
+    # are written directly, modes are 0666 less the umask or kept
+    old = os.umask(0o027)
+    try:
+        for name, args, o in outputs:
+            target = os.path.join(WORK, "target-" + os.path.basename(o))
+            link = os.path.join(WORK, "link-" + os.path.basename(o))
+            for p in (target, link):
+                if os.path.lexists(p):
+                    os.remove(p)
+            os.symlink(os.path.basename(target), link)
+            expect(f"{name} through a dangling symlink", args + [link], 0)
+            if not os.path.islink(link) or not os.path.isfile(target):
+                fail(f"{name}: the symlink was replaced or its target not written")
+            elif stat.S_IMODE(os.stat(target).st_mode) != 0o640:
+                fail(f"{name}: new file mode {oct(os.stat(target).st_mode)}, want 0o640 (umask 027)")
+            os.chmod(target, 0o604)
+            expect(f"{name} over an existing file through the symlink", args + [link], 0)
+            if stat.S_IMODE(os.stat(target).st_mode) != 0o604 or not os.path.islink(link):
+                fail(f"{name}: the existing mode was not kept ({oct(os.stat(target).st_mode)})")
+            expect(f"{name} to /dev/null", args + ["/dev/null"], 0)
+            if not stat.S_ISCHR(os.stat("/dev/null").st_mode):
+                fail(f"{name}: /dev/null was replaced")
+            fifo = os.path.join(WORK, "fifo")
+            if os.path.lexists(fifo):
+                os.remove(fifo)
+            os.mkfifo(fifo)
+            got = {}
+
+            def reader():
+                with open(fifo, "rb") as f:
+                    got["n"] = len(f.read())
+            t = threading.Thread(target=reader, daemon=True)
+            t.start()
+            expect(f"{name} into a FIFO", args + [fifo], 0)
+            t.join(60)
+            if not stat.S_ISFIFO(os.stat(fifo).st_mode) or not got.get("n"):
+                fail(f"{name}: the FIFO was replaced or got nothing ({got})")
+            left = [f for f in os.listdir(WORK) if ".lbtmp." in f]
+            if left:
+                fail(f"{name}: temporary files left: {left}")
+    finally:
+        os.umask(old)
+    print(f"{rows} exit-status and output-path rows checked")
+    if rows < 60:
+        fail(f"only {rows} rows")
+    if failures:
+        print(f"{len(failures)} failures")
+        sys.exit(1)
+    print("all exit-status rows passed")
+
+
+main()
