@@ -41,7 +41,8 @@ typedef struct lb_pov_options {
 
 /* The camera the exporter uses: the scene's render section, or one framing
  * the bounds. POV-Ray's conventions: left-handed, sky +y, angle the
- * horizontal field of view in degrees, image aspect `aspect` (0: 4/3). */
+ * horizontal field of view in degrees, image aspect `aspect` (0: 4/3).
+ * Writes nothing when any pointer is NULL. */
 LB_API void lb_pov_camera(const lb_scene *scene, double aspect, double location[3],
                           double look_at[3], double *angle);
 

@@ -86,11 +86,12 @@ LB_API lb_status lb_primitive_torus(lb_primitive *out, const double c[3], const 
  * kernel (LB_KERNEL_NONE switches back to the zero convention). */
 LB_API lb_status lb_primitive_soften(lb_primitive *prim, lb_kernel kernel, lb_error *err);
 
-/* The ray-linear function rho at X (grad may be NULL). */
+/* The ray-linear function rho at X (grad may be NULL; NaN when prim or X is
+ * NULL). */
 LB_API double lb_primitive_rho(const lb_primitive *prim, const double X[3], double grad[3]);
 
 /* The primitive's field at X in its convention, and its gradient (grad may be
- * NULL). prim must come from a constructor above. */
+ * NULL). prim must come from a constructor above; NaN when prim or X is NULL. */
 LB_API double lb_primitive_eval(const lb_primitive *prim, const double X[3], double grad[3]);
 
 #ifdef __cplusplus

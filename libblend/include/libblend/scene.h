@@ -106,7 +106,7 @@ LB_API void lb_scene_stats_get(const lb_scene *scene, lb_scene_stats *stats);
 /* Write the tree as indented text (one node per line, shared defs printed
  * once and referenced by name afterwards) into buf, NUL-terminated and
  * truncated to size. Returns the length the whole text needs (without the
- * NUL), like snprintf. buf may be NULL when size is 0. */
+ * NUL), like snprintf. A NULL buf (with any size) only measures. */
 LB_API size_t lb_scene_describe(const lb_scene *scene, char *buf, size_t size);
 
 /* Reference evaluator: a plain recursive walk over the scene tree, one

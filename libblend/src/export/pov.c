@@ -264,6 +264,7 @@ static lb_status emit(pctx *c, const lb__node *n, int *out) {
 void lb_pov_camera(const lb_scene *scene, double aspect, double loc[3], double at[3],
                    double *angle) {
     (void)aspect;
+    if (!scene || !loc || !at || !angle) return; /* nothing to write to, or from */
     const lb_render *R = &scene->render;
     *angle = R->has_camera ? R->angle : 40.0;
     if (R->has_camera) {

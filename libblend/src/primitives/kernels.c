@@ -43,6 +43,7 @@ double lb__kernel(lb_kernel kernel, double rho, double *df) {
 }
 
 double lb_primitive_eval(const lb_primitive *P, const double X[3], double grad[3]) {
+    if (!P || !X) return NAN;
     double g[3], df;
     const double f = lb__kernel(P->kernel, lb_primitive_rho(P, X, g), &df);
     if (grad)

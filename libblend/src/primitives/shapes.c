@@ -135,5 +135,7 @@ lb_status lb_primitive_torus(lb_primitive *out, const double c[3], const double 
 }
 
 double lb_primitive_rho(const lb_primitive *P, const double X[3], double g[3]) {
-    return lb__rho(P->kind, P, X, g);
+    if (!P || !X) return NAN;
+    double scratch[3];
+    return lb__rho(P->kind, P, X, g ? g : scratch);
 }

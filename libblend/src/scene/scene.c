@@ -154,6 +154,7 @@ static void describe(sbuf *b, const lb__node *n, int indent, const char *role, c
 }
 
 size_t lb_scene_describe(const lb_scene *s, char *buf, size_t size) {
+    if (!buf) size = 0; /* a NULL buffer with any size only measures */
     sbuf b = {buf, size, 0};
     if (buf && size) buf[0] = '\0';
     if (!s || !s->root) return 0;

@@ -1,0 +1,376 @@
+/* Every public function with every combination of NULL and valid pointer
+ * arguments, and sizes 0, 1 and the largest, as a binding (ctypes, another
+ * runtime) might pass them by mistake. Nothing may crash (this test runs in
+ * the sanitizer build too); a call that fails returns a status and, when err
+ * is given, the same status and a message; a call missing a pointer it
+ * needs fails; functions that return a value instead of a status return NaN,
+ * 0 or nothing for NULL. The combinations are generated: one bit of the
+ * mask per pointer argument. */
+#define _POSIX_C_SOURCE 200809L
+#include "testlib.h"
+
+#include <stdlib.h>
+#include <unistd.h>
+
+#define NARGS_MAX 10
+
+typedef struct ctx {
+    lb_scene *scene;
+    lb_evaluator *ev;
+    lb_mesh *mesh;
+    char tmpdir[64];
+} ctx;
+
+static ctx C;
+static long calls, failures_checked;
+
+/* One enumerated function: call it with mask bit i set meaning "pointer
+ * argument i is NULL"; `size` picks 0, 1 or the largest count. Returns the
+ * status; *has_status is 0 for functions without one. */
+typedef lb_status (*caller)(unsigned mask, int size, lb_error *err, int *has_status);
+
+typedef struct fn_case {
+    const char *name;
+    int npointers;     /* err counts as the last pointer where the function has one */
+    unsigned required; /* pointers whose NULL must make the call fail */
+    caller call;
+} fn_case;
+
+#define P(i, v) ((mask >> (i)) & 1u ? NULL : (v))
+static size_t sz(int size, size_t one) {
+    return size == 0 ? 0 : size == 1 ? one : (size_t)-1 / 16;
+}
+
+static double X2[2] = {0.1, -0.2}, R2[2] = {0.5, 0.5}, P2[2] = {2, 2}, M2[2] = {1, 1};
+static double G3a[3] = {1, 0, 0}, G3b[3] = {0, 1, 0};
+static double outv, outg[LB_MAX_ARITY], outg2[LB_MAX_ARITY], dg1[3], dg2[3];
+
+static lb_status c_version(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)mask, (void)size, (void)err;
+    *hs = 0;
+    assert_true(lb_version() > 0);
+    for (int s = -1; s < 9; ++s) assert_non_null(lb_status_string((lb_status)s));
+    return LB_OK;
+}
+
+static lb_status c_displacement(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    return lb_displacement(LB_UNION, sz(size, 2), P(0, X2), P(1, R2), P(2, P2), P(3, M2),
+                           P(4, &outv), P(5, outg), P(6, err));
+}
+static lb_status c_conic(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    return lb_conic(LB_UNION, P(0, X2), P(1, R2), 0.0, P(2, M2), P(3, &outv), P(4, outg),
+                    P(5, err));
+}
+static lb_status c_scale_ba(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    return lb_scale_ba(sz(size, 2), P(0, X2), P(1, R2), P(2, P2), P(3, &outv), P(4, outg),
+                       P(5, err));
+}
+static lb_status c_scale_bs(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    return lb_scale_bs(sz(size, 2), P(0, X2), P(1, R2), P(2, P2), P(3, &outv), P(4, outg),
+                       P(5, err));
+}
+static lb_status c_scale(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    return lb_scale(LB_UNION, sz(size, 2), P(0, X2), P(1, R2), P(2, P2), P(3, &outv), P(4, outg),
+                    P(5, err));
+}
+static lb_status c_bounded(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    return lb_bounded(LB_UNION, sz(size, 2), P(0, X2), P(1, R2), P(2, P2), P(3, &outv), P(4, outg),
+                      P(5, outg2), P(6, err));
+}
+static lb_status c_bulge(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    const lb_bulge_params bp = {{0.3, 0.3}, {2, 2}, 0.0, {1, 1}, 0.001, LB_BULGE_RANGE};
+    return lb_bulge(LB_BULGE_DISPLACEMENT, LB_UNION, P(0, &bp), P(1, X2), P(2, G3a), P(3, G3b),
+                    P(4, &outv), P(5, outg), P(6, dg1), P(7, dg2), P(8, err));
+}
+static double S2v[2] = {0.4, 0.6};
+static lb_status c_soft_hyper(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    return lb_soft_hyper(LB_UNION, sz(size, 2), P(0, S2v), P(1, R2), P(2, P2), P(3, M2),
+                         P(4, &outv), P(5, outg), P(6, err));
+}
+static lb_status c_soft_conic(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    return lb_soft_conic(LB_UNION, P(0, S2v), P(1, R2), 0.0, P(2, M2), P(3, &outv), P(4, outg),
+                         P(5, err));
+}
+static lb_status c_classic(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    return lb_classic(LB_RFUNC_UNION, sz(size, 2), P(0, X2), 0.0, P(1, &outv), P(2, outg),
+                      P(3, err));
+}
+
+static const double C3[3] = {0, 0, 0}, A3[3] = {1, 1, 1}, N3[3] = {0, 0, 1}, Q3[3] = {1, 0, 0};
+static lb_primitive prim;
+static lb_status c_prims(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    /* every constructor with the same three pointer slots: out, the first
+     * vector, and (where there is one) the second; err last */
+    lb_status s = lb_primitive_sphere(P(0, &prim), P(1, C3), 1.0, P(3, err));
+    lb_status t;
+#define MERGE(call)                                                                                \
+    t = (call);                                                                                    \
+    if (t && !s) s = t;                                                                            \
+    if (!t && s) s = t
+    /* all must agree: with the same pointers NULL, each fails or each passes */
+    MERGE(lb_primitive_ellipsoid(P(0, &prim), P(1, C3), P(2, A3), P(3, err)));
+    MERGE(lb_primitive_lp(P(0, &prim), P(1, C3), P(2, A3), 3.0, P(3, err)));
+    MERGE(lb_primitive_superquadric(P(0, &prim), P(1, C3), P(2, A3), 1.0, 1.0, P(3, err)));
+    MERGE(lb_primitive_slab(P(0, &prim), P(1, C3), P(2, N3), 0.5, P(3, err)));
+    MERGE(lb_primitive_halfspace(P(0, &prim), P(1, C3), P(2, N3), 0.0, P(3, err)));
+    MERGE(lb_primitive_cylinder(P(0, &prim), P(1, C3), P(2, N3), 0.5, P(3, err)));
+    MERGE(lb_primitive_capsule(P(0, &prim), P(1, C3), P(2, Q3), 0.5, P(3, err)));
+    MERGE(lb_primitive_torus(P(0, &prim), P(1, C3), P(2, N3), 1.0, 0.2, P(3, err)));
+#undef MERGE
+    return s;
+}
+static lb_status c_prim_use(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 0;
+    lb_primitive p;
+    assert_int_equal(lb_primitive_sphere(&p, C3, 1.0, NULL), LB_OK);
+    double g[3];
+    const double v = lb_primitive_eval(P(0, &p), P(1, C3), P(2, g));
+    const double w = lb_primitive_rho(P(0, &p), P(1, C3), P(2, g));
+    if (mask & 3u)
+        assert_true(isnan(v) && isnan(w));
+    else
+        assert_true(isfinite(v) && isfinite(w));
+    *hs = 1;
+    return lb_primitive_soften(P(3, &p), LB_KERNEL_WYVILL, P(4, err));
+}
+
+static const char SCENE[] = "{\"format\":\"libblend-scene\",\"version\":1,\"convention\":\"zero\","
+                            "\"bounds\":{\"min\":[-2,-2,-2],\"max\":[2,2,2]},"
+                            "\"root\":{\"type\":\"sphere\",\"center\":[0,0,0],\"radius\":1}}";
+
+static lb_status c_scene_parse(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    lb_scene *s = NULL;
+    const size_t len = size == 2 ? (size_t)-1 : size == 0 ? 0 : strlen(SCENE);
+    lb_status st = lb_scene_parse(P(0, SCENE), len, P(1, "ffi.json"), P(2, &s), P(3, err));
+    lb_scene_free(s);
+    return st;
+}
+static lb_status c_scene_load(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    lb_scene *s = NULL;
+    lb_status st = lb_scene_load(P(0, "/dev/null"), P(1, &s), P(2, err));
+    lb_scene_free(s);
+    return st;
+}
+static lb_status c_scene_queries(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 0;
+    double mn[3], mx[3];
+    lb_scene_stats st;
+    char buf[64];
+    (void)lb_scene_convention(P(0, C.scene));
+    const int b = lb_scene_bounds(P(0, C.scene), P(1, mn), P(2, mx));
+    if (mask & 1u) assert_int_equal(b, 0); /* NULL min / max: only asks */
+    (void)lb_scene_render(P(0, C.scene));
+    lb_scene_stats_get(P(0, C.scene), P(3, &st));
+    const size_t n = lb_scene_describe(P(0, C.scene), P(4, buf),
+                                       size == 0   ? 0
+                                       : size == 1 ? 1
+                                                   : sizeof buf);
+    if (mask & 1u) assert_int_equal(n, 0);
+    if (!(mask & 1u)) assert_int_equal(n, lb_scene_describe(C.scene, NULL, 10));
+    double loc[3], look[3], ang;
+    lb_pov_camera(P(0, C.scene), 1.0, P(1, loc), P(2, look), P(3, &ang));
+    *hs = 1;
+    double v, g[3];
+    return lb_scene_eval_reference(P(0, C.scene), P(1, C3), P(2, &v), P(3, g), P(5, err));
+}
+static lb_status c_evaluator(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    (void)size;
+    lb_evaluator *ev = NULL;
+    lb_status s = lb_evaluator_create(P(0, C.scene), P(1, &ev), P(2, err));
+    (void)lb_evaluator_size(ev);
+    (void)lb_evaluator_cost(ev);
+    (void)lb_evaluator_convention(ev);
+    lb_evaluator_free(ev);
+    return s;
+}
+static lb_status c_eval(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    double x[2] = {0, 0.5}, y[2] = {0, 0}, z[2] = {0, 0}, v[2], g[3][2];
+    const size_t n = size == 0 ? 0 : 2; /* a count past the buffers is no NULL misuse */
+    return lb_evaluator_eval(P(0, C.ev), n, P(1, x), P(2, y), P(3, z), P(4, v), P(5, g[0]),
+                             P(6, g[1]), P(7, g[2]), 1, P(8, err));
+}
+static lb_status c_bounds(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    double lo, hi;
+    const double bmin[3] = {-1, -1, -1}, bmax[3] = {1, 1, 1};
+    return lb_evaluator_bounds(P(0, C.ev), P(1, bmin), P(2, bmax), P(3, &lo), P(4, &hi), P(5, err));
+}
+static lb_status c_mesh(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    lb_mesh_options o;
+    lb_mesh_options_init(NULL);
+    lb_mesh_options_init(&o);
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -2;
+        o.bmax[d] = 2;
+    }
+    o.resolution = 8;
+    o.threads = 1;
+    lb_mesh *m = NULL;
+    lb_status s = lb_mesh_create(P(0, C.ev), P(1, &o), P(2, &m), P(3, err));
+    lb_mesh_free(m);
+    return s;
+}
+static lb_status c_mesh_write(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    char path[128];
+    snprintf(path, sizeof path, "%s/m.ply", C.tmpdir);
+    lb_status s = lb_mesh_write(P(0, C.mesh), P(1, path), (lb_mesh_format)(size * 2), P(3, err));
+    FILE *f = tmpfile();
+    assert_non_null(f);
+    lb_status t = lb_mesh_write_stream(P(0, C.mesh), P(2, f), LB_MESH_FORMAT_PLY, P(3, err));
+    fclose(f);
+    (void)lb_mesh_format_of(P(1, path));
+    remove(path);
+    return s ? s : t;
+}
+static lb_status c_pov(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    char path[128];
+    snprintf(path, sizeof path, "%s/s.pov", C.tmpdir);
+    const lb_pov_options o = {0, 0, 0.0, 2.0, 1};
+    double g;
+    lb_status s =
+        lb_scene_write_pov(P(0, C.scene), P(1, C.ev), P(2, &o), P(3, path), P(4, &g), P(5, err));
+    remove(path);
+    return s;
+}
+static lb_status c_output(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    char path[128];
+    snprintf(path, sizeof path, "%s/o.bin", C.tmpdir);
+    lb_output *o = NULL;
+    lb_status s = lb_output_open(P(0, path), P(1, &o), P(4, err));
+    (void)lb_output_stream(o);
+    (void)lb_output_temp_name(o);
+    lb_output_stream(NULL);
+    lb_output_temp_name(NULL);
+    lb_output_discard(NULL);
+    if (!s) {
+        if (mask & 8u)
+            lb_output_discard(o);
+        else
+            s = lb_output_commit(o, P(4, err));
+    } else {
+        lb_status t = lb_output_commit(NULL, P(4, err));
+        assert_int_not_equal(t, LB_OK);
+    }
+    lb_status t = lb_output_write_file(P(0, path), P(2, "abc"), (size_t)size, P(4, err));
+    if ((mask & 4u) && size && !t)
+        fail_msg("lb_output_write_file took NULL data of %d bytes", size);
+    remove(path);
+    return s ? s : t;
+}
+
+static const fn_case CASES[] = {
+    {"lb_version / lb_status_string", 0, 0, c_version},
+    {"lb_displacement", 7, 0x17, c_displacement},
+    {"lb_conic", 6, 0x0b, c_conic},
+    {"lb_scale_ba", 6, 0x0f, c_scale_ba},
+    {"lb_scale_bs", 6, 0x0f, c_scale_bs},
+    {"lb_scale", 6, 0x0f, c_scale},
+    {"lb_bounded", 7, 0x0f, c_bounded},
+    {"lb_bulge", 9, 0x13, c_bulge},
+    {"lb_soft_hyper", 7, 0x17, c_soft_hyper},
+    {"lb_soft_conic", 6, 0x0b, c_soft_conic},
+    {"lb_classic", 4, 0x03, c_classic},
+    {"lb_primitive_* constructors", 4, 0x03, c_prims},
+    {"lb_primitive_eval / rho / soften", 5, 0x08, c_prim_use},
+    {"lb_scene_parse", 4, 0x05, c_scene_parse},
+    {"lb_scene_load", 3, 0x03, c_scene_load},
+    {"lb_scene_* queries and reference walk", 6, 0x07, c_scene_queries},
+    {"lb_evaluator_create", 3, 0x03, c_evaluator},
+    {"lb_evaluator_eval", 9, 0x1f, c_eval},
+    {"lb_evaluator_bounds", 6, 0x1f, c_bounds},
+    {"lb_mesh_create", 4, 0x07, c_mesh},
+    {"lb_mesh_write / _stream", 4, 0x07, c_mesh_write},
+    {"lb_scene_write_pov", 6, 0x0b, c_pov},
+    {"lb_output_*", 5, 0x03, c_output},
+};
+
+static void test_every_null_combination(void **state) {
+    (void)state;
+    const size_t ncases = sizeof CASES / sizeof CASES[0];
+    for (size_t c = 0; c < ncases; ++c) {
+        const fn_case *F = &CASES[c];
+        for (unsigned mask = 0; mask < (1u << F->npointers); ++mask)
+            for (int size = 0; size < 3; ++size) {
+                lb_error e = {LB_OK, ""};
+                int hs = 0;
+                const lb_status s = F->call(mask, size, &e, &hs);
+                ++calls;
+                if (!hs) continue;
+                const int err_null = F->npointers && (mask >> (F->npointers - 1)) & 1u;
+                if (s != LB_OK && !err_null) {
+                    ++failures_checked;
+                    if (e.status != s || !e.message[0])
+                        fail_msg("%s mask %#x size %d: status %d but err says %d \"%s\"", F->name,
+                                 mask, size, s, e.status, e.message);
+                }
+                /* size 0 is an empty count for eval: no pointer is needed */
+                if ((mask & F->required) && s == LB_OK && !(size == 0 && F->call == c_eval))
+                    fail_msg("%s mask %#x size %d: a required pointer is NULL but it succeeded",
+                             F->name, mask, size);
+            }
+    }
+    printf("%ld calls, %ld failures with messages checked\n", calls, failures_checked);
+    assert_true(calls > 5000);
+    assert_true(failures_checked > 2000);
+}
+
+static int setup(void **state) {
+    (void)state;
+    lb_error e = {LB_OK, ""};
+    if (lb_scene_parse(SCENE, strlen(SCENE), "ffi.json", &C.scene, &e) ||
+        lb_evaluator_create(C.scene, &C.ev, &e))
+        return -1;
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -2;
+        o.bmax[d] = 2;
+    }
+    o.resolution = 8;
+    o.threads = 1;
+    if (lb_mesh_create(C.ev, &o, &C.mesh, &e)) return -1;
+    snprintf(C.tmpdir, sizeof C.tmpdir, "/tmp/libblend-ffi-XXXXXX");
+    return mkdtemp(C.tmpdir) ? 0 : -1;
+}
+
+static int teardown(void **state) {
+    (void)state;
+    lb_mesh_free(C.mesh);
+    lb_evaluator_free(C.ev);
+    lb_scene_free(C.scene);
+    rmdir(C.tmpdir);
+    return 0;
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_every_null_combination)};
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
