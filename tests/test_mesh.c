@@ -638,6 +638,49 @@ static void test_memory_cap_and_empty(void **state) {
     lb_scene_free(sc);
 }
 
+/* docs/meshing.md "The smallest feature kept": a sphere of radius just over
+ * half the cell diagonal, anywhere relative to the grid, is always meshed
+ * closed. */
+static void test_min_feature(void **state) {
+    (void)state;
+    rng_t r = {20261201};
+    const double h = 2.0 / 16.0, rad = 1.001 * 0.5 * sqrt(3.0) * h;
+    int kept = 0;
+    for (int t = 0; t < 400; ++t) {
+        const double c[3] = {rng_range(&r, -h, h), rng_range(&r, -h, h), rng_range(&r, -h, h)};
+        char text[512];
+        const int n = snprintf(text, sizeof text,
+                               "{\"format\":\"libblend-scene\",\"version\":1,\"convention\":"
+                               "\"zero\",\"root\":{\"type\":\"sphere\",\"center\":[%.17g,%.17g,"
+                               "%.17g],\"radius\":%.17g}}",
+                               c[0], c[1], c[2], rad);
+        lb_scene *sc = NULL;
+        lb_evaluator *ev = NULL;
+        lb_error e = {LB_OK, ""};
+        assert_int_equal(lb_scene_parse(text, (size_t)n, "small.json", &sc, &e), LB_OK);
+        assert_int_equal(lb_evaluator_create(sc, &ev, &e), LB_OK);
+        lb_mesh_options o;
+        lb_mesh_options_init(&o);
+        for (int d = 0; d < 3; ++d) {
+            o.bmin[d] = -1.0;
+            o.bmax[d] = 1.0;
+        }
+        o.resolution = 16;
+        o.threads = 1;
+        lb_mesh *m = NULL;
+        assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_OK);
+        if (m->ntriangles == 0)
+            fail_msg("a sphere of radius %g (cell %g) at (%g, %g, %g) vanished", rad, h, c[0], c[1],
+                     c[2]);
+        expect_closed_manifold("small sphere", m);
+        kept += m->ntriangles > 0;
+        lb_mesh_free(m);
+        lb_evaluator_free(ev);
+        lb_scene_free(sc);
+    }
+    assert_int_equal(kept, 400);
+}
+
 static void test_bad_options(void **state) {
     (void)state;
     static const char text[] =
@@ -732,6 +775,7 @@ int main(void) {
         cmocka_unit_test(test_progress_and_cancel),
         cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_memory_cap_and_empty),
+        cmocka_unit_test(test_min_feature),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }
