@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The whole test suite: install what is missing, then a Release build and a
-# sanitizer (ASan + UBSan) build, each run by ctest; the threaded tests under
-# ThreadSanitizer; then the scene parser under libFuzzer (clang, ASan +
-# UBSan) for LIBBLEND_FUZZ_SECONDS (60).
+# sanitizer (ASan + UBSan) build, each run by ctest (the sanitizer build also
+# runs random valid scenes through every command for 60 s); the threaded
+# tests under ThreadSanitizer; then the scene parser under libFuzzer (clang,
+# ASan + UBSan) for LIBBLEND_FUZZ_SECONDS (60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh

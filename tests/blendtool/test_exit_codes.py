@@ -79,6 +79,15 @@ def main():
         if not os.path.exists(o):
             fail(f"{name}: no output")
     expect("validate succeeds", ["validate", S1, S2], 0)
+    # the documented extremes are accepted: bounds at +-1e9, underflowing
+    # numbers and trailing comments in points
+    expect("mesh at --bounds +-1e9", ["mesh", S1, "-q", "--resolution", "8", "--bounds",
+                                      "-1e9,-1e9,-1e9,1e9,1e9,1e9", "-o", out["ply"]], 0)
+    r1 = subprocess.run([BT, "eval", S1], input=b"1e-400 0 0 # underflows to 0\n2.5e-320 0 0\n",
+                        capture_output=True)
+    r0 = subprocess.run([BT, "eval", S1], input=b"0 0 0\n2.5e-320 0 0\n", capture_output=True)
+    if r1.returncode != 0 or r1.stdout != r0.stdout:
+        fail(f"eval of 1e-400 with a comment: {r1.returncode} {r1.stdout!r} vs {r0.stdout!r}")
     expect("info succeeds", ["info", "--json", S2], 0)
     for o in out.values():
         os.remove(o)
