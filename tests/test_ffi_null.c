@@ -217,18 +217,23 @@ static lb_status c_bounds(unsigned mask, int size, lb_error *err, int *hs) {
     const double bmin[3] = {-1, -1, -1}, bmax[3] = {1, 1, 1};
     return lb_evaluator_bounds(P(0, C.ev), P(1, bmin), P(2, bmax), P(3, &lo), P(4, &hi), P(5, err));
 }
+/* the test scene's bounds, 8 cells, one thread */
+static void small_options(lb_mesh_options *o) {
+    lb_mesh_options_init(o);
+    for (int d = 0; d < 3; ++d) {
+        o->bmin[d] = -2;
+        o->bmax[d] = 2;
+    }
+    o->resolution = 8;
+    o->threads = 1;
+}
+
 static lb_status c_mesh(unsigned mask, int size, lb_error *err, int *hs) {
     (void)size;
     *hs = 1;
     lb_mesh_options o;
     lb_mesh_options_init(NULL);
-    lb_mesh_options_init(&o);
-    for (int d = 0; d < 3; ++d) {
-        o.bmin[d] = -2;
-        o.bmax[d] = 2;
-    }
-    o.resolution = 8;
-    o.threads = 1;
+    small_options(&o);
     lb_mesh *m = NULL;
     lb_status s = lb_mesh_create(P(0, C.ev), P(1, &o), P(2, &m), P(3, err));
     lb_mesh_free(m);
@@ -349,13 +354,7 @@ static int setup(void **state) {
         lb_evaluator_create(C.scene, &C.ev, &e))
         return -1;
     lb_mesh_options o;
-    lb_mesh_options_init(&o);
-    for (int d = 0; d < 3; ++d) {
-        o.bmin[d] = -2;
-        o.bmax[d] = 2;
-    }
-    o.resolution = 8;
-    o.threads = 1;
+    small_options(&o);
     if (lb_mesh_create(C.ev, &o, &C.mesh, &e)) return -1;
     snprintf(C.tmpdir, sizeof C.tmpdir, "/tmp/libblend-ffi-XXXXXX");
     return mkdtemp(C.tmpdir) ? 0 : -1;

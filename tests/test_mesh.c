@@ -539,18 +539,24 @@ static int on_progress(double f, void *user) {
     return ++p->calls == p->cancel_at;
 }
 
-static void test_progress_and_cancel(void **state) {
-    (void)state;
+/* S2 (64 spheres) compiled, with default options over its bounds */
+static void load_s2(lb_scene **sc, lb_evaluator **ev, lb_mesh_options *o) {
     char path[1100];
     snprintf(path, sizeof path, "%s/scenes/bench-s2-64-spheres.json", SOURCE_DIR);
     lb_error e = {LB_OK, ""};
+    assert_int_equal(lb_scene_load(path, sc, &e), LB_OK);
+    assert_int_equal(lb_evaluator_create(*sc, ev, &e), LB_OK);
+    lb_mesh_options_init(o);
+    lb_scene_bounds(*sc, o->bmin, o->bmax);
+}
+
+static void test_progress_and_cancel(void **state) {
+    (void)state;
+    lb_error e = {LB_OK, ""};
     lb_scene *sc = NULL;
     lb_evaluator *ev = NULL;
-    assert_int_equal(lb_scene_load(path, &sc, &e), LB_OK);
-    assert_int_equal(lb_evaluator_create(sc, &ev, &e), LB_OK);
     lb_mesh_options o;
-    lb_mesh_options_init(&o);
-    lb_scene_bounds(sc, o.bmin, o.bmax);
+    load_s2(&sc, &ev, &o);
     o.resolution = 64;
     o.threads = 2;
     prog p = {0, 0.0, 1, -1};
@@ -581,16 +587,11 @@ static void test_progress_and_cancel(void **state) {
  * valid mesh with no triangles, written in every format. */
 static void test_memory_cap_and_empty(void **state) {
     (void)state;
-    char path[1100];
-    snprintf(path, sizeof path, "%s/scenes/bench-s2-64-spheres.json", SOURCE_DIR);
     lb_error e = {LB_OK, ""};
     lb_scene *sc = NULL;
     lb_evaluator *ev = NULL;
-    assert_int_equal(lb_scene_load(path, &sc, &e), LB_OK);
-    assert_int_equal(lb_evaluator_create(sc, &ev, &e), LB_OK);
     lb_mesh_options o;
-    lb_mesh_options_init(&o);
-    lb_scene_bounds(sc, o.bmin, o.bmax);
+    load_s2(&sc, &ev, &o);
     o.threads = 1;
     o.max_memory = (size_t)12 << 20; /* 96 blocks */
     o.resolution = 4096;
