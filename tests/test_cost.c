@@ -133,7 +133,7 @@ static void gen_shared(sbuf *b, int k) {
 /* siblings up to the arity limit: linear, and equal to the count */
 static void test_sibling_bulges_linear(void **st) {
     (void)st;
-    check_linear("siblings", gen_siblings, 64);
+    check_linear("siblings", gen_siblings, LB_MAX_ARITY);
     sbuf b = {0};
     gen_siblings(&b, LB_MAX_ARITY);
     lb_evaluator *ev = compile(&b, LB_OK, NULL);
@@ -145,7 +145,7 @@ static void test_sibling_bulges_linear(void **st) {
 
 static void test_shared_bulges_linear(void **st) {
     (void)st;
-    check_linear("shared def", gen_shared, 64);
+    check_linear("shared def", gen_shared, LB_MAX_ARITY);
 }
 
 /* a chain of bulges nested n deep over the same arguments, all

@@ -145,6 +145,8 @@ def main():
     expect("mesh: --resolution with --cell-size",
            ["mesh", S1, "--resolution", "8", "--cell-size", "0.1", "-o", out["ply"]], 2,
            "both given", None, [out["ply"]])
+    expect("a control character in an argument stays one line",
+           ["mesh", S1, "-o", out["ply"], "--frob\nnicate"], 2, "unknown option --frob\\nnicate")
     expect("eval: bad points", ["eval", S1, "-o", out["txt"]], 2, "<stdin>:1: expected three",
            None, [out["txt"]], stdin=open(write("bp.txt", "1 2\n")))
     expect("eval: an endless line", ["eval", "--points", "/dev/zero", S1, "-o", out["txt"]], 2,

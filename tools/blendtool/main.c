@@ -18,13 +18,24 @@ int bt_exit_for(lb_status s) {
                                                                   : BT_EXIT_INTERNAL;
 }
 
+/* One line whatever the arguments hold (file names, option values): control
+ * characters are written as \n, \t, \r or \xNN, as the library does. */
 void bt_error(const char *cmd, const char *fmt, ...) {
+    char raw[4096];
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "blendtool %s: ", cmd);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
+    vsnprintf(raw, sizeof raw, fmt, ap);
     va_end(ap);
+    fprintf(stderr, "blendtool %s: ", cmd);
+    for (const unsigned char *c = (const unsigned char *)raw; *c; ++c) {
+        if (*c == '\n' || *c == '\t' || *c == '\r')
+            fprintf(stderr, "\\%c", *c == '\n' ? 'n' : *c == '\t' ? 't' : 'r');
+        else if (*c < 0x20 || *c == 0x7f)
+            fprintf(stderr, "\\x%02x", *c);
+        else
+            fputc(*c, stderr);
+    }
+    fputc('\n', stderr);
 }
 
 int bt_option(const char *cmd, int argc, char **argv, int *i, const char *name,
