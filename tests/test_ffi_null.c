@@ -109,6 +109,22 @@ static lb_status c_classic(unsigned mask, int size, lb_error *err, int *hs) {
                       P(3, err));
 }
 
+static lb_status c_clean(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    const double alpha[2] = {0.1, 0.2};
+    return lb_clean_union((lb_clean_kind)(size + 1), P(0, S2v), 0.5, P(1, alpha), P(2, &outv),
+                          P(3, outg), P(4, err));
+}
+static lb_status c_barthe(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    return lb_barthe_blend(P(0, S2v), 0.2, 0.3, P(1, &outv), P(2, outg), P(3, err));
+}
+static lb_status c_mix(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    return lb_local_mix(0.4, 0.6, 0.5 * size, 2.0, P(0, &outv), P(1, outg), P(2, err));
+}
+
 static const double C3[3] = {0, 0, 0}, A3[3] = {1, 1, 1}, N3[3] = {0, 0, 1}, Q3[3] = {1, 0, 0};
 static lb_primitive prim;
 static lb_status c_prims(unsigned mask, int size, lb_error *err, int *hs) {
@@ -303,6 +319,9 @@ static const fn_case CASES[] = {
     {"lb_soft_hyper", 7, 0x17, c_soft_hyper},
     {"lb_soft_conic", 6, 0x0b, c_soft_conic},
     {"lb_classic", 4, 0x03, c_classic},
+    {"lb_clean_union", 5, 0x05, c_clean},
+    {"lb_barthe_blend", 4, 0x03, c_barthe},
+    {"lb_local_mix", 3, 0x01, c_mix},
     {"lb_primitive_* constructors", 4, 0x03, c_prims},
     {"lb_primitive_eval / rho / soften", 5, 0x08, c_prim_use},
     {"lb_scene_parse", 4, 0x05, c_scene_parse},

@@ -199,6 +199,59 @@ typedef enum lb_classic_kind {
 LB_API lb_status lb_classic(lb_classic_kind kind, size_t k, const double *x, double param,
                             double *value, double *grad, lb_error *err);
 
+/* ---- Local blending's operators [bernhardt2010 §3] ------------------------
+ * Soft convention with iso value C > 0 (0.5 for fields in [0, 1]): f > C
+ * inside, the unions are Max-like. These are the pieces of the local blend
+ * (two objects blend only inside a volume around their intersection
+ * curves): a clean union UC outside it, Barthe's smooth blend UB inside, and
+ * their interpolation.
+ *  - LB_CLEAN_UR:  UR(f1, f2) = f1 + f2 + sqrt(f1^2 + f2^2) (Rvachev; C unused).
+ *  - LB_CLEAN_UC2: C + UR(f1 - C, f2 - C) / (2 - sqrt 2): exactly C on the
+ *    union surface max(f1, f2) = C, 0 at (0, 0).
+ *  - LB_CLEAN_UC3: max + w (UC2 - max), w the weight below.
+ *  - LB_CLEAN_UC:  max + w (V - max) with V = UC2 outside both objects,
+ *    C + sqrt((f1 - C)^2 + (f2 - C)^2) inside both, max elsewhere: no
+ *    contraction inside (UC(f, C) = f for f >= C).
+ * The weight w is 0 where u = f1 - alpha1 f2 <= 0 or v = f2 - alpha2 f1 <= 0,
+ * else (4 u v / (u + v)^2)^4; alpha (may be NULL: 0, 0, finite support, so
+ * UC = f1 where f2 = 0) takes each alpha_i in [0, 1) for fields of infinite
+ * support (convolution surfaces). UC and UC3 equal max(f1, f2) exactly on
+ * the union surface and wherever w = 0, and are C1 away from the union
+ * surface. */
+typedef enum lb_clean_kind {
+    LB_CLEAN_UR = 0,
+    LB_CLEAN_UC2 = 1,
+    LB_CLEAN_UC3 = 2,
+    LB_CLEAN_UC = 3
+} lb_clean_kind;
+
+/* Smallest iso value C accepted by the clean unions. */
+#define LB_SOFT_MIN_ISO 1e-100
+
+LB_API lb_status lb_clean_union(lb_clean_kind kind, const double f[2], double C,
+                                const double alpha[2], double *value, double grad[2],
+                                lb_error *err);
+
+/* Largest p, q accepted by Barthe's blend (the formula needs p, q < 1). */
+#define LB_BARTHE_MAX_PQ 0.999
+
+/* Barthe's smooth union UB(x, y) with 0 <= p, q <= LB_BARTHE_MAX_PQ: max(x, y)
+ * where y <= q x or x <= p y; between those lines the level u is the quarter
+ * ellipse ((x - p u)/(1 - p))^2 + ((y - q u)/(1 - q))^2 = u^2, tangent to
+ * x = u and y = u, evaluated in the rationalised closed form
+ * UB = D / (B + sqrt(B^2 - A D)). With q = v1 / C and p = v2 / C the blend
+ * leaves f1 = C where f2 = v1 and f2 = C where f1 = v2. Homogeneous of
+ * degree 1. grad (may be NULL) receives dUB/dx, dUB/dy. */
+LB_API lb_status lb_barthe_blend(const double x[2], double p, double q, double *value,
+                                 double grad[2], lb_error *err);
+
+/* The local blend's interpolation U = (1 - beta) uc + beta ub, beta = v^n,
+ * v in [0, 1] the blending volume's field, n in [1, 1000]: U = uc exactly
+ * where v = 0 and ub exactly where v = 1. grad (may be NULL) receives
+ * dU/duc, dU/dub, dU/dv. */
+LB_API lb_status lb_local_mix(double uc, double ub, double v, double n, double *value,
+                              double grad[3], lb_error *err);
+
 #ifdef __cplusplus
 }
 #endif
