@@ -96,9 +96,11 @@ def operator(r, soft, depth, defs):
         return primitive(r, soft)
     k = r.choice([1, 2, 2, 2, 3, 4])
     kind = r.choice(["soft_hyper", "soft_conic", "soft_sum", "ricci", "perlin", "min", "max",
-                     "complement"] if soft else
+                     "complement", "local_union", "clean_union"] if soft else
                     ["displacement", "displacement", "conic", "scale", "rfunction", "min", "max",
-                     "complement"])
+                     "complement", "local_union", "clean_union"])
+    if kind in ("local_union", "clean_union") and k < 2:
+        k = 2
     if kind in ("conic", "soft_conic", "rfunction"):
         k = 2
     if kind == "complement":
@@ -125,6 +127,13 @@ def operator(r, soft, depth, defs):
     elif kind == "soft_conic":
         n.update(op=r.choice(["union", "intersection", "difference"]), r=per_arg(r, 2, 0.05, 0.9),
                  m=per_arg(r, 2, 0.3, 1.5))
+    elif kind == "local_union":
+        if r.random() < 0.3:
+            n["support"] = "feature"
+        if r.random() < 0.3:
+            n["exponent"] = round(r.uniform(1, 4), 3)
+        if r.random() < 0.2:
+            n["alpha"] = [round(r.uniform(0, 0.5), 3), round(r.uniform(0, 0.5), 3)]
     elif kind == "ricci":
         n["n"] = round(r.uniform(1, 8), 3)
     elif kind == "perlin":

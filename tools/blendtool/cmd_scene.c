@@ -96,6 +96,15 @@ static int run_info(int argc, char **argv) {
         goto done;
     }
     lb_scene_describe(sc, tree, tlen + 1);
+    const size_t llen = lb_evaluator_describe_local(ev, NULL, 0);
+    char *curves = malloc(llen + 1);
+    if (!curves) {
+        free(tree);
+        bt_error(cmd, "out of memory");
+        rc = BT_EXIT_INTERNAL;
+        goto done;
+    }
+    lb_evaluator_describe_local(ev, curves, llen + 1);
     if (json) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "file", path);
@@ -114,6 +123,7 @@ static int run_info(int argc, char **argv) {
         cJSON_AddNumberToObject(o, "instructions", (double)lb_evaluator_size(ev));
         cJSON_AddNumberToObject(o, "cost_per_point", lb_evaluator_cost(ev));
         cJSON_AddStringToObject(o, "tree", tree);
+        cJSON_AddStringToObject(o, "local_blends", curves);
         char *txt = o ? cJSON_Print(o) : NULL;
         cJSON_Delete(o);
         if (!txt) {
@@ -135,8 +145,10 @@ static int run_info(int argc, char **argv) {
         printf("instructions: %zu\ncost: %.0f instruction runs per point (at most %d x the "
                "instructions)\ntree:\n%s",
                lb_evaluator_size(ev), lb_evaluator_cost(ev), LB_SCENE_MAX_COST_FACTOR, tree);
+        if (llen) printf("local blends:\n%s", curves);
     }
     free(tree);
+    free(curves);
 done:
     lb_evaluator_free(ev);
     lb_scene_free(sc);

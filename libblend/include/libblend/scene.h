@@ -138,6 +138,11 @@ LB_API size_t lb_evaluator_size(const lb_evaluator *ev);
  * lb_evaluator_size, at most LB_SCENE_MAX_COST_FACTOR times it. 0 for NULL. */
 LB_API double lb_evaluator_cost(const lb_evaluator *ev);
 
+/* The intersection curves and blending volumes of the local_union nodes,
+ * as text (one line per node, one per curve: vertices, length, diameter,
+ * R, v1, v2, d1, d2), into buf like lb_scene_describe. */
+LB_API size_t lb_evaluator_describe_local(const lb_evaluator *ev, char *buf, size_t size);
+
 /* Values and gradients at n points given as three coordinate arrays
  * (structure of arrays). value must be non-NULL; gx, gy, gz may each be NULL.
  * threads: 0 = one per online CPU, 1 = only the calling thread, N = at most

@@ -210,7 +210,8 @@ static lb_status charge(cctx *c, uint32_t idx) {
     lb_evaluator *ev = c->ev;
     lb__instr *in = &ev->ins[idx];
     in->cost = 1.0;
-    if (in->code == LB__I_OP && in->op.bulge) {
+    const int local = in->code == LB__I_OP && in->op.family == LB__F_LOCAL;
+    if (in->code == LB__I_OP && (in->op.bulge || local)) {
         size_t len = 0, cap = 0;
         uint32_t *list = NULL;
         double w[2] = {0.0, 0.0};
@@ -225,7 +226,8 @@ static lb_status charge(cctx *c, uint32_t idx) {
         }
         in = &ev->ins[idx];
         in->cone = list;
-        in->cost += 2.0 * (w[0] + w[1]);
+        /* a local blend runs its cones at compile time only */
+        if (!local) in->cost += 2.0 * (w[0] + w[1]);
     }
     if (in->cost > ev->ins[c->costliest].cost) c->costliest = idx;
     ev->cost += in->cost;
@@ -385,6 +387,7 @@ void lb_evaluator_free(lb_evaluator *ev) {
         free(in->srci);
         free(in->srcb);
         free(in->cone);
+        lb__curves_free(in->curves);
         free(in->op.r);
         free(in->op.p);
         free(in->op.m);
@@ -420,6 +423,7 @@ lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_erro
     free(c.mark);
     free(c.stack);
     if (!s) s = allocate_registers(ev, root, err);
+    if (!s) s = lb__local_prepare(ev, scene, err);
     if (s) {
         lb_evaluator_free(ev);
         return s;

@@ -339,6 +339,9 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
                 const uint16_t na = cull(&in->op, x, act);
                 if (plan) plan->nact[i] = na;
                 fast_bounds(in, x, act, na, &o);
+            } else if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN) {
+                lb__local_bounds(ev, in, x, bc, br, &o);
+                if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
             } else {
                 op_bounds(ev->conv, &in->op, x, c, &o);
                 if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
@@ -415,7 +418,34 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
             for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
             if (in->op.family == LB__F_BOUNDED)
                 for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
-            op_bounds(ev->conv, &in->op, x, c, &o);
+            if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN)
+                lb__local_bounds(ev, in, x, bc, br, &o);
+            else
+                op_bounds(ev->conv, &in->op, x, c, &o);
+        }
+        o.lo = clampd(o.lo);
+        o.hi = clampd(o.hi);
+        R[in->dst] = o;
+    }
+}
+
+void lb__bounds_pass_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist,
+                          const double bc[3], const double br[3], iv *R) {
+    iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
+    for (size_t q = 0; q < nlist; ++q) {
+        const lb__instr *in = &ev->ins[list[q]];
+        iv o;
+        if (in->code != LB__I_OP) {
+            prim_bounds(in, bc, br, &o);
+        } else {
+            const size_t k = in->op.k;
+            for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
+            if (in->op.family == LB__F_BOUNDED)
+                for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
+            if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN)
+                lb__local_bounds(ev, in, x, bc, br, &o);
+            else
+                op_bounds(ev->conv, &in->op, x, c, &o);
         }
         o.lo = clampd(o.lo);
         o.hi = clampd(o.hi);

@@ -236,6 +236,8 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
                         const double *px, const double *py, const double *pz, double *regs,
                         size_t *count, lb_error *err) {
     const lb__node *nd = &in->op;
+    if (nd->family == LB__F_LOCAL || nd->family == LB__F_CLEAN)
+        return lb__local_run(ev, in, n, px, py, pz, regs, err);
     const size_t kf = nd->k;
     const int bounded = nd->family == LB__F_BOUNDED;
     /* the active arguments: all, or those the plan kept (fast kernels only) */
@@ -422,6 +424,12 @@ static lb_status run_list(const lb_evaluator *ev, const lb__plan *plan, const ui
         }
     }
     return LB_OK;
+}
+
+lb_status lb__tape_run_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist, size_t n,
+                            const double *x, const double *y, const double *z, double *regs,
+                            lb_error *err) {
+    return nlist ? run_list(ev, NULL, list, nlist - 1, n, x, y, z, regs, NULL, err) : LB_OK;
 }
 
 lb_status lb__tape_run_counted(const lb_evaluator *ev, size_t n, const double *x, const double *y,

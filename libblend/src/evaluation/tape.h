@@ -37,15 +37,16 @@ typedef struct lb__instr {
     uint32_t *src;  /* k argument registers, then k bounding registers (bounded) */
     uint32_t *srci; /* k argument instruction indices (bulge: prefix re-evaluation) */
     uint32_t *srcb; /* k bounding-solid instruction indices (bounded), else NULL */
-    uint32_t *cone; /* bulge: the instructions each argument depends on, in tape order,
+    uint32_t *cone; /* bulge, local_union: the instructions each argument depends on, in tape order,
                        argument 0's ncone[0] then argument 1's ncone[1] (re-run for the
                        Hessian terms) */
     uint32_t ncone[2];
-    double cost; /* instruction runs per point, reruns included (the cost model) */
-    int fast;    /* LB__FAST_* */
-    int mode;    /* exponent mode for the fast kernels */
-    double lip;  /* primitives: Lipschitz factor of rho in the primitive frame */
-    size_t aoff; /* operators: offset of this instruction's slots in a plan's act */
+    double cost;               /* instruction runs per point, reruns included (the cost model) */
+    struct lb__curves *curves; /* local_union: intersection curves, blending volumes */
+    int fast;                  /* LB__FAST_* */
+    int mode;                  /* exponent mode for the fast kernels */
+    double lip;                /* primitives: Lipschitz factor of rho in the primitive frame */
+    size_t aoff;               /* operators: offset of this instruction's slots in a plan's act */
 } lb__instr;
 
 enum { LB__FAST_NONE = 0, LB__FAST_DISPLACEMENT, LB__FAST_CONIC, LB__FAST_SCALE, LB__FAST_MINMAX };
@@ -86,6 +87,57 @@ LB_INTERNAL void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], con
  * instructions and blend arguments the parent kept (eval_bounds.c). */
 LB_INTERNAL void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent,
                                      const double bc[3], const double br[3], lb__iv *R);
+
+/* Run instructions list[0..nlist) (tape order, no culling) on n <= LB__CHUNK
+ * points into regs: one argument's cone, at compile time (local.c). */
+LB_INTERNAL lb_status lb__tape_run_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist,
+                                        size_t n, const double *x, const double *y, const double *z,
+                                        double *regs, lb_error *err);
+/* The interval pass over instructions list[0..nlist) only (R as above). */
+LB_INTERNAL void lb__bounds_pass_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist,
+                                      const double bc[3], const double br[3], lb__iv *R);
+
+/* One intersection component and its blending volume (local.c). */
+typedef struct lb__component {
+    size_t first, count; /* vertices [first, first + count) */
+    int closed;
+    double length, diameter, R, v1, v2, d1, d2, p, q;
+} lb__component;
+
+typedef struct bvh_node {
+    double lo[3], hi[3];
+    uint32_t left, right; /* children, or (first, count) of segments when leaf */
+    int leaf;
+} bvh_node;
+
+struct lb__curves {
+    size_t nv, ncomp, nseg, nnodes;
+    double *pts; /* 3 per vertex */
+    lb__component *comp;
+    uint32_t *seg;  /* 2 vertex indices per segment */
+    uint32_t *segc; /* component of each segment */
+    bvh_node *bvh;
+    double rmax; /* largest R */
+    double scene_size;
+};
+
+/* The n-th local_union instruction's curves, in tape order (tests). */
+LB_INTERNAL const struct lb__curves *lb__local_nth(const lb_evaluator *ev, size_t which);
+
+/* ---- local blending (local.c) ----
+ * After registers are assigned, every local_union instruction gets its
+ * children's intersection curves (octree by intervals, segments exact on
+ * each tetrahedron's linear pieces, chained, refined onto both surfaces),
+ * the blending volumes' parameters and a bounding-volume hierarchy. */
+LB_INTERNAL lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, lb_error *err);
+LB_INTERNAL void lb__curves_free(struct lb__curves *c);
+/* Values and gradients of a local_union or clean_union over a chunk. */
+LB_INTERNAL lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n,
+                                    const double *x, const double *y, const double *z, double *regs,
+                                    lb_error *err);
+/* An interval containing the node over the box, from its children's. */
+LB_INTERNAL void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv x[2],
+                                  const double bc[3], const double br[3], lb__iv *out);
 
 /* lb_evaluator_bounds without its coordinate limit: the mesher's closing
  * layer lies half a cell beyond a region that may reach the limit. */

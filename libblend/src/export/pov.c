@@ -106,6 +106,11 @@ static lb_status emit(pctx *c, const lb__node *n, int *out) {
      * step); these three are limited to the include's 16 */
     const int k16 =
         n->family == LB__F_SCALE || n->family == LB__F_BOUNDED || n->family == LB__F_SOFT_HYPER;
+    if (n->family == LB__F_LOCAL || n->family == LB__F_CLEAN)
+        return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: %s: %s has no POV-Ray form yet; allowed in POV-Ray: the other "
+                        "blends (mesh the scene with blendtool mesh instead)",
+                        FN, n->path, n->type);
     if (k16 && n->k > LB_POV_MAX_ARITY)
         return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
                         "%s: %s: a %s blend of %zu arguments; allowed in POV-Ray: at most %d "

@@ -2,6 +2,32 @@
  * the single place that maps a scene node to the core operator it names. */
 #include "scene_internal.h"
 
+void lb__local_in(const lb__node *n, lb_convention conv, const double f[2], double g[2]) {
+    const double s = n->lp.zero_scale;
+    for (int i = 0; i < 2; ++i)
+        g[i] = conv == LB_CONVENTION_ZERO ? LB__LOCAL_ISO * (1.0 - f[i] / s) : f[i];
+}
+
+double lb__local_out(const lb__node *n, lb_convention conv, double u) {
+    if (conv == LB_CONVENTION_ZERO) return n->lp.zero_scale * (1.0 - u / LB__LOCAL_ISO);
+    /* UC2(0, 0) = 0 rounds to about -1e-17: soft fields stay >= 0 */
+    return u > 0.0 ? u : 0.0;
+}
+
+lb_status lb__clean_apply(const lb__node *n, lb_convention conv, const double *x, double *value,
+                          double *dx, lb_error *err) {
+    double g[2], u = 0.0, gu[2];
+    lb__local_in(n, conv, x, g);
+    const lb_status s = lb_clean_union(LB_CLEAN_UC, g, LB__LOCAL_ISO, n->lp.alpha, &u, gu, err);
+    if (s) return s;
+    *value = lb__local_out(n, conv, u);
+    if (dx) { /* zero: the scalings -C/s in and -s/C out cancel */
+        dx[0] = gu[0];
+        dx[1] = gu[1];
+    }
+    return LB_OK;
+}
+
 lb_status lb__node_apply(const lb__node *n, lb_convention conv, const double *x, const double *c,
                          const double *g, double *value, double *dx, double *dc, double *dg,
                          lb_error *err) {
@@ -63,6 +89,9 @@ lb_status lb__node_apply(const lb__node *n, lb_convention conv, const double *x,
         *value = conv == LB_CONVENTION_ZERO ? -x[0] : 1.0 - x[0];
         if (dx) dx[0] = -1.0;
         return LB_OK;
+    case LB__F_LOCAL: /* without its curves (the compiled evaluator has them): UC */
+    case LB__F_CLEAN:
+        return lb__clean_apply(n, conv, x, value, dx, err);
     case LB__F_GROUP:
         *value = x[0];
         if (dx) dx[0] = 1.0;

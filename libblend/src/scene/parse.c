@@ -365,6 +365,10 @@ static const char *const k_soft[] = {"type", "op", "args", "r", "p", "m", TRANSF
 static const char *const k_args[] = {"type", "args", TRANSFORM_KEYS, NULL};
 static const char *const k_opargs[] = {"type", "op", "args", TRANSFORM_KEYS, NULL};
 static const char *const k_ricci[] = {"type", "args", "n", TRANSFORM_KEYS, NULL};
+static const char *const k_local[] = {"type",   "args",       "feature_size",   "limits",
+                                      "radius", "support",    "support_factor", "exponent",
+                                      "alpha",  "zero_scale", TRANSFORM_KEYS,   NULL};
+static const char *const k_clean[] = {"type", "args", "alpha", "zero_scale", TRANSFORM_KEYS, NULL};
 
 enum { CONV_ZERO = 1, CONV_SOFT = 2, CONV_BOTH = 3 };
 
@@ -391,13 +395,15 @@ static const type_info TYPES[] = {
     {"ricci", LB__F_RICCI, 0, CONV_SOFT, 0, 1, LB_MAX_ARITY, k_ricci},
     {"perlin", LB__F_PERLIN, 0, CONV_SOFT, 1, 1, LB_MAX_ARITY, k_opargs},
     {"complement", LB__F_COMPLEMENT, 0, CONV_BOTH, 0, 1, 1, k_args},
+    {"local_union", LB__F_LOCAL, 0, CONV_BOTH, 0, 2, LB_MAX_ARITY, k_local},
+    {"clean_union", LB__F_CLEAN, 0, CONV_BOTH, 0, 2, LB_MAX_ARITY, k_clean},
 };
 #define NTYPES (sizeof TYPES / sizeof TYPES[0])
 
 static const char TYPE_LIST[] =
     "sphere, ellipsoid, lp, superquadric, slab, halfspace, cylinder, capsule, torus, "
     "displacement, conic, scale, bounded, soft_hyper, soft_conic, min, max, rfunction, "
-    "soft_sum, ricci, perlin, complement (or {\"ref\": NAME})";
+    "soft_sum, ricci, perlin, complement, local_union, clean_union (or {\"ref\": NAME})";
 
 /* ---- primitives ---- */
 
@@ -645,6 +651,96 @@ static lb_status parse_op(pctx *c, const cJSON *j, const type_info *t, lb_setop 
     return s;
 }
 
+/* local_union / clean_union parameters, with their defaults */
+static lb_status parse_local(pctx *c, const cJSON *j, lb__node *n) {
+    lb__local_params *L = &n->lp;
+    memset(L, 0, sizeof *L);
+    L->support = 0.25;
+    L->exponent = 2.0;
+    L->zero_scale = 1.0;
+    lb_status s;
+    double *v = NULL;
+    if ((s = get_param(c, j, "alpha", 2, 0, 1, 0.0, 0.0, 0.999,
+                       "0 <= alpha <= 0.999 (0: fields of finite support)", &v)))
+        return s;
+    L->alpha[0] = v[0];
+    L->alpha[1] = v[1];
+    free(v);
+    v = NULL;
+    if ((s = get_number(c, j, "zero_scale", 0, 1e-9, 1e9,
+                        "1e-9 <= zero_scale <= 1e9 (scene units: g = 0.5 (1 - f / zero_scale))",
+                        &L->zero_scale)))
+        return s;
+    if (n->family == LB__F_CLEAN) return LB_OK;
+    if ((s = get_param(c, j, "feature_size", 2, 0, 0, 0.0, 1e-9, 1e9,
+                       "1e-9 <= value <= 1e9 (half the radius of the smallest feature to keep)",
+                       &v)))
+        return s;
+    if (v) {
+        L->has_feature = 1;
+        L->feature[0] = v[0];
+        L->feature[1] = v[1];
+        free(v);
+        v = NULL;
+    }
+    if ((s = get_param(c, j, "limits", 2, 0, 0, 0.0, 0.0, 0.4995,
+                       "0 <= value <= 0.4995 (field values below the iso value 0.5)", &v)))
+        return s;
+    if (v) {
+        L->has_limits = 1;
+        L->limits[0] = v[0];
+        L->limits[1] = v[1];
+        free(v);
+    }
+    const char *mode = NULL;
+    if ((s = get_number(c, j, "radius", 0, 1e-9, 1e9, "1e-9 <= radius <= 1e9 (scene units)",
+                        &L->radius)) ||
+        (s = get_number(c, j, "support_factor", 0, 1e-3, 100.0, "1e-3 <= value <= 100",
+                        &L->support)) ||
+        (s = get_number(c, j, "exponent", 0, 1.0, 1000.0, "1 <= exponent <= 1000", &L->exponent)) ||
+        (s = get_string(c, j, "support", 0, "\"progressive\" or \"feature\"", &mode)))
+        return s;
+    if (mode && strcmp(mode, "progressive") != 0) {
+        if (strcmp(mode, "feature") != 0) {
+            const size_t old = push_key(c, "support");
+            s = perr(c, LB_ERR_INVALID_ARGUMENT,
+                     "\"%.40s\"; allowed: \"progressive\" (R = support_factor x the curve's "
+                     "diameter) or \"feature\" (R = 2 min(d1, d2))",
+                     mode);
+            pop(c, old);
+            return s;
+        }
+        L->feature_support = 1;
+    }
+    return LB_OK;
+}
+
+/* A k-ary local or clean union is a left fold of binary ones (order
+ * matters): n keeps (fold of the first k - 1, last). */
+static lb_status fold_local(pctx *c, lb__node *n) {
+    lb__node *acc = n->args[0];
+    for (size_t i = 1; i + 1 < n->k; ++i) {
+        lb__node *m = new_node(c, n->family, n->type);
+        if (!m) return oom(c);
+        m->lp = n->lp;
+        m->k = 2;
+        m->args = malloc(2 * sizeof *m->args);
+        if (!m->args) return oom(c);
+        m->args[0] = acc;
+        m->args[1] = n->args[i];
+        for (int a = 0; a < 2; ++a) {
+            if (m->args[a]->depth + 1 > m->depth) m->depth = m->args[a]->depth + 1;
+            if (m->args[a]->bulge_depth > m->bulge_depth) m->bulge_depth = m->args[a]->bulge_depth;
+            m->walk_cost += m->args[a]->walk_cost;
+        }
+        acc = m;
+    }
+    n->args[0] = acc;
+    n->args[1] = n->args[n->k - 1];
+    n->k = 2;
+    return LB_OK;
+}
+
 static lb_status parse_bulge(pctx *c, const cJSON *j, lb__node *n) {
     const cJSON *b = cJSON_GetObjectItemCaseSensitive(j, "bulge");
     if (!b) return LB_OK;
@@ -770,9 +866,10 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
                  "%s",
                  t->name, t->conv == CONV_ZERO ? "zero" : "soft",
                  conv_bit == CONV_ZERO ? "zero" : "soft",
-                 conv_bit == CONV_ZERO
-                     ? "displacement, conic, scale, bounded, rfunction, min, max, complement"
-                     : "soft_hyper, soft_conic, soft_sum, ricci, perlin, min, max, complement");
+                 conv_bit == CONV_ZERO ? "displacement, conic, scale, bounded, rfunction, min, "
+                                         "max, complement, local_union, clean_union"
+                                       : "soft_hyper, soft_conic, soft_sum, ricci, perlin, min, "
+                                         "max, complement, local_union, clean_union");
         pop(c, old);
         return s;
     }
@@ -881,6 +978,11 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
         }
         break;
     }
+    case LB__F_LOCAL:
+    case LB__F_CLEAN:
+        if ((s = parse_local(c, j, n))) return s;
+        if (k > 2 && (s = fold_local(c, n))) return s;
+        break;
     case LB__F_RICCI:
         n->shape = 2.0;
         if ((s = get_number(c, j, "n", 1, 1.0, 1000.0, "1 <= n <= 1000", &n->shape))) return s;

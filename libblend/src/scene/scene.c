@@ -246,6 +246,13 @@ lb_status lb_scene_eval_reference(const lb_scene *s, const double X[3], double *
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "lb_scene_eval_reference: X[%d] = %g; allowed: |X| <= %g", i, X[i],
                             LB_SCENE_MAX_COORD);
+    for (size_t i = 0; i < s->nnodes; ++i)
+        if (s->nodes[i]->family == LB__F_LOCAL)
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "lb_scene_eval_reference: %s: a local_union needs its intersection "
+                            "curves, which the compiled evaluator finds; allowed: scenes without "
+                            "local_union (use lb_evaluator_eval)",
+                            s->nodes[i]->path);
     if (s->root->walk_cost > LB_SCENE_MAX_COST)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "lb_scene_eval_reference: the plain walk would visit %.3g nodes per "

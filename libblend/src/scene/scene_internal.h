@@ -24,6 +24,8 @@ typedef enum lb__family {
     LB__F_PERLIN,       /* Perlin union / intersection / difference, soft */
     LB__F_COMPLEMENT,   /* -f (zero) or 1 - f (soft), one arg */
     LB__F_GROUP,        /* a transform applied to one arg (a transformed ref) */
+    LB__F_LOCAL,        /* local blend around the intersection curves, binary, both */
+    LB__F_CLEAN,        /* clean union UC, binary, both */
     LB__F_COUNT
 } lb__family;
 
@@ -32,6 +34,20 @@ typedef struct lb__affine {
     double M[9];
     double t[3];
 } lb__affine;
+
+/* local_union / clean_union parameters (docs/scene-format.md) */
+typedef struct lb__local_params {
+    int has_feature;
+    double feature[2]; /* feature sizes d_i (user), else from the curvature */
+    int has_limits;
+    double limits[2];    /* v1, v2 (user), else by stepping off the curve */
+    double radius;       /* blending volume support R (user), 0 = automatic */
+    int feature_support; /* R = 2 min(d1, d2) instead of the progressive rule */
+    double support;      /* progressive: R = support x the curve's diameter */
+    double exponent;     /* n in beta = v^n */
+    double alpha[2];     /* convolution weights of the clean union */
+    double zero_scale;   /* zero convention: g = C (1 - f / zero_scale) */
+} lb__local_params;
 
 typedef struct lb__node lb__node;
 struct lb__node {
@@ -49,11 +65,12 @@ struct lb__node {
     int has_transform;
     lb__affine to_local; /* parent coordinates -> this node's coordinates */
     lb__affine to_parent;
-    char *path;         /* JSON path of the node, for messages */
-    char *def_name;     /* name when the node is a def, else NULL */
-    size_t depth;       /* height: 1 for a leaf */
-    size_t bulge_depth; /* bulge nodes on the longest path down (4 re-evaluations each) */
-    double walk_cost;   /* nodes the reference walk visits per point (shared nodes per use) */
+    char *path;          /* JSON path of the node, for messages */
+    char *def_name;      /* name when the node is a def, else NULL */
+    size_t depth;        /* height: 1 for a leaf */
+    size_t bulge_depth;  /* bulge nodes on the longest path down (4 re-evaluations each) */
+    double walk_cost;    /* nodes the reference walk visits per point (shared nodes per use) */
+    lb__local_params lp; /* LB__F_LOCAL, LB__F_CLEAN */
 };
 
 struct lb_scene {
@@ -82,5 +99,15 @@ LB_INTERNAL int lb__affine_is_identity(const lb__affine *a);
 LB_INTERNAL lb_status lb__node_apply(const lb__node *n, lb_convention conv, const double *x,
                                      const double *c, const double *g, double *value, double *dx,
                                      double *dc, double *dg, lb_error *err);
+
+/* local_union / clean_union (scene/apply.c): children in the soft form the
+ * operators take (zero convention: g = C (1 - f / zero_scale), C = 0.5),
+ * and the result back in the scene's convention; the clean union alone. */
+#define LB__LOCAL_ISO 0.5
+LB_INTERNAL void lb__local_in(const lb__node *n, lb_convention conv, const double f[2],
+                              double g[2]);
+LB_INTERNAL double lb__local_out(const lb__node *n, lb_convention conv, double u);
+LB_INTERNAL lb_status lb__clean_apply(const lb__node *n, lb_convention conv, const double *x,
+                                      double *value, double *dx, lb_error *err);
 
 #endif

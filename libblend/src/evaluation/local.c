@@ -1,0 +1,1031 @@
+/* Local blending (Bernhardt, Barthe, Cani, Wyvill 2010): a local_union
+ * blends its two children only inside blending volumes around the curves
+ * where their surfaces intersect; everywhere else it is the clean union UC.
+ *
+ * At compile time (lb__local_prepare, per instruction, in world space):
+ * 1. cells: an octree over the scene's bounds, 64 cells along the longest
+ *    side, keeps the cells where both children's interval bounds contain
+ *    the iso value C (lb__bounds_pass_list over each child's cone);
+ * 2. segments: each kept cell is split into the six Kuhn tetrahedra the
+ *    mesher uses; on a tetrahedron both children are linear, so their
+ *    surfaces meet in a segment whose ends lie on two of its faces. A face's
+ *    point is computed from the face's three nodes in a canonical order, so
+ *    the tetrahedra sharing a face share the point exactly;
+ * 3. chains: segments sharing a face point are chained into polylines, one
+ *    per intersection component (closed, or open where the region cuts);
+ * 4. refinement: every vertex is moved onto both surfaces by the
+ *    simultaneous Newton step p += a grad g1 + b grad g2 (the 2x2 Gram
+ *    system) until |g_i - C| / |grad g_i| <= 1e-10 of the scene size; a
+ *    segment whose projected midpoint strays more than 1e-5 of the scene
+ *    size from the chord gets that point inserted (4 passes at most);
+ * 5. parameters per component: feature sizes d_i (user, else half the
+ *    local radius of curvature 2 / |div n_i| averaged over the vertices,
+ *    capped at the scene size), limits v1 = g2(P - d1 n2), v2 = g1(P - d2 n1)
+ *    averaged (user values override), the support R (user; else
+ *    support_factor x the curve's diameter, or 2 min(d1, d2));
+ * 6. a bounding-volume hierarchy over all segments.
+ * At a point: v = W(d / R) (Wyvill's kernel of the distance to the nearest
+ * curve, the component with the smallest d / R), UC and UB = Barthe's blend
+ * with q = v1 / C, p = v2 / C, and U = (1 - v^n) UC + v^n UB. Outside every
+ * volume U = UC exactly. */
+#include "tape.h"
+
+#include <float.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GRID 64           /* cells along the longest side of the region */
+#define REFINE_STEPS 40   /* Newton steps at most per vertex */
+#define ON_SURFACE 1e-10  /* of the scene size */
+#define MIDPOINT_TOL 1e-5 /* of the scene size */
+#define SUBDIVIDE_PASSES 4
+
+void lb__curves_free(struct lb__curves *c) {
+    if (!c) return;
+    free(c->pts);
+    free(c->comp);
+    free(c->seg);
+    free(c->segc);
+    free(c->bvh);
+    free(c);
+}
+
+/* ---- child evaluation at compile time ---- */
+
+typedef struct child_eval {
+    const lb_evaluator *ev;
+    const lb__instr *in;
+    double *regs;
+    lb_error *err;
+} child_eval;
+
+/* g (soft form) of both children and their gradients at n points */
+static lb_status children_at(child_eval *E, size_t n, const double *x, const double *y,
+                             const double *z, double *g, double *grad) {
+    const lb__instr *in = E->in;
+    for (size_t s = 0; s < n; s += LB__CHUNK) {
+        const size_t m = n - s < LB__CHUNK ? n - s : LB__CHUNK;
+        for (int a = 0; a < 2; ++a) {
+            const uint32_t *cone = in->cone + (a ? in->ncone[0] : 0);
+            lb_status st = lb__tape_run_list(E->ev, cone, in->ncone[a], m, x + s, y + s, z + s,
+                                             E->regs, E->err);
+            if (st) return st;
+            const uint32_t r = in->src[a];
+            const double k =
+                E->ev->conv == LB_CONVENTION_ZERO ? -LB__LOCAL_ISO / in->op.lp.zero_scale : 1.0;
+            for (size_t j = 0; j < m; ++j) {
+                const double f = lb__reg(E->regs, r, 0)[j];
+                double fv[2] = {f, f}, gv[2];
+                lb__local_in(&in->op, E->ev->conv, fv, gv);
+                g[2 * (s + j) + a] = gv[0];
+                if (grad)
+                    for (int d = 0; d < 3; ++d)
+                        grad[6 * (s + j) + 3 * a + d] = k * lb__reg(E->regs, r, 1 + d)[j];
+            }
+        }
+    }
+    return LB_OK;
+}
+
+/* ---- hash map of 64-bit keys (node ids, face triples) ---- */
+
+typedef struct hmap {
+    uint64_t *k1, *k2; /* a face is (k1, k2) = packed sorted node ids */
+    uint32_t *val;
+    size_t cap, n;
+} hmap;
+
+static uint64_t mix64(uint64_t a, uint64_t b) {
+    uint64_t h = a * 0x9E3779B97F4A7C15ull ^ (b + 0x632BE59BD9B4E019ull + (a << 6) + (a >> 2));
+    h ^= h >> 31;
+    h *= 0xBF58476D1CE4E5B9ull;
+    return h ^ (h >> 29);
+}
+
+static int hmap_init(hmap *m, size_t want) {
+    m->cap = 64;
+    while (m->cap < 2 * want) m->cap *= 2;
+    m->n = 0;
+    m->k1 = malloc(m->cap * sizeof *m->k1);
+    m->k2 = malloc(m->cap * sizeof *m->k2);
+    m->val = malloc(m->cap * sizeof *m->val);
+    if (!m->k1 || !m->k2 || !m->val) return -1;
+    for (size_t i = 0; i < m->cap; ++i) m->val[i] = UINT32_MAX;
+    return 0;
+}
+
+static void hmap_free(hmap *m) {
+    free(m->k1);
+    free(m->k2);
+    free(m->val);
+}
+
+/* slot of (a, b): found (val != UINT32_MAX) or empty */
+static size_t hmap_slot(const hmap *m, uint64_t a, uint64_t b) {
+    size_t i = (size_t)mix64(a, b) & (m->cap - 1);
+    while (m->val[i] != UINT32_MAX && (m->k1[i] != a || m->k2[i] != b)) i = (i + 1) & (m->cap - 1);
+    return i;
+}
+
+/* ---- step 1: cells ---- */
+
+typedef struct grid {
+    double origin[3], h;
+    uint32_t cells[3];
+} grid;
+
+typedef struct cellset {
+    uint32_t *c; /* 3 per cell */
+    size_t n, cap;
+} cellset;
+
+static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], const uint32_t hi[3],
+                        lb__iv *R, cellset *S) {
+    double bmin[3], bmax[3], bc[3], br[3];
+    for (int d = 0; d < 3; ++d) {
+        bmin[d] = G->origin[d] + G->h * lo[d];
+        bmax[d] = G->origin[d] + G->h * hi[d];
+    }
+    lb__box_centre(bmin, bmax, bc, br);
+    const lb__instr *in = E->in;
+    for (int a = 0; a < 2; ++a) {
+        lb__bounds_pass_list(E->ev, in->cone + (a ? in->ncone[0] : 0), in->ncone[a], bc, br, R);
+        const lb__iv f = R[in->src[a]];
+        double fl[2] = {f.lo, f.hi}, gl[2];
+        lb__local_in(&in->op, E->ev->conv, fl, gl);
+        const double glo = gl[0] < gl[1] ? gl[0] : gl[1], ghi = gl[0] < gl[1] ? gl[1] : gl[0];
+        if (!(glo <= LB__LOCAL_ISO && ghi >= LB__LOCAL_ISO)) return LB_OK;
+    }
+    int axis = -1;
+    uint32_t span = 1;
+    for (int d = 0; d < 3; ++d)
+        if (hi[d] - lo[d] > span) {
+            span = hi[d] - lo[d];
+            axis = d;
+        }
+    if (axis < 0) {
+        if (S->n == S->cap) {
+            const size_t nc = S->cap ? 2 * S->cap : 256;
+            uint32_t *q = realloc(S->c, 3 * nc * sizeof *q);
+            if (!q) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+            S->c = q;
+            S->cap = nc;
+        }
+        memcpy(S->c + 3 * S->n++, lo, 3 * sizeof *lo);
+        return LB_OK;
+    }
+    uint32_t mid[3], lo2[3];
+    memcpy(mid, hi, sizeof mid);
+    memcpy(lo2, lo, sizeof lo2);
+    mid[axis] = lo[axis] + span / 2;
+    lo2[axis] = mid[axis];
+    lb_status s = octree(E, G, lo, mid, R, S);
+    return s ? s : octree(E, G, lo2, hi, R, S);
+}
+
+/* ---- step 2: segments on the Kuhn tetrahedra ---- */
+
+static uint64_t node_id(const grid *G, uint32_t i, uint32_t j, uint32_t k) {
+    return (uint64_t)i +
+           (uint64_t)(G->cells[0] + 1) * ((uint64_t)j + (uint64_t)(G->cells[1] + 1) * k);
+}
+
+static void node_pos(const grid *G, uint64_t id, double p[3]) {
+    const uint64_t nx = G->cells[0] + 1, ny = G->cells[1] + 1;
+    p[0] = G->origin[0] + G->h * (double)(id % nx);
+    p[1] = G->origin[1] + G->h * (double)(id / nx % ny);
+    p[2] = G->origin[2] + G->h * (double)(id / nx / ny);
+}
+
+/* the six tetrahedra of a cell: corner bit paths 0 -> e_a -> e_a + e_b -> 7 */
+static const int KUHN[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
+                               {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+
+typedef struct builder {
+    const grid *G;
+    hmap nodes;   /* node id -> index into nv (values) */
+    double *nval; /* 2 per node: g1 - C, g2 - C */
+    hmap faces;   /* face -> index into fpts */
+    double *fpts; /* 3 per face point */
+    size_t nf, fcap;
+    uint32_t *seg; /* 2 face indices per segment */
+    size_t ns, scap;
+} builder;
+
+static int face_point(builder *B, const uint64_t v[3], uint32_t *out) {
+    uint64_t s[3] = {v[0], v[1], v[2]};
+    for (int a = 0; a < 2; ++a) /* sort the three ids: the face's canonical order */
+        for (int b = 0; b < 2 - a; ++b)
+            if (s[b] > s[b + 1]) {
+                const uint64_t t = s[b];
+                s[b] = s[b + 1];
+                s[b + 1] = t;
+            }
+    /* node ids are below 65^3 < 2^21: three fit in one word */
+    const uint64_t k1 = s[0] | s[1] << 21 | s[2] << 42, k2 = 1;
+    size_t slot = hmap_slot(&B->faces, k1, k2);
+    if (B->faces.val[slot] != UINT32_MAX) {
+        *out = B->faces.val[slot];
+        return *out != UINT32_MAX - 1;
+    }
+    double h1[3], h2[3], P[3][3];
+    for (int i = 0; i < 3; ++i) {
+        const size_t ni = B->nodes.val[hmap_slot(&B->nodes, s[i], 0)];
+        h1[i] = B->nval[2 * ni];
+        h2[i] = B->nval[2 * ni + 1];
+        node_pos(B->G, s[i], P[i]);
+    }
+    /* barycentric weights where both linear functions vanish: h1 x h2 */
+    const double l[3] = {h1[1] * h2[2] - h1[2] * h2[1], h1[2] * h2[0] - h1[0] * h2[2],
+                         h1[0] * h2[1] - h1[1] * h2[0]};
+    const int pos = l[0] > 0.0 && l[1] > 0.0 && l[2] > 0.0;
+    const int neg = l[0] < 0.0 && l[1] < 0.0 && l[2] < 0.0;
+    B->faces.k1[slot] = k1;
+    B->faces.k2[slot] = k2;
+    B->faces.n++;
+    if (!pos && !neg) {
+        B->faces.val[slot] = UINT32_MAX - 1; /* no point on this face */
+        return 0;
+    }
+    if (B->nf == B->fcap) {
+        const size_t nc = B->fcap ? 2 * B->fcap : 256;
+        double *q = realloc(B->fpts, 3 * nc * sizeof *q);
+        if (!q) return -1;
+        B->fpts = q;
+        B->fcap = nc;
+    }
+    const double sum = l[0] + l[1] + l[2];
+    for (int d = 0; d < 3; ++d)
+        B->fpts[3 * B->nf + d] = (l[0] * P[0][d] + l[1] * P[1][d] + l[2] * P[2][d]) / sum;
+    B->faces.val[slot] = (uint32_t)B->nf;
+    *out = (uint32_t)B->nf++;
+    return 1;
+}
+
+static int tet_segments(builder *B, const uint64_t corner[8]) {
+    static const int FACES[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+    for (int t = 0; t < 6; ++t) {
+        uint32_t ends[4];
+        int ne = 0;
+        for (int f = 0; f < 4; ++f) {
+            const uint64_t v[3] = {corner[KUHN[t][FACES[f][0]]], corner[KUHN[t][FACES[f][1]]],
+                                   corner[KUHN[t][FACES[f][2]]]};
+            uint32_t idx;
+            const int r = face_point(B, v, &idx);
+            if (r < 0) return -1;
+            if (r) ends[ne++] = idx;
+        }
+        if (ne != 2) continue; /* 0 generically; 1, 3 or 4 only on degenerate ties */
+        if (B->ns == B->scap) {
+            const size_t nc = B->scap ? 2 * B->scap : 256;
+            uint32_t *q = realloc(B->seg, 2 * nc * sizeof *q);
+            if (!q) return -1;
+            B->seg = q;
+            B->scap = nc;
+        }
+        B->seg[2 * B->ns] = ends[0];
+        B->seg[2 * B->ns + 1] = ends[1];
+        B->ns++;
+    }
+    return 0;
+}
+
+/* ---- step 4: refinement ---- */
+
+static lb_status project(child_eval *E, size_t n, double *p, double size) {
+    double *x = malloc(3 * n * sizeof *x), *g = malloc(2 * n * sizeof *g);
+    double *gr = malloc(6 * n * sizeof *gr);
+    lb_status s = LB_OK;
+    if (!x || !g || !gr)
+        s = lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+    for (int it = 0; it < REFINE_STEPS && !s; ++it) {
+        for (size_t i = 0; i < n; ++i)
+            for (int d = 0; d < 3; ++d) x[d * n + i] = p[3 * i + d];
+        if ((s = children_at(E, n, x, x + n, x + 2 * n, g, gr))) break;
+        int moved = 0;
+        for (size_t i = 0; i < n; ++i) {
+            const double *a = gr + 6 * i, *b = a + 3;
+            const double r1 = LB__LOCAL_ISO - g[2 * i], r2 = LB__LOCAL_ISO - g[2 * i + 1];
+            const double aa = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+            const double bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+            const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            if (!(aa > 0.0 && bb > 0.0)) continue;
+            if (fabs(r1) <= ON_SURFACE * size * sqrt(aa) &&
+                fabs(r2) <= ON_SURFACE * size * sqrt(bb))
+                continue;
+            const double det = aa * bb - ab * ab;
+            if (!(det > 1e-12 * aa * bb)) continue; /* tangent surfaces: leave it */
+            const double ca = (r1 * bb - r2 * ab) / det, cb = (r2 * aa - r1 * ab) / det;
+            double step = 0.0;
+            for (int d = 0; d < 3; ++d) {
+                const double dd = ca * a[d] + cb * b[d];
+                step += dd * dd;
+            }
+            /* a step of more than a tenth of the scene is no refinement */
+            if (!(sqrt(step) <= 0.1 * size)) continue;
+            for (int d = 0; d < 3; ++d) p[3 * i + d] += ca * a[d] + cb * b[d];
+            moved = 1;
+        }
+        if (!moved) break;
+    }
+    free(x);
+    free(g);
+    free(gr);
+    return s;
+}
+
+/* ---- the whole preparation of one instruction ---- */
+
+static double dist3(const double *a, const double *b) {
+    const double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
+    return sqrt(x * x + y * y + z * z);
+}
+
+/* chains: vertices per component in order, from segments over face points */
+static lb_status chain(child_eval *E, const builder *B, struct lb__curves *C) {
+    const size_t nf = B->nf, ns = B->ns;
+    uint32_t *adj = malloc(2 * (nf ? nf : 1) * sizeof *adj);
+    uint8_t *used = calloc(ns ? ns : 1, 1);
+    C->pts = malloc(3 * (nf + 1) * sizeof *C->pts);
+    C->comp = malloc((ns + 1) * sizeof *C->comp);
+    if (!adj || !used || !C->pts || !C->comp) {
+        free(adj);
+        free(used);
+        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+    }
+    for (size_t i = 0; i < 2 * nf; ++i) adj[i] = UINT32_MAX;
+    for (size_t s = 0; s < ns; ++s)
+        for (int e = 0; e < 2; ++e) {
+            const uint32_t f = B->seg[2 * s + e];
+            if (adj[2 * f] == UINT32_MAX)
+                adj[2 * f] = (uint32_t)s;
+            else if (adj[2 * f + 1] == UINT32_MAX)
+                adj[2 * f + 1] = (uint32_t)s;
+        }
+        /* the other segment at face f, not s */
+#define OTHER(f, s) (adj[2 * (f)] == (s) ? adj[2 * (f) + 1] : adj[2 * (f)])
+    size_t nv = 0;
+    C->ncomp = 0;
+    /* open chains first (start at a face with one segment), then loops */
+    for (int pass = 0; pass < 2; ++pass)
+        for (size_t s0 = 0; s0 < ns; ++s0) {
+            if (used[s0]) continue;
+            uint32_t start = B->seg[2 * s0];
+            if (pass == 0) {
+                const int open0 = adj[2 * B->seg[2 * s0] + 1] == UINT32_MAX;
+                const int open1 = adj[2 * B->seg[2 * s0 + 1] + 1] == UINT32_MAX;
+                if (!open0 && !open1) continue;
+                start = open0 ? B->seg[2 * s0] : B->seg[2 * s0 + 1];
+            }
+            lb__component *K = &C->comp[C->ncomp++];
+            memset(K, 0, sizeof *K);
+            K->first = nv;
+            uint32_t f = start, s = (uint32_t)s0;
+            memcpy(C->pts + 3 * nv++, B->fpts + 3 * f, 3 * sizeof(double));
+            for (;;) {
+                used[s] = 1;
+                f = B->seg[2 * s] == f ? B->seg[2 * s + 1] : B->seg[2 * s];
+                if (f == start) {
+                    K->closed = 1;
+                    break;
+                }
+                memcpy(C->pts + 3 * nv++, B->fpts + 3 * f, 3 * sizeof(double));
+                const uint32_t next = OTHER(f, s);
+                if (next == UINT32_MAX || used[next]) break;
+                s = next;
+            }
+            K->count = nv - K->first;
+            if (K->count < 2) --C->ncomp, nv = K->first; /* a lone point is no curve */
+        }
+#undef OTHER
+    C->nv = nv;
+    free(adj);
+    free(used);
+    return LB_OK;
+}
+
+/* insert projected midpoints where a segment strays from the curve */
+static lb_status subdivide(child_eval *E, struct lb__curves *C, double size) {
+    for (int pass = 0; pass < SUBDIVIDE_PASSES; ++pass) {
+        /* midpoints of every segment, projected */
+        size_t nseg = 0;
+        for (size_t c = 0; c < C->ncomp; ++c)
+            nseg += C->comp[c].count - (C->comp[c].closed ? 0 : 1);
+        if (!nseg) return LB_OK;
+        double *mid = malloc(3 * nseg * sizeof *mid);
+        if (!mid) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        size_t q = 0;
+        for (size_t c = 0; c < C->ncomp; ++c) {
+            const lb__component *K = &C->comp[c];
+            const size_t ne = K->count - (K->closed ? 0 : 1);
+            for (size_t i = 0; i < ne; ++i) {
+                const double *a = C->pts + 3 * (K->first + i);
+                const double *b = C->pts + 3 * (K->first + (i + 1) % K->count);
+                for (int d = 0; d < 3; ++d) mid[3 * q + d] = 0.5 * (a[d] + b[d]);
+                ++q;
+            }
+        }
+        double *chord = malloc(3 * nseg * sizeof *chord);
+        if (!chord) {
+            free(mid);
+            return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        }
+        memcpy(chord, mid, 3 * nseg * sizeof *mid);
+        lb_status s = project(E, nseg, mid, size);
+        size_t add = 0;
+        for (size_t i = 0; i < nseg && !s; ++i)
+            add += dist3(mid + 3 * i, chord + 3 * i) > MIDPOINT_TOL * size;
+        if (s || !add) {
+            free(mid);
+            free(chord);
+            return s;
+        }
+        double *np = malloc(3 * (C->nv + add) * sizeof *np);
+        if (!np) {
+            free(mid);
+            free(chord);
+            return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        }
+        size_t nv = 0;
+        q = 0;
+        for (size_t c = 0; c < C->ncomp; ++c) {
+            lb__component *K = &C->comp[c];
+            const size_t first = nv;
+            for (size_t i = 0; i < K->count; ++i) {
+                memcpy(np + 3 * nv++, C->pts + 3 * (K->first + i), 3 * sizeof(double));
+                if (i + 1 < K->count || K->closed) {
+                    if (dist3(mid + 3 * q, chord + 3 * q) > MIDPOINT_TOL * size)
+                        memcpy(np + 3 * nv++, mid + 3 * q, 3 * sizeof(double));
+                    ++q;
+                }
+            }
+            K->first = first;
+            K->count = nv - first;
+        }
+        free(C->pts);
+        C->pts = np;
+        C->nv = nv;
+        free(mid);
+        free(chord);
+    }
+    return LB_OK;
+}
+
+/* feature sizes, limits and support of each component */
+static lb_status parameters(child_eval *E, struct lb__curves *C, double size) {
+    const lb__local_params *L = &E->in->op.lp;
+    const size_t n = C->nv;
+    if (!n) return LB_OK;
+    /* gradients at X +- h e_d for the divergence of the unit normals */
+    const double h = 1e-4 * size;
+    double *x = malloc(3 * 7 * n * sizeof *x), *g = malloc(2 * 7 * n * sizeof *g);
+    double *gr = malloc(6 * 7 * n * sizeof *gr);
+    if (!x || !g || !gr) {
+        free(x);
+        free(g);
+        free(gr);
+        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+    }
+    const size_t N = 7 * n;
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 7; ++k)
+            for (int d = 0; d < 3; ++d)
+                x[d * N + 7 * i + k] =
+                    C->pts[3 * i + d] + (k && (k - 1) / 2 == d ? (k % 2 ? h : -h) : 0.0);
+    lb_status s = children_at(E, N, x, x + N, x + 2 * N, g, gr);
+    for (size_t c = 0; c < C->ncomp && !s; ++c) {
+        lb__component *K = &C->comp[c];
+        double rho[2] = {0.0, 0.0};
+        K->length = 0.0;
+        K->diameter = 0.0;
+        const size_t stride = K->count > 3000 ? K->count / 3000 : 1;
+        for (size_t i = 0; i < K->count; ++i) {
+            const double *P = C->pts + 3 * (K->first + i);
+            if (i + 1 < K->count || K->closed)
+                K->length += dist3(P, C->pts + 3 * (K->first + (i + 1) % K->count));
+            if (i % stride == 0)
+                for (size_t j = i + stride; j < K->count; j += stride) {
+                    const double dd = dist3(P, C->pts + 3 * (K->first + j));
+                    if (dd > K->diameter) K->diameter = dd;
+                }
+            for (int a = 0; a < 2; ++a) {
+                double div = 0.0;
+                for (int d = 0; d < 3; ++d) {
+                    const double *gp = gr + 6 * (7 * (K->first + i) + 1 + 2 * d) + 3 * a;
+                    const double *gm = gr + 6 * (7 * (K->first + i) + 2 + 2 * d) + 3 * a;
+                    const double lp = sqrt(gp[0] * gp[0] + gp[1] * gp[1] + gp[2] * gp[2]);
+                    const double lm = sqrt(gm[0] * gm[0] + gm[1] * gm[1] + gm[2] * gm[2]);
+                    if (lp > 0.0 && lm > 0.0) div += (gp[d] / lp - gm[d] / lm) / (2.0 * h);
+                }
+                const double r = fabs(div) > 2.0 / size ? 2.0 / fabs(div) : size;
+                rho[a] += r;
+            }
+        }
+        K->d1 = L->has_feature ? L->feature[0] : 0.5 * rho[0] / (double)K->count;
+        K->d2 = L->has_feature ? L->feature[1] : 0.5 * rho[1] / (double)K->count;
+        if (L->has_limits) {
+            K->v1 = L->limits[0];
+            K->v2 = L->limits[1];
+        } else {
+            /* v1 = g2(P - d1 n2), v2 = g1(P - d2 n1): a second evaluation */
+            const size_t m = K->count;
+            double *y = malloc(3 * 2 * m * sizeof *y), *gy = malloc(2 * 2 * m * sizeof *gy);
+            if (!y || !gy) {
+                free(y);
+                free(gy);
+                s = lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+                break;
+            }
+            for (size_t i = 0; i < m; ++i) {
+                const double *P = C->pts + 3 * (K->first + i);
+                const double *g0 = gr + 6 * (7 * (K->first + i));
+                for (int a = 0; a < 2; ++a) {
+                    const double *nn = g0 + 3 * (1 - a); /* the other child's normal */
+                    const double ln = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+                    const double dist = a == 0 ? K->d1 : K->d2;
+                    for (int d = 0; d < 3; ++d)
+                        y[d * 2 * m + 2 * i + a] = P[d] - (ln > 0.0 ? dist * nn[d] / ln : 0.0);
+                }
+            }
+            s = children_at(E, 2 * m, y, y + 2 * m, y + 4 * m, gy, NULL);
+            double s1 = 0.0, s2 = 0.0;
+            for (size_t i = 0; i < m && !s; ++i) {
+                s1 += gy[2 * (2 * i + 0) + 1]; /* g2 at P - d1 n2 */
+                s2 += gy[2 * (2 * i + 1) + 0]; /* g1 at P - d2 n1 */
+            }
+            K->v1 = s1 / (double)m;
+            K->v2 = s2 / (double)m;
+            free(y);
+            free(gy);
+        }
+        K->q = K->v1 / LB__LOCAL_ISO;
+        K->p = K->v2 / LB__LOCAL_ISO;
+        if (!(K->q >= 0.0)) K->q = 0.0;
+        if (!(K->p >= 0.0)) K->p = 0.0;
+        if (K->q > LB_BARTHE_MAX_PQ) K->q = LB_BARTHE_MAX_PQ;
+        if (K->p > LB_BARTHE_MAX_PQ) K->p = LB_BARTHE_MAX_PQ;
+        K->R = L->radius > 0.0      ? L->radius
+               : L->feature_support ? 2.0 * (K->d1 < K->d2 ? K->d1 : K->d2)
+                                    : L->support * K->diameter;
+        if (!(K->R > 1e-12 * size)) K->R = 1e-12 * size;
+        if (K->R > C->rmax) C->rmax = K->R;
+    }
+    free(x);
+    free(g);
+    free(gr);
+    return s;
+}
+
+/* ---- step 6: the segment hierarchy ---- */
+
+static void seg_box(const struct lb__curves *C, uint32_t s, double lo[3], double hi[3]) {
+    const double *a = C->pts + 3 * C->seg[2 * s], *b = C->pts + 3 * C->seg[2 * s + 1];
+    for (int d = 0; d < 3; ++d) {
+        lo[d] = a[d] < b[d] ? a[d] : b[d];
+        hi[d] = a[d] < b[d] ? b[d] : a[d];
+    }
+}
+
+static uint32_t build(struct lb__curves *C, uint32_t *order, uint32_t first, uint32_t count) {
+    const uint32_t id = (uint32_t)C->nnodes++;
+    bvh_node *N = &C->bvh[id];
+    for (int d = 0; d < 3; ++d) {
+        N->lo[d] = INFINITY;
+        N->hi[d] = -INFINITY;
+    }
+    for (uint32_t i = 0; i < count; ++i) {
+        double lo[3], hi[3];
+        seg_box(C, order[first + i], lo, hi);
+        for (int d = 0; d < 3; ++d) {
+            if (lo[d] < N->lo[d]) N->lo[d] = lo[d];
+            if (hi[d] > N->hi[d]) N->hi[d] = hi[d];
+        }
+    }
+    if (count <= 4) {
+        N->leaf = 1;
+        N->left = first;
+        N->right = count;
+        return id;
+    }
+    int axis = 0;
+    for (int d = 1; d < 3; ++d)
+        if (N->hi[d] - N->lo[d] > N->hi[axis] - N->lo[axis]) axis = d;
+    /* partial sort by the segments' centres along the axis: median split */
+    const double cut = 0.5 * (N->lo[axis] + N->hi[axis]);
+    uint32_t l = first, r = first + count;
+    while (l < r) {
+        const uint32_t s = order[l];
+        const double c =
+            0.5 * (C->pts[3 * C->seg[2 * s] + axis] + C->pts[3 * C->seg[2 * s + 1] + axis]);
+        if (c < cut)
+            ++l;
+        else {
+            order[l] = order[--r];
+            order[r] = s;
+        }
+    }
+    uint32_t half = l - first;
+    if (half == 0 || half == count) half = count / 2;
+    N->leaf = 0;
+    const uint32_t left = build(C, order, first, half);
+    const uint32_t right = build(C, order, first + half, count - half);
+    C->bvh[id].left = left;
+    C->bvh[id].right = right;
+    return id;
+}
+
+static lb_status make_bvh(child_eval *E, struct lb__curves *C) {
+    size_t ns = 0;
+    for (size_t c = 0; c < C->ncomp; ++c) ns += C->comp[c].count - (C->comp[c].closed ? 0 : 1);
+    C->nseg = ns;
+    if (!ns) return LB_OK;
+    C->seg = malloc(2 * ns * sizeof *C->seg);
+    C->segc = malloc(ns * sizeof *C->segc);
+    C->bvh = malloc(2 * ns * sizeof *C->bvh);
+    uint32_t *order = malloc(ns * sizeof *order);
+    if (!C->seg || !C->segc || !C->bvh || !order) {
+        free(order);
+        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+    }
+    size_t q = 0;
+    for (size_t c = 0; c < C->ncomp; ++c) {
+        const lb__component *K = &C->comp[c];
+        for (size_t i = 0; i + 1 < K->count || (K->closed && i < K->count); ++i) {
+            C->seg[2 * q] = (uint32_t)(K->first + i);
+            C->seg[2 * q + 1] = (uint32_t)(K->first + (i + 1) % K->count);
+            C->segc[q] = (uint32_t)c;
+            order[q] = (uint32_t)q;
+            ++q;
+        }
+    }
+    C->nnodes = 0;
+    build(C, order, 0, (uint32_t)ns);
+    /* leaves refer to the order: store the segments in that order */
+    uint32_t *seg = malloc(2 * ns * sizeof *seg), *segc = malloc(ns * sizeof *segc);
+    if (!seg || !segc) {
+        free(seg);
+        free(segc);
+        free(order);
+        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+    }
+    for (size_t i = 0; i < ns; ++i) {
+        seg[2 * i] = C->seg[2 * order[i]];
+        seg[2 * i + 1] = C->seg[2 * order[i] + 1];
+        segc[i] = C->segc[order[i]];
+    }
+    free(C->seg);
+    free(C->segc);
+    C->seg = seg;
+    C->segc = segc;
+    free(order);
+    return LB_OK;
+}
+
+static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double bmin[3],
+                             const double bmax[3], lb_error *err) {
+    struct lb__curves *C = calloc(1, sizeof *C);
+    double *regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
+    lb__iv *R = malloc(ev->nregs * sizeof *R);
+    builder B;
+    memset(&B, 0, sizeof B);
+    cellset S = {NULL, 0, 0};
+    lb_status s = LB_OK;
+    if (!C || !regs || !R) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+    child_eval E = {ev, in, regs, err};
+    grid G;
+    double size = 0.0;
+    if (!s) {
+        double longest = 0.0;
+        for (int d = 0; d < 3; ++d) {
+            const double e = bmax[d] - bmin[d];
+            size += e * e;
+            if (e > longest) longest = e;
+        }
+        size = sqrt(size);
+        C->scene_size = size;
+        G.h = longest / GRID;
+        for (int d = 0; d < 3; ++d) {
+            G.cells[d] = (uint32_t)ceil((bmax[d] - bmin[d]) / G.h - 1e-9);
+            if (G.cells[d] < 1) G.cells[d] = 1;
+            /* centre the grid on the region; shifted by a fraction of a cell
+             * so that symmetric scenes do not put nodes exactly on surfaces */
+            G.origin[d] = 0.5 * (bmin[d] + bmax[d]) - 0.5 * G.h * G.cells[d] + 1e-7 * G.h * (d + 1);
+        }
+        const uint32_t zero[3] = {0, 0, 0};
+        s = octree(&E, &G, zero, G.cells, R, &S);
+    }
+    /* sample the kept cells' nodes */
+    if (!s && S.n) {
+        if (hmap_init(&B.nodes, 8 * S.n) || hmap_init(&B.faces, 24 * S.n))
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+        B.G = &G;
+        uint64_t *ids = s ? NULL : malloc(8 * S.n * sizeof *ids);
+        if (!s && !ids) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+        size_t nn = 0;
+        for (size_t c = 0; c < S.n && !s; ++c)
+            for (int k = 0; k < 8; ++k) {
+                const uint32_t *q = S.c + 3 * c;
+                const uint64_t id =
+                    node_id(&G, q[0] + (k & 1), q[1] + (k >> 1 & 1), q[2] + (k >> 2));
+                const size_t slot = hmap_slot(&B.nodes, id, 0);
+                if (B.nodes.val[slot] != UINT32_MAX) continue;
+                B.nodes.k1[slot] = id;
+                B.nodes.k2[slot] = 0;
+                B.nodes.val[slot] = (uint32_t)nn;
+                ids[nn++] = id;
+            }
+        double *x = s ? NULL : malloc(3 * nn * sizeof *x);
+        B.nval = s ? NULL : malloc(2 * nn * sizeof *B.nval);
+        if (!s && (!x || !B.nval))
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+        for (size_t i = 0; i < nn && !s; ++i) {
+            double p[3];
+            node_pos(&G, ids[i], p);
+            for (int d = 0; d < 3; ++d) x[d * nn + i] = p[d];
+        }
+        if (!s) s = children_at(&E, nn, x, x + nn, x + 2 * nn, B.nval, NULL);
+        for (size_t i = 0; i < 2 * nn && !s; ++i) {
+            B.nval[i] -= LB__LOCAL_ISO;
+            if (B.nval[i] == 0.0) B.nval[i] = DBL_MIN; /* a tie counts as inside */
+        }
+        free(x);
+        free(ids);
+        for (size_t c = 0; c < S.n && !s; ++c) {
+            const uint32_t *q = S.c + 3 * c;
+            uint64_t corner[8];
+            for (int k = 0; k < 8; ++k)
+                corner[k] = node_id(&G, q[0] + (k & 1), q[1] + (k >> 1 & 1), q[2] + (k >> 2));
+            if (tet_segments(&B, corner))
+                s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+        }
+    }
+    if (!s) s = chain(&E, &B, C);
+    if (!s && C->nv) s = project(&E, C->nv, C->pts, size);
+    if (!s) s = subdivide(&E, C, size);
+    if (!s) s = parameters(&E, C, size);
+    if (!s) s = make_bvh(&E, C);
+    hmap_free(&B.nodes);
+    hmap_free(&B.faces);
+    free(B.nval);
+    free(B.fpts);
+    free(B.seg);
+    free(S.c);
+    free(regs);
+    free(R);
+    if (s) {
+        lb__curves_free(C);
+        return s;
+    }
+    in->curves = C;
+    return LB_OK;
+}
+
+lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, lb_error *err) {
+    for (size_t i = 0; i < ev->n; ++i) {
+        lb__instr *in = &ev->ins[i];
+        if (in->code != LB__I_OP || in->op.family != LB__F_LOCAL) continue;
+        double bmin[3], bmax[3];
+        if (!lb_scene_bounds(scene, bmin, bmax))
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: local_union finds its children's intersection curves inside the "
+                            "scene's bounds; allowed: a scene with \"bounds\"",
+                            in->op.path);
+        lb_status s = prepare_one(ev, in, bmin, bmax, err);
+        if (s) return s;
+    }
+    return LB_OK;
+}
+
+/* ---- evaluation ---- */
+
+static double box_dist2(const double lo[3], const double hi[3], const double X[3]) {
+    double s = 0.0;
+    for (int d = 0; d < 3; ++d) {
+        const double e = X[d] < lo[d] ? lo[d] - X[d] : X[d] > hi[d] ? X[d] - hi[d] : 0.0;
+        s += e * e;
+    }
+    return s;
+}
+
+/* the component with the smallest d / R near X (a < 1), the distance and
+ * the closest point; returns a = d / R (>= 1: outside every volume) */
+static double nearest(const struct lb__curves *C, const double X[3], uint32_t *comp, double Q[3],
+                      double *dist) {
+    double best = 1.0;
+    if (!C || !C->nseg) return best;
+    uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top) {
+        const bvh_node *N = &C->bvh[stack[--top]];
+        if (box_dist2(N->lo, N->hi, X) >= C->rmax * C->rmax * best * best) continue;
+        if (!N->leaf) {
+            if (top + 2 <= 128) {
+                stack[top++] = N->left;
+                stack[top++] = N->right;
+            }
+            continue;
+        }
+        for (uint32_t i = 0; i < N->right; ++i) {
+            const uint32_t s = N->left + i;
+            const double *a = C->pts + 3 * C->seg[2 * s], *b = C->pts + 3 * C->seg[2 * s + 1];
+            double ab[3], ax[3], ll = 0.0, t = 0.0;
+            for (int d = 0; d < 3; ++d) {
+                ab[d] = b[d] - a[d];
+                ax[d] = X[d] - a[d];
+                ll += ab[d] * ab[d];
+                t += ab[d] * ax[d];
+            }
+            t = ll > 0.0 ? t / ll : 0.0;
+            if (t < 0.0) t = 0.0;
+            if (t > 1.0) t = 1.0;
+            double P[3], dd = 0.0;
+            for (int d = 0; d < 3; ++d) {
+                P[d] = a[d] + t * ab[d];
+                dd += (X[d] - P[d]) * (X[d] - P[d]);
+            }
+            const double R = C->comp[C->segc[s]].R, aa = sqrt(dd) / R;
+            if (aa < best) {
+                best = aa;
+                *comp = C->segc[s];
+                memcpy(Q, P, sizeof P);
+                *dist = sqrt(dd);
+            }
+        }
+    }
+    return best;
+}
+
+/* Wyvill's kernel W(a) = 1 - 4/9 a^6 + 17/9 a^4 - 22/9 a^2 on [0, 1] */
+static double wyvill(double a, double *dw) {
+    const double a2 = a * a;
+    *dw = a * (-24.0 / 9.0 * a2 * a2 + 68.0 / 9.0 * a2 - 44.0 / 9.0);
+    return 1.0 + a2 * (-4.0 / 9.0 * a2 * a2 + 17.0 / 9.0 * a2 - 22.0 / 9.0);
+}
+
+lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
+                        const double *y, const double *z, double *regs, lb_error *err) {
+    const lb__node *nd = &in->op;
+    const lb_convention conv = ev->conv;
+    const double k = conv == LB_CONVENTION_ZERO ? -LB__LOCAL_ISO / nd->lp.zero_scale : 1.0;
+    double *ov = lb__reg(regs, in->dst, 0), *ox = lb__reg(regs, in->dst, 1),
+           *oy = lb__reg(regs, in->dst, 2), *oz = lb__reg(regs, in->dst, 3);
+    const uint32_t r0 = in->src[0], r1 = in->src[1];
+    for (size_t j = 0; j < n; ++j) {
+        const double f[2] = {lb__reg(regs, r0, 0)[j], lb__reg(regs, r1, 0)[j]};
+        double gf[2][3];
+        for (int d = 0; d < 3; ++d) {
+            gf[0][d] = lb__reg(regs, r0, 1 + d)[j];
+            gf[1][d] = lb__reg(regs, r1, 1 + d)[j];
+        }
+        double g[2], uc, guc[2];
+        lb__local_in(nd, conv, f, g);
+        lb_status s = lb_clean_union(LB_CLEAN_UC, g, LB__LOCAL_ISO, nd->lp.alpha, &uc, guc, err);
+        if (s) return s;
+        double u = uc, du[2] = {guc[0], guc[1]}, dv[3] = {0.0, 0.0, 0.0};
+        if (nd->family == LB__F_LOCAL) {
+            const double X[3] = {x[j], y[j], z[j]};
+            uint32_t c = 0;
+            double Q[3] = {0.0, 0.0, 0.0}, dist = 0.0;
+            const double a = nearest(in->curves, X, &c, Q, &dist);
+            if (a < 1.0) {
+                const lb__component *K = &in->curves->comp[c];
+                double dw, ub, gub[2], gm[3];
+                const double v = wyvill(a, &dw);
+                if ((s = lb_barthe_blend(g, K->p, K->q, &ub, gub, err)) ||
+                    (s = lb_local_mix(uc, ub, v, nd->lp.exponent, &u, gm, err)))
+                    return s;
+                du[0] = gm[0] * guc[0] + gm[1] * gub[0];
+                du[1] = gm[0] * guc[1] + gm[1] * gub[1];
+                /* grad v = W'(a) / R (X - Q) / dist */
+                if (dist > 0.0)
+                    for (int d = 0; d < 3; ++d) dv[d] = gm[2] * dw / K->R * (X[d] - Q[d]) / dist;
+            }
+        }
+        /* back to the scene's convention: zero f = s (1 - U / C) */
+        const double out_k = conv == LB_CONVENTION_ZERO ? -nd->lp.zero_scale / LB__LOCAL_ISO : 1.0;
+        ov[j] = lb__local_out(nd, conv, u);
+        double gg[3];
+        for (int d = 0; d < 3; ++d)
+            gg[d] = out_k * (k * (du[0] * gf[0][d] + du[1] * gf[1][d]) + dv[d]);
+        ox[j] = gg[0];
+        oy[j] = gg[1];
+        oz[j] = gg[2];
+    }
+    return LB_OK;
+}
+
+/* ---- bounds ---- */
+
+/* does any blending volume reach the box? (conservative) */
+static int volume_reaches(const struct lb__curves *C, const double bc[3], const double br[3]) {
+    if (!C || !C->nseg) return 0;
+    const bvh_node *N = &C->bvh[0];
+    double s = 0.0;
+    for (int d = 0; d < 3; ++d) {
+        const double lo = bc[d] - br[d], hi = bc[d] + br[d];
+        const double e = hi < N->lo[d] ? N->lo[d] - hi : lo > N->hi[d] ? lo - N->hi[d] : 0.0;
+        s += e * e;
+    }
+    return s < C->rmax * C->rmax;
+}
+
+static double ur_val(double a, double b) {
+    return a + b + hypot(a, b);
+}
+
+void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv x[2],
+                      const double bc[3], const double br[3], lb__iv *out) {
+    const lb__node *nd = &in->op;
+    const lb_convention conv = ev->conv;
+    double lo[2], hi[2];
+    for (int a = 0; a < 2; ++a) {
+        double f[2] = {x[a].lo, x[a].hi}, g[2];
+        lb__local_in(nd, conv, f, g);
+        lo[a] = g[0] < g[1] ? g[0] : g[1];
+        hi[a] = g[0] < g[1] ? g[1] : g[0];
+    }
+    const double C = LB__LOCAL_ISO, K = 2.0 - sqrt(2.0);
+    /* max is always among the convex combination's ends */
+    double ulo = lo[0] > lo[1] ? lo[0] : lo[1], uhi = hi[0] > hi[1] ? hi[0] : hi[1];
+    if (ulo < C) { /* outside both can occur: UC2 is increasing in both */
+        const double v1 = C + ur_val(lo[0] - C, lo[1] - C) / K;
+        const double v2 = C + ur_val(hi[0] - C, hi[1] - C) / K;
+        if (v1 < ulo) ulo = v1;
+        if (v2 > uhi) uhi = v2;
+    }
+    if (hi[0] >= C && hi[1] >= C) { /* inside both can occur */
+        const double v2 = C + hypot(hi[0] - C, hi[1] - C);
+        if (v2 > uhi) uhi = v2;
+    }
+    if (nd->family == LB__F_LOCAL && volume_reaches(in->curves, bc, br)) {
+        /* UB >= max, increasing in both: its largest value at the top corner */
+        const struct lb__curves *Cv = in->curves;
+        for (size_t c = 0; c < Cv->ncomp; ++c) {
+            const double xy[2] = {hi[0], hi[1]};
+            double ub = 0.0;
+            if (lb_barthe_blend(xy, Cv->comp[c].p, Cv->comp[c].q, &ub, NULL, NULL) == LB_OK &&
+                ub > uhi)
+                uhi = ub;
+        }
+    }
+    ulo -= 1e-9 * (1.0 + fabs(ulo));
+    uhi += 1e-9 * (1.0 + fabs(uhi));
+    const double o1 = lb__local_out(nd, conv, ulo), o2 = lb__local_out(nd, conv, uhi);
+    out->lo = o1 < o2 ? o1 : o2;
+    out->hi = o1 < o2 ? o2 : o1;
+}
+
+/* ---- description (blendtool info) ---- */
+
+typedef struct tbuf {
+    char *s;
+    size_t size, len;
+} tbuf;
+
+static void tput(tbuf *b, const char *fmt, ...) LB_PRINTF(2, 3);
+static void tput(tbuf *b, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    const size_t room = b->len < b->size ? b->size - b->len : 0;
+    const int w = vsnprintf(room ? b->s + b->len : NULL, room, fmt, ap);
+    va_end(ap);
+    if (w > 0) b->len += (size_t)w;
+}
+
+size_t lb_evaluator_describe_local(const lb_evaluator *ev, char *buf, size_t size) {
+    tbuf b = {buf, buf ? size : 0, 0};
+    if (b.size) buf[0] = '\0';
+    if (!ev) return 0;
+    for (size_t i = 0; i < ev->n; ++i) {
+        const lb__instr *in = &ev->ins[i];
+        if (in->code != LB__I_OP || in->op.family != LB__F_LOCAL || !in->curves) continue;
+        const struct lb__curves *C = in->curves;
+        tput(&b, "%s: %zu intersection curve%s, %zu vertices\n", in->op.path, C->ncomp,
+             C->ncomp == 1 ? "" : "s", C->nv);
+        for (size_t c = 0; c < C->ncomp; ++c) {
+            const lb__component *K = &C->comp[c];
+            tput(&b,
+                 "  curve %zu: %s, %zu vertices, length %.6g, diameter %.6g, R %.6g, v1 %.6g, "
+                 "v2 %.6g, d1 %.6g, d2 %.6g\n",
+                 c, K->closed ? "closed" : "open", K->count, K->length, K->diameter, K->R, K->v1,
+                 K->v2, K->d1, K->d2);
+        }
+    }
+    if (b.size && b.len >= b.size) buf[b.size - 1] = '\0';
+    return b.len;
+}
+
+/* ---- inspection (tests) ---- */
+
+const struct lb__curves *lb__local_nth(const lb_evaluator *ev, size_t which) {
+    size_t seen = 0;
+    for (size_t i = 0; ev && i < ev->n; ++i) {
+        const lb__instr *in = &ev->ins[i];
+        if (in->code == LB__I_OP && in->op.family == LB__F_LOCAL && seen++ == which)
+            return in->curves;
+    }
+    return NULL;
+}
