@@ -29,6 +29,13 @@
 #define LB_READS(ptr, n)
 #endif
 
+/* ---- local blending's kernels (operators/local.c), unchecked: the
+ * compiled evaluator's inner loop; f finite, C > 0, alpha in [0, 1),
+ * 0 <= p, q <= LB_BARTHE_MAX_PQ; g receives the two partial derivatives ---- */
+LB_INTERNAL double lb__clean_eval(lb_clean_kind kind, const double f[2], double C,
+                                  const double alpha[2], double g[2]);
+LB_INTERNAL double lb__barthe_eval(const double xy[2], double p, double q, double g[2]);
+
 /* ---- errors and validation (common/error.c) ---- */
 LB_INTERNAL lb_status lb__fail(lb_error *err, lb_status status, const char *fmt, ...)
     LB_PRINTF(3, 4);

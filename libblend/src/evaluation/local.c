@@ -865,6 +865,19 @@ static double wyvill(double a, double *dw) {
     return 1.0 + a2 * (-4.0 / 9.0 * a2 * a2 + 17.0 / 9.0 * a2 - 22.0 / 9.0);
 }
 
+/* does any blending volume reach the box? (conservative) */
+static int volume_reaches(const struct lb__curves *C, const double bc[3], const double br[3]) {
+    if (!C || !C->nseg) return 0;
+    const bvh_node *N = &C->bvh[0];
+    double s = 0.0;
+    for (int d = 0; d < 3; ++d) {
+        const double lo = bc[d] - br[d], hi = bc[d] + br[d];
+        const double e = hi < N->lo[d] ? N->lo[d] - hi : lo > N->hi[d] ? lo - N->hi[d] : 0.0;
+        s += e * e;
+    }
+    return s < C->rmax * C->rmax;
+}
+
 lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
                         const double *y, const double *z, double *regs, lb_error *err) {
     const lb__node *nd = &in->op;
@@ -873,6 +886,22 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
     double *ov = lb__reg(regs, in->dst, 0), *ox = lb__reg(regs, in->dst, 1),
            *oy = lb__reg(regs, in->dst, 2), *oz = lb__reg(regs, in->dst, 3);
     const uint32_t r0 = in->src[0], r1 = in->src[1];
+    /* a chunk (spatially compact: the evaluator sorts points) that no
+     * blending volume reaches skips the distance queries */
+    int reach = nd->family == LB__F_LOCAL && in->curves && in->curves->nseg;
+    if (reach && n) {
+        double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
+        for (size_t j = 1; j < n; ++j) {
+            const double P[3] = {x[j], y[j], z[j]};
+            for (int d = 0; d < 3; ++d) {
+                if (P[d] < lo[d]) lo[d] = P[d];
+                if (P[d] > hi[d]) hi[d] = P[d];
+            }
+        }
+        double bc[3], br[3];
+        lb__box_centre(lo, hi, bc, br);
+        reach = volume_reaches(in->curves, bc, br);
+    }
     for (size_t j = 0; j < n; ++j) {
         const double f[2] = {lb__reg(regs, r0, 0)[j], lb__reg(regs, r1, 0)[j]};
         double gf[2][3];
@@ -880,23 +909,26 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
             gf[0][d] = lb__reg(regs, r0, 1 + d)[j];
             gf[1][d] = lb__reg(regs, r1, 1 + d)[j];
         }
-        double g[2], uc, guc[2];
+        double g[2], guc[2];
         lb__local_in(nd, conv, f, g);
-        lb_status s = lb_clean_union(LB_CLEAN_UC, g, LB__LOCAL_ISO, nd->lp.alpha, &uc, guc, err);
-        if (s) return s;
+        if (!(fabs(g[0]) <= LB_MAX_ABS_ARG && fabs(g[1]) <= LB_MAX_ABS_ARG))
+            return lb__fail(err, LB_ERR_NOT_FINITE,
+                            "%s: a child's value %g, %g is not finite or beyond 1e100", nd->path,
+                            f[0], f[1]);
+        const double uc = lb__clean_eval(LB_CLEAN_UC, g, LB__LOCAL_ISO, nd->lp.alpha, guc);
         double u = uc, du[2] = {guc[0], guc[1]}, dv[3] = {0.0, 0.0, 0.0};
-        if (nd->family == LB__F_LOCAL) {
+        if (reach) {
             const double X[3] = {x[j], y[j], z[j]};
             uint32_t c = 0;
             double Q[3] = {0.0, 0.0, 0.0}, dist = 0.0;
             const double a = nearest(in->curves, X, &c, Q, &dist);
             if (a < 1.0) {
                 const lb__component *K = &in->curves->comp[c];
-                double dw, ub, gub[2], gm[3];
+                double dw, gub[2], gm[3];
                 const double v = wyvill(a, &dw);
-                if ((s = lb_barthe_blend(g, K->p, K->q, &ub, gub, err)) ||
-                    (s = lb_local_mix(uc, ub, v, nd->lp.exponent, &u, gm, err)))
-                    return s;
+                const double ub = lb__barthe_eval(g, K->p, K->q, gub);
+                lb_status s = lb_local_mix(uc, ub, v, nd->lp.exponent, &u, gm, err);
+                if (s) return s;
                 du[0] = gm[0] * guc[0] + gm[1] * gub[0];
                 du[1] = gm[0] * guc[1] + gm[1] * gub[1];
                 /* grad v = W'(a) / R (X - Q) / dist */
@@ -918,19 +950,6 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
 }
 
 /* ---- bounds ---- */
-
-/* does any blending volume reach the box? (conservative) */
-static int volume_reaches(const struct lb__curves *C, const double bc[3], const double br[3]) {
-    if (!C || !C->nseg) return 0;
-    const bvh_node *N = &C->bvh[0];
-    double s = 0.0;
-    for (int d = 0; d < 3; ++d) {
-        const double lo = bc[d] - br[d], hi = bc[d] + br[d];
-        const double e = hi < N->lo[d] ? N->lo[d] - hi : lo > N->hi[d] ? lo - N->hi[d] : 0.0;
-        s += e * e;
-    }
-    return s < C->rmax * C->rmax;
-}
 
 static double ur_val(double a, double b) {
     return a + b + hypot(a, b);

@@ -53,8 +53,8 @@ static double weight(const double f[2], const double a[2], double g[2]) {
     return t3 * t;
 }
 
-static double clean_eval(lb_clean_kind kind, const double f[2], double C, const double a[2],
-                         double g[2]) {
+double lb__clean_eval(lb_clean_kind kind, const double f[2], double C, const double a[2],
+                      double g[2]) {
     if (kind == LB_CLEAN_UR) return ur(f[0], f[1], g);
     if (kind == LB_CLEAN_UC2) return uc2(f, C, g);
     const int first = f[0] >= f[1];
@@ -100,7 +100,7 @@ lb_status lb_clean_union(lb_clean_kind kind, const double f[2], double C, const 
                                       "0 <= alpha_i < 1 (0: finite support)", err)))
         return s;
     double g[2];
-    *value = clean_eval(kind, f, C, alpha ? alpha : zero, g);
+    *value = lb__clean_eval(kind, f, C, alpha ? alpha : zero, g);
     if (grad) {
         grad[0] = g[0];
         grad[1] = g[1];
@@ -111,7 +111,7 @@ lb_status lb_clean_union(lb_clean_kind kind, const double f[2], double C, const 
 /* UB: max outside the wedge q x < y, p y < x; inside, the rationalised
  * root of A u^2 - 2 B u + D = 0 (the level-u quarter ellipse through
  * (x, y), tangent to x = u and y = u). */
-static double barthe_eval(const double xy[2], double p, double q, double g[2]) {
+double lb__barthe_eval(const double xy[2], double p, double q, double g[2]) {
     const double x = xy[0], y = xy[1];
     if (y <= q * x || x <= p * y) {
         const int first = x >= y;
@@ -146,7 +146,7 @@ lb_status lb_barthe_blend(const double x[2], double p, double q, double *value, 
                              "0 <= q <= 0.999 (the blend leaves y = u where x = q u)", err)))
         return s;
     double g[2];
-    *value = barthe_eval(x, p, q, g);
+    *value = lb__barthe_eval(x, p, q, g);
     if (grad) {
         grad[0] = g[0];
         grad[1] = g[1];
