@@ -51,7 +51,13 @@ BLENDS_SOFT = [
     ("ricci", "Ricci", "Ricci's union (sum x^n)^(1/n)"),
     ("perlin", "Perlin", "Perlin's products"),
 ]
-BLENDS = BLENDS_ZERO + [b for b in BLENDS_SOFT]
+#: both conventions
+BLENDS_BOTH = [
+    ("local_union", "Local Union", "blends only around the intersection curves (Bernhardt et al. "
+     "2010): the exact union elsewhere"),
+    ("clean_union", "Clean Union", "the exact union surface, C1 elsewhere, no blend"),
+]
+BLENDS = BLENDS_ZERO + [b for b in BLENDS_SOFT] + BLENDS_BOTH
 OPS = [("union", "Union", ""), ("intersection", "Intersection", ""),
        ("difference", "Difference", "the first argument minus the others")]
 
@@ -133,6 +139,21 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
     bulge_slope: BoolProperty(name="Slope", default=False, update=_changed)
     bulge_omega: FloatProperty(name="Omega", default=0.001, min=1e-6, max=1.0, precision=4,
                                update=_changed)
+
+    local_exponent: FloatProperty(name="Exponent n", description="beta = v^n inside the blending "
+                                  "volume", default=2.0, min=1.0, max=1000.0, update=_changed)
+    local_support: EnumProperty(name="Support", items=[
+        ("progressive", "Progressive", "R = support factor x the intersection curve's diameter"),
+        ("feature", "Feature", "R = 2 min(d1, d2)")], update=_changed)
+    local_support_factor: FloatProperty(name="Support Factor", default=0.25, min=1e-3, max=100.0,
+                                        update=_changed)
+    local_radius: FloatProperty(name="Radius R", description="the blending volume's support "
+                                "(0 = automatic)", default=0.0, min=0.0, update=_changed)
+    zero_scale: FloatProperty(name="Zero Scale", description="zero convention: the children "
+                              "enter as 0.5 (1 - f / zero_scale)", default=1.0, min=1e-9,
+                              max=1e9, update=_changed)
+    local_extra: StringProperty(name="More Keys", description="feature_size, limits and alpha "
+                                "of the scene file, kept for export (JSON)", update=_changed)
 
     # ---- this node as an argument of its parent blend
     arg_override: BoolProperty(name="Own r / p / m", description="use this argument's own "

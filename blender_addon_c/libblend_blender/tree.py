@@ -29,7 +29,10 @@ BLEND_KEYS = {
     "soft_hyper": ("op", "r", "p", "m"),
     "soft_conic": ("op", "r", "conic_p", "m"),
     "soft_sum": (), "ricci": ("n",), "perlin": ("op",),
+    "local_union": ("local", "zero_scale"), "clean_union": ("zero_scale",),
 }
+#: local_union keys the panel does not show, kept as JSON text
+LOCAL_EXTRA = ("feature_size", "limits", "alpha")
 #: scene keys of each primitive -> settings attribute
 PRIM_KEYS = {
     "sphere": (("center", "center"), ("radius", "radius")),
@@ -185,6 +188,22 @@ def _node(obj, path, paths, convention, depth):
         out["bulge"] = {"range": s.bulge_range, "slope": s.bulge_slope, "omega": f32(s.bulge_omega)}
     if "bulge_range" in keys and s.bulge:
         out["bulge"] = {"range": True, "omega": f32(s.bulge_omega)}
+    if "local" in keys:
+        out["support"] = s.local_support
+        out["support_factor"] = f32(s.local_support_factor)
+        out["exponent"] = f32(s.local_exponent)
+        if s.local_radius > 0:
+            out["radius"] = f32(s.local_radius)
+    if "zero_scale" in keys:
+        if convention == "zero":
+            out["zero_scale"] = f32(s.zero_scale)
+        if s.local_extra:
+            try:
+                extra = json.loads(s.local_extra)
+            except ValueError:
+                raise TreeError("object '%s': its kept keys (More Keys) are not JSON; clear them"
+                                % obj.name) from None
+            out.update({k: v for k, v in extra.items() if k in LOCAL_EXTRA})
     _transform(obj, out, False)
     out["args"] = [_node(a, "%s.args[%d]" % (path, i), paths, convention, depth + 1)
                    for i, a in enumerate(args)]
@@ -365,6 +384,15 @@ def from_scene(scene, collection, name="libblend field"):
             st.conic_p = node["p"]
         if "n" in node:
             st.ricci_n = node["n"]
+        if t == "local_union":
+            st.local_support = node.get("support", "progressive")
+            st.local_support_factor = node.get("support_factor", 0.25)
+            st.local_exponent = node.get("exponent", 2.0)
+            st.local_radius = node.get("radius", 0.0)
+        if t in ("local_union", "clean_union"):
+            st.zero_scale = node.get("zero_scale", 1.0)
+            extra = {k: node[k] for k in LOCAL_EXTRA if k in node}
+            st.local_extra = json.dumps(extra) if extra else ""
         if "bulge" in node:
             b = node["bulge"]
             st.bulge = True

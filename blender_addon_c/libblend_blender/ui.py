@@ -149,6 +149,14 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
             layout.prop(s, "conic_p")
         if "n" in keys:
             layout.prop(s, "ricci_n")
+        if "local" in keys:
+            layout.prop(s, "local_exponent")
+            layout.prop(s, "local_support")
+            if s.local_support == "progressive":
+                layout.prop(s, "local_support_factor")
+            layout.prop(s, "local_radius")
+        if "zero_scale" in keys:
+            layout.prop(s, "zero_scale")
         if "bulge" in keys or "bulge_range" in keys:
             col = layout.column()
             col.prop(s, "bulge")

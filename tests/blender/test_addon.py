@@ -238,9 +238,19 @@ with open(wheel) as f1, open(again) as f2:
     check(json.load(f1) == json.load(f2), "export -> import -> export gives the same tree")
 Vi, Fi = blender_mesh(imp)
 check(len(Fi) == len(F1) and np.array_equal(Vi, V1), "the imported wheel meshes like the built one")
-for path in sorted(glob.glob(os.path.join(SRC, "scenes", "*.json"))):
+local_scenes = sorted(glob.glob(os.path.join(SRC, "tests", "data", "local", "*.json")))
+check(len(local_scenes) >= 2, "local-blend scenes to round-trip")
+for path in sorted(glob.glob(os.path.join(SRC, "scenes", "*.json"))) + local_scenes:
     sc = json.load(open(path))
     imp, again = roundtrip(path, os.path.basename(path))
+    if path in local_scenes:
+        # the local blend meshes in Blender, closed and manifold
+        activate(imp)
+        check(bpy.ops.libblend.update_mesh() == {"FINISHED"}, "update_mesh " + path)
+        Vl, Fl = blender_mesh(imp)
+        il = meshcheck.check(Vl, Fl)
+        check(il["triangles"] > 1000 and il["closed"] and il["manifold"],
+              "local blend meshed closed and manifold in Blender: " + path)
     lo, hi = sc["bounds"]["min"], sc["bounds"]["max"]
     P = rng.uniform(lo, hi, size=(1000, 3))
     d = np.abs(field(path, P) - field(again, P))
