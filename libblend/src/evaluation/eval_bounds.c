@@ -368,6 +368,20 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
     }
 }
 
+/* An operator over all its arguments' intervals (no culling). */
+static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const double bc[3],
+                            const double br[3], const iv *R, iv *o) {
+    iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
+    const size_t k = in->op.k;
+    for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
+    if (in->op.family == LB__F_BOUNDED)
+        for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
+    if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN)
+        lb__local_bounds(ev, in, x, bc, br, o);
+    else
+        op_bounds(ev->conv, &in->op, x, c, o);
+}
+
 /* The same pass over a box inside the box of `parent` (a plan made by
  * lb__bounds_pass): instructions the parent does not need are skipped, and
  * blends consider only the arguments the parent kept, which are the only
@@ -375,7 +389,7 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
  * root's interval is R[ev->out]. */
 void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const double bc[3],
                          const double br[3], iv *R) {
-    iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
+    iv x[LB_MAX_ARITY];
     for (size_t i = 0; i < ev->n; ++i) {
         if (!parent->need[i]) continue;
         const lb__instr *in = &ev->ins[i];
@@ -414,14 +428,7 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                 fast_bounds(in, x, act, na, &o);
             }
         } else {
-            const size_t k = in->op.k;
-            for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
-            if (in->op.family == LB__F_BOUNDED)
-                for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
-            if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN)
-                lb__local_bounds(ev, in, x, bc, br, &o);
-            else
-                op_bounds(ev->conv, &in->op, x, c, &o);
+            all_args_bounds(ev, in, bc, br, R, &o);
         }
         o.lo = clampd(o.lo);
         o.hi = clampd(o.hi);
@@ -431,22 +438,13 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
 
 void lb__bounds_pass_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist,
                           const double bc[3], const double br[3], iv *R) {
-    iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
     for (size_t q = 0; q < nlist; ++q) {
         const lb__instr *in = &ev->ins[list[q]];
         iv o;
-        if (in->code != LB__I_OP) {
+        if (in->code != LB__I_OP)
             prim_bounds(in, bc, br, &o);
-        } else {
-            const size_t k = in->op.k;
-            for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
-            if (in->op.family == LB__F_BOUNDED)
-                for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
-            if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN)
-                lb__local_bounds(ev, in, x, bc, br, &o);
-            else
-                op_bounds(ev->conv, &in->op, x, c, &o);
-        }
+        else
+            all_args_bounds(ev, in, bc, br, R, &o);
         o.lo = clampd(o.lo);
         o.hi = clampd(o.hi);
         R[in->dst] = o;
