@@ -1,4 +1,5 @@
-/* Error records and parameter validation shared by every public entry point. */
+/* Error records, parameter validation and bounded text shared by every
+ * public entry point. */
 #include "internal.h"
 
 #include <stdarg.h>
@@ -56,6 +57,15 @@ lb_status lb__fail(lb_error *err, lb_status status, const char *fmt, ...) {
         err->status = status;
     }
     return status;
+}
+
+void lb__text_put(lb__text *b, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    const size_t room = b->len < b->size ? b->size - b->len : 0;
+    const int n = vsnprintf(room ? b->buf + b->len : NULL, room, fmt, ap);
+    va_end(ap);
+    if (n > 0) b->len += (size_t)n;
 }
 
 lb_status lb__check_k(const char *fn, size_t k, size_t kmin, size_t kmax, lb_error *err) {

@@ -39,6 +39,14 @@ LB_INTERNAL double lb__barthe_eval(const double xy[2], double p, double q, doubl
 /* ---- errors and validation (common/error.c) ---- */
 LB_INTERNAL lb_status lb__fail(lb_error *err, lb_status status, const char *fmt, ...)
     LB_PRINTF(3, 4);
+/* Text into a caller's buffer, snprintf-style: len grows by what the whole
+ * text needs, buf (size bytes, may be NULL with size 0) holds what fits,
+ * NUL-terminated. The describers' writer (scene, local blends). */
+typedef struct lb__text {
+    char *buf;
+    size_t size, len;
+} lb__text;
+LB_INTERNAL void lb__text_put(lb__text *b, const char *fmt, ...) LB_PRINTF(2, 3);
 LB_INTERNAL lb_status lb__check_k(const char *fn, size_t k, size_t kmin, size_t kmax,
                                   lb_error *err);
 LB_INTERNAL lb_status lb__check_finite(const char *fn, const char *name, size_t n, const double *v,

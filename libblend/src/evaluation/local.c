@@ -31,7 +31,6 @@
 #include "tape.h"
 
 #include <float.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -999,38 +998,24 @@ void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv 
 
 /* ---- description (blendtool info) ---- */
 
-typedef struct tbuf {
-    char *s;
-    size_t size, len;
-} tbuf;
-
-static void tput(tbuf *b, const char *fmt, ...) LB_PRINTF(2, 3);
-static void tput(tbuf *b, const char *fmt, ...) {
-    va_list ap;
-    va_start(ap, fmt);
-    const size_t room = b->len < b->size ? b->size - b->len : 0;
-    const int w = vsnprintf(room ? b->s + b->len : NULL, room, fmt, ap);
-    va_end(ap);
-    if (w > 0) b->len += (size_t)w;
-}
-
 size_t lb_evaluator_describe_local(const lb_evaluator *ev, char *buf, size_t size) {
-    tbuf b = {buf, buf ? size : 0, 0};
+    lb__text b = {buf, buf ? size : 0, 0};
     if (b.size) buf[0] = '\0';
     if (!ev) return 0;
     for (size_t i = 0; i < ev->n; ++i) {
         const lb__instr *in = &ev->ins[i];
         if (in->code != LB__I_OP || in->op.family != LB__F_LOCAL || !in->curves) continue;
         const struct lb__curves *C = in->curves;
-        tput(&b, "%s: %zu intersection curve%s, %zu vertices\n", in->op.path, C->ncomp,
-             C->ncomp == 1 ? "" : "s", C->nv);
+        lb__text_put(&b, "%s: %zu intersection curve%s, %zu vertices\n", in->op.path, C->ncomp,
+                     C->ncomp == 1 ? "" : "s", C->nv);
         for (size_t c = 0; c < C->ncomp; ++c) {
             const lb__component *K = &C->comp[c];
-            tput(&b,
-                 "  curve %zu: %s, %zu vertices, length %.6g, diameter %.6g, R %.6g, v1 %.6g, "
-                 "v2 %.6g, d1 %.6g, d2 %.6g\n",
-                 c, K->closed ? "closed" : "open", K->count, K->length, K->diameter, K->R, K->v1,
-                 K->v2, K->d1, K->d2);
+            lb__text_put(
+                &b,
+                "  curve %zu: %s, %zu vertices, length %.6g, diameter %.6g, R %.6g, v1 %.6g, "
+                "v2 %.6g, d1 %.6g, d2 %.6g\n",
+                c, K->closed ? "closed" : "open", K->count, K->length, K->diameter, K->R, K->v1,
+                K->v2, K->d1, K->d2);
         }
     }
     if (b.size && b.len >= b.size) buf[b.size - 1] = '\0';

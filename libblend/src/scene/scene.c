@@ -3,7 +3,6 @@
  * tested and benchmarked against). */
 #include "scene_internal.h"
 
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -59,94 +58,80 @@ void lb_scene_stats_get(const lb_scene *s, lb_scene_stats *st) {
 
 /* ---- describe ---- */
 
-typedef struct sbuf {
-    char *buf;
-    size_t size, len;
-} sbuf;
-
-static void put(sbuf *b, const char *fmt, ...) LB_PRINTF(2, 3);
-static void put(sbuf *b, const char *fmt, ...) {
-    va_list ap;
-    va_start(ap, fmt);
-    const size_t room = b->len < b->size ? b->size - b->len : 0;
-    int n = vsnprintf(room ? b->buf + b->len : NULL, room, fmt, ap);
-    va_end(ap);
-    if (n > 0) b->len += (size_t)n;
-}
-
-static void put_params(sbuf *b, const char *name, size_t k, const double *v) {
+static void put_params(lb__text *b, const char *name, size_t k, const double *v) {
     if (!v) return;
     int same = 1;
     for (size_t i = 1; i < k; ++i) same &= v[i] == v[0];
     if (same) {
-        put(b, " %s=%g", name, v[0]);
+        lb__text_put(b, " %s=%g", name, v[0]);
         return;
     }
-    put(b, " %s=[", name);
-    for (size_t i = 0; i < k; ++i) put(b, "%s%g", i ? "," : "", v[i]);
-    put(b, "]");
+    lb__text_put(b, " %s=[", name);
+    for (size_t i = 0; i < k; ++i) lb__text_put(b, "%s%g", i ? "," : "", v[i]);
+    lb__text_put(b, "]");
 }
 
 static const char *op_name(lb_setop op) {
     return op == LB_UNION ? "union" : op == LB_INTERSECTION ? "intersection" : "difference";
 }
 
-static void describe(sbuf *b, const lb__node *n, int indent, const char *role, const void **seen,
-                     size_t *nseen) {
-    put(b, "%*s%s", 2 * indent, "", role);
+static void describe(lb__text *b, const lb__node *n, int indent, const char *role,
+                     const void **seen, size_t *nseen) {
+    lb__text_put(b, "%*s%s", 2 * indent, "", role);
     if (n->def_name) {
         for (size_t i = 0; i < *nseen; ++i)
             if (seen[i] == n) {
-                put(b, "ref %s (shared, described above)\n", n->def_name);
+                lb__text_put(b, "ref %s (shared, described above)\n", n->def_name);
                 return;
             }
         seen[(*nseen)++] = n;
-        put(b, "[def %s] ", n->def_name);
+        lb__text_put(b, "[def %s] ", n->def_name);
     }
     if (n->family == LB__F_GROUP) {
-        put(b, "transform\n");
+        lb__text_put(b, "transform\n");
         describe(b, n->args[0], indent + 1, "", seen, nseen);
         return;
     }
-    put(b, "%s", n->type);
+    lb__text_put(b, "%s", n->type);
     if (n->family == LB__F_PRIMITIVE) {
         const lb_primitive *P = &n->prim;
         switch (P->kind) {
         case LB_PRIM_ELLIPSOID:
         case LB_PRIM_LP:
         case LB_PRIM_SUPERQUADRIC:
-            put(b, " center=(%g,%g,%g) semi_axes=(%g,%g,%g)", P->c[0], P->c[1], P->c[2], P->a[0],
-                P->a[1], P->a[2]);
+            lb__text_put(b, " center=(%g,%g,%g) semi_axes=(%g,%g,%g)", P->c[0], P->c[1], P->c[2],
+                         P->a[0], P->a[1], P->a[2]);
             break;
         case LB_PRIM_CAPSULE:
-            put(b, " start=(%g,%g,%g) end=(%g,%g,%g) radius=%g", P->c[0], P->c[1], P->c[2], P->q[0],
-                P->q[1], P->q[2], P->s0);
+            lb__text_put(b, " start=(%g,%g,%g) end=(%g,%g,%g) radius=%g", P->c[0], P->c[1], P->c[2],
+                         P->q[0], P->q[1], P->q[2], P->s0);
             break;
         default:
-            put(b, " point=(%g,%g,%g) direction=(%g,%g,%g)", P->c[0], P->c[1], P->c[2], P->n[0],
-                P->n[1], P->n[2]);
+            lb__text_put(b, " point=(%g,%g,%g) direction=(%g,%g,%g)", P->c[0], P->c[1], P->c[2],
+                         P->n[0], P->n[1], P->n[2]);
             break;
         }
         if (P->kernel != LB_KERNEL_NONE)
-            put(b, " kernel=%s", P->kernel == LB_KERNEL_WYVILL ? "wyvill" : "blinn");
+            lb__text_put(b, " kernel=%s", P->kernel == LB_KERNEL_WYVILL ? "wyvill" : "blinn");
     } else {
         if (n->family == LB__F_DISPLACEMENT || n->family == LB__F_CONIC ||
             n->family == LB__F_SCALE || n->family == LB__F_BOUNDED ||
             n->family == LB__F_SOFT_HYPER || n->family == LB__F_SOFT_CONIC ||
             n->family == LB__F_PERLIN || n->family == LB__F_RFUNCTION)
-            put(b, " %s", op_name(n->op));
-        put(b, " k=%zu", n->k);
+            lb__text_put(b, " %s", op_name(n->op));
+        lb__text_put(b, " k=%zu", n->k);
         put_params(b, "r", n->k, n->r);
         put_params(b, "p", n->k, n->p);
         put_params(b, "m", n->k, n->m);
-        if (n->family == LB__F_CONIC || n->family == LB__F_SOFT_CONIC) put(b, " p=%g", n->shape);
-        if (n->family == LB__F_RICCI) put(b, " n=%g", n->shape);
+        if (n->family == LB__F_CONIC || n->family == LB__F_SOFT_CONIC)
+            lb__text_put(b, " p=%g", n->shape);
+        if (n->family == LB__F_RICCI) lb__text_put(b, " n=%g", n->shape);
         if (n->bulge)
-            put(b, " bulge(%s%s omega=%g)", n->bp.flags & LB_BULGE_RANGE ? "range " : "",
-                n->bp.flags & LB_BULGE_SLOPE ? "slope" : "", n->bp.omega);
+            lb__text_put(b, " bulge(%s%s omega=%g)", n->bp.flags & LB_BULGE_RANGE ? "range " : "",
+                         n->bp.flags & LB_BULGE_SLOPE ? "slope" : "", n->bp.omega);
     }
-    if (n->has_transform) put(b, " +transform");
-    put(b, "\n");
+    if (n->has_transform) lb__text_put(b, " +transform");
+    lb__text_put(b, "\n");
     for (size_t i = 0; i < n->k && n->family != LB__F_PRIMITIVE; ++i) {
         describe(b, n->args[i], indent + 1, "", seen, nseen);
         if (n->bounds) describe(b, n->bounds[i], indent + 2, "bound: ", seen, nseen);
@@ -155,7 +140,7 @@ static void describe(sbuf *b, const lb__node *n, int indent, const char *role, c
 
 size_t lb_scene_describe(const lb_scene *s, char *buf, size_t size) {
     if (!buf) size = 0; /* a NULL buffer with any size only measures */
-    sbuf b = {buf, size, 0};
+    lb__text b = {buf, size, 0};
     if (buf && size) buf[0] = '\0';
     if (!s || !s->root) return 0;
     const void **seen = calloc(s->nnodes + 1, sizeof *seen);
