@@ -9,8 +9,9 @@
  * step. Stops when
  * |phi| <= 1e-7 h |grad phi| (the vertex is within 1e-7 cell sizes of the
  * surface to first order) or when the bracket is below 1e-12 of the edge;
- * or takes one last Newton step unevaluated when a curvature bound from the
- * normals makes its error below 1e-9 h (see the loop). The normal is the
+ * or takes one last Newton step unevaluated when bounds on the curvature
+ * (from the normals) and on the change of the slope along the edge (from
+ * the end slopes) make its error below 1e-9 h (see the loop). The normal is the
  * gradient at the last evaluated point. */
 #include "mesh_internal.h"
 
@@ -168,8 +169,17 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
                     if (sqrt(dn) > kap) kap = sqrt(dn);
                 }
                 kap = 4.0 * kap / L;
+                /* the slope along the edge may change too (fields whose
+                 * gradient length varies, as blends' do): phi'' from the
+                 * end slopes and this one, with the same safety factor */
+                const double s0 = (G[0][0] * e[0] + G[0][1] * e[1] + G[0][2] * e[2]) / L,
+                             s1 = (G[1][0] * e[0] + G[1][1] * e[1] + G[1][2] * e[2]) / L,
+                             sh = dt / L;
+                const double M =
+                    4.0 * fmax(fabs(sh - s0) / (t[i] * L), fabs(s1 - sh) / ((1.0 - t[i]) * L));
                 const double step = fabs(tn - t[i]) * L;
-                if (0.5 * kap * step * step <= 0.01 * tol && kap * step <= 1e-6) {
+                if (0.5 * kap * step * step <= 0.01 * tol && kap * step <= 1e-6 &&
+                    0.5 * M * step * step <= 0.01 * tol * fabs(sh)) {
                     for (int d = 0; d < 3; ++d) {
                         pos[3 * i + d] = A[d] + tn * e[d];
                         nrm[3 * i + d] = gp[d] / gl;
