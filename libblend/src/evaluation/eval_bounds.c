@@ -253,10 +253,20 @@ static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const 
         return; /* exact */
     } else if (n->family == LB__F_PERLIN && any_above_one(x, k)) {
         /* Perlin's products are monotone only on [0, 1]: an argument a soft
-         * union took above 1 flips a factor's sign. No information then. */
-        out->lo = 0.0;
-        out->hi = BIG;
-        return;
+         * union took above 1 flips a factor's sign. Interval products then
+         * (sound, and exact for points): union 1 - prod(1 - f_i),
+         * intersection prod f_i, difference f_0 prod_{i>0} (1 - f_i). */
+        iv P = {1.0, 1.0};
+        for (size_t i = 0; i < k; ++i) {
+            const int flip = n->op == LB_UNION || (n->op == LB_DIFFERENCE && i > 0);
+            const iv f = flip ? (iv){1.0 - x[i].hi, 1.0 - x[i].lo} : x[i];
+            const double a = P.lo * f.lo, b = P.lo * f.hi, c2 = P.hi * f.lo, d = P.hi * f.hi;
+            P.lo = fmin(fmin(a, b), fmin(c2, d));
+            P.hi = fmax(fmax(a, b), fmax(c2, d));
+        }
+        if (n->op == LB_UNION) P = (iv){1.0 - P.hi, 1.0 - P.lo};
+        out->lo = P.lo > 0.0 ? P.lo : 0.0;
+        out->hi = P.hi > 0.0 ? P.hi : 0.0;
     } else {
         double xl[LB_MAX_ARITY], xh[LB_MAX_ARITY], v1 = 0.0, v2 = 0.0;
         for (size_t i = 0; i < k; ++i) {
