@@ -722,6 +722,13 @@ static lb_status fold_local(pctx *c, lb__node *n) {
     for (size_t i = 1; i + 1 < n->k; ++i) {
         lb__node *m = new_node(c, n->family, n->type);
         if (!m) return oom(c);
+        /* the fold's inner node: named by the arguments it unites */
+        const size_t pl = strlen(m->path) + 32;
+        char *path = malloc(pl);
+        if (!path) return oom(c);
+        snprintf(path, pl, "%s (args 0-%zu)", m->path, i);
+        free(m->path);
+        m->path = path;
         m->lp = n->lp;
         m->k = 2;
         m->args = malloc(2 * sizeof *m->args);
