@@ -516,6 +516,93 @@ static void primitive_cases(rng *g) {
     }
 }
 
+/* one evaluation of a scalar expression (the include's scalar functions) */
+static void record_expr(const char *fam, const char *expr, double value) {
+    if (ncases >= MAXCASES) abort();
+    fprintf(pov, "#write (FO, str(%s, 0, 17), \"\\n\")\n", expr);
+    family[ncases] = fam;
+    expect[ncases++] = value;
+}
+
+/* a soft value: inside, outside, on the iso value, zero, or above 1 */
+static double soft_value(rng *g) {
+    const double u = unit(g);
+    return u < 0.1 ? 0.5 : u < 0.15 ? 0.0 : u < 0.2 ? range(g, 1.0, 2.0) : unit(g);
+}
+
+/* The clean unions, Barthe's blend and the local mix against
+ * lb_clean_union, lb_barthe_blend and lb_local_mix. */
+static void local_cases(rng *g) {
+    static const char *const fams[4] = {"clean union UR", "clean union UC2", "clean union UC3",
+                                        "clean union UC"};
+    static const char *const fns[4] = {"lb_clean_ur", "lb_clean_uc2", "lb_clean_uc3",
+                                       "lb_clean_uc"};
+    char e[512];
+    for (int kind = LB_CLEAN_UR; kind <= LB_CLEAN_UC; ++kind)
+        for (int i = 0; i < 1200; ++i) {
+            double f[2] = {soft_value(g), soft_value(g)};
+            if (i % 10 == 0) f[1] = f[0]; /* the diagonal */
+            const double C = i % 3 ? 0.5 : range(g, 0.1, 0.9);
+            const double al[2] = {i % 2 ? 0.0 : range(g, 0.0, 0.95),
+                                  i % 2 ? 0.0 : range(g, 0.0, 0.95)};
+            double v = 0.0;
+            if (lb_clean_union((lb_clean_kind)kind, f, C, al, &v, NULL, NULL)) abort();
+            if (kind == LB_CLEAN_UR)
+                snprintf(e, sizeof e, "lb_clean_ur(%.17g, %.17g)", f[0], f[1]);
+            else if (kind == LB_CLEAN_UC2)
+                snprintf(e, sizeof e, "lb_clean_uc2(%.17g, %.17g, %.17g)", f[0], f[1], C);
+            else
+                snprintf(e, sizeof e, "%s(%.17g, %.17g, %.17g, %.17g, %.17g)", fns[kind], f[0],
+                         f[1], C, al[0], al[1]);
+            record_expr(fams[kind], e, v);
+        }
+    for (int i = 0; i < 1200; ++i) {
+        const double x[2] = {range(g, -0.2, 1.5), range(g, -0.2, 1.5)};
+        const double p = i % 5 ? range(g, 0.0, LB_BARTHE_MAX_PQ) : 0.0;
+        const double q = i % 7 ? range(g, 0.0, LB_BARTHE_MAX_PQ) : 0.0;
+        double v = 0.0;
+        if (lb_barthe_blend(x, p, q, &v, NULL, NULL)) abort();
+        snprintf(e, sizeof e, "lb_barthe(%.17g, %.17g, %.17g, %.17g)", x[0], x[1], p, q);
+        record_expr("Barthe UB", e, v);
+    }
+    for (int i = 0; i < 1200; ++i) {
+        const double uc = unit(g), ub = uc + 0.3 * unit(g);
+        const double v = i % 9 ? unit(g) : i % 2 ? 0.0 : 1.0, n = i % 4 ? range(g, 1.0, 8.0) : 1.0;
+        double u = 0.0;
+        if (lb_local_mix(uc, ub, v, n, &u, NULL, NULL)) abort();
+        snprintf(e, sizeof e, "lb_local_mix(%.17g, %.17g, %.17g, %.17g)", uc, ub, v, n);
+        record_expr("local mix", e, u);
+    }
+    /* the clean-union macros over argument functions: soft, and zero
+     * convention through g = 0.5 (1 - f / s) and back */
+    for (int i = 0; i < 200; ++i) {
+        const double a[2] = {range(g, -1, 1), range(g, -1, 1)},
+                     b[2] = {range(g, 0.0, 1.0), range(g, 0.0, 1.0)};
+        const double al[2] = {i % 2 ? 0.0 : range(g, 0.0, 0.9), i % 2 ? 0.0 : range(g, 0.0, 0.9)};
+        const int zero = i % 2;
+        const double s = zero ? range(g, 0.2, 3.0) : 1.0;
+        fprintf(pov,
+                "#ifdef (CU) #undef CU #undef CA #undef CB #end\n"
+                "#declare CA = function(x, y, z) { x * %.17g + %.17g }\n"
+                "#declare CB = function(x, y, z) { x * %.17g + %.17g }\n",
+                a[0], b[0], a[1], b[1]);
+        if (zero)
+            fprintf(pov, "#declare CU = LB_CleanUnionZero(CA, CB, %.17g, %.17g, %.17g)\n", al[0],
+                    al[1], s);
+        else
+            fprintf(pov, "#declare CU = LB_CleanUnion(CA, CB, %.17g, %.17g)\n", al[0], al[1]);
+        for (int j = 0; j < 5; ++j) {
+            const double X = range(g, -1, 1);
+            double f[2] = {a[0] * X + b[0], a[1] * X + b[1]}, u = 0.0;
+            if (zero)
+                for (int k = 0; k < 2; ++k) f[k] = 0.5 * (1.0 - f[k] / s);
+            if (lb_clean_union(LB_CLEAN_UC, f, 0.5, al, &u, NULL, NULL)) abort();
+            record(zero ? "clean union macro, zero" : "clean union macro, soft", "CU", X, 0.0, 0.0,
+                   zero ? s * (1.0 - u / 0.5) : fmax(0.0, u));
+        }
+    }
+}
+
 int main(int argc, char **argv) {
     if (argc != 3) {
         fprintf(stderr, "usage: test_pov_agreement SOURCE_DIR WORK_DIR\n");
@@ -541,6 +628,7 @@ int main(int argc, char **argv) {
     bulge_cases(&g);
     classic_cases(&g);
     primitive_cases(&g);
+    local_cases(&g);
     fprintf(pov, "#fclose FO\n");
     fclose(pov);
     remove(outp);

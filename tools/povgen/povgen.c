@@ -1267,6 +1267,84 @@ static void displacement(int steps) {
     w(") }\n  #end\n#end\n\n");
 }
 
+/* Local blending [bernhardt2010; docs/local-blending.md]: the clean unions,
+ * Barthe's UB and the interpolation as scalar functions, mirroring
+ * operators/local.c formula for formula (soft convention, iso value C);
+ * the node macros and the blending-volume distance helpers the exporter
+ * calls. */
+static void local_blend(void) {
+    w("// ---- local blending (soft convention, iso value C; docs/local-blending.md) ----\n\n");
+    w("// Rvachev's UR(x, y) = x + y + sqrt(x^2 + y^2)\n"
+      "#declare lb_clean_ur = function(lbLx, lbLy) { lbLx + lbLy + sqrt(lbLx * lbLx + lbLy * lbLy) "
+      "}\n");
+    w("// UC2 = C + UR(f1 - C, f2 - C) / (2 - sqrt 2): C on the union surface\n"
+      "#declare lb_clean_uc2 = function(lbLf1, lbLf2, lbLC) { lbLC + lb_clean_ur(lbLf1 - lbLC, "
+      "lbLf2 - lbLC) / %.17g }\n",
+      2.0 - sqrt(2.0));
+    w("// the weight delta_c of u = f1 - a1 f2, v = f2 - a2 f1: 0 unless both > %.17g\n"
+      "#declare lb_clean_w2 = function(lbLu, lbLv) { select(min(lbLu, lbLv) - %.17g, 0, 0, "
+      "pow(4 * (lbLu / (lbLu + lbLv)) * (lbLv / (lbLu + lbLv)), 4)) }\n"
+      "#declare lb_clean_w = function(lbLf1, lbLf2, lbLa1, lbLa2) { lb_clean_w2(lbLf1 - lbLa1 * "
+      "lbLf2, lbLf2 - lbLa2 * lbLf1) }\n",
+      LB_SOFT_MIN_FIELD, LB_SOFT_MIN_FIELD);
+    w("// UC3 = max + w (UC2 - max)\n"
+      "#declare lb_clean_uc3 = function(lbLf1, lbLf2, lbLC, lbLa1, lbLa2) { max(lbLf1, lbLf2) + "
+      "lb_clean_w(lbLf1, lbLf2, lbLa1, lbLa2) * (lb_clean_uc2(lbLf1, lbLf2, lbLC) - max(lbLf1, "
+      "lbLf2)) }\n");
+    w("// UC's V: UC2 outside both, C + |(f1 - C, f2 - C)| inside both, max elsewhere\n"
+      "#declare lb_clean_v = function(lbLf1, lbLf2, lbLC) { select(max(lbLf1, lbLf2) - lbLC, "
+      "lb_clean_uc2(lbLf1, lbLf2, lbLC), select(min(lbLf1, lbLf2) - lbLC, max(lbLf1, lbLf2), "
+      "lbLC + sqrt(pow(lbLf1 - lbLC, 2) + pow(lbLf2 - lbLC, 2)))) }\n"
+      "// the final clean union UC = max + w (V - max): exact union surface, no inner contraction\n"
+      "#declare lb_clean_uc = function(lbLf1, lbLf2, lbLC, lbLa1, lbLa2) { max(lbLf1, lbLf2) + "
+      "lb_clean_w(lbLf1, lbLf2, lbLa1, lbLa2) * (lb_clean_v(lbLf1, lbLf2, lbLC) - max(lbLf1, "
+      "lbLf2)) }\n\n");
+    w("// Barthe's UB(x, y; p, q): max outside the wedge q x < y, p y < x, else the\n"
+      "// rationalised root D / (B + sqrt(B^2 - A D)) of the level's quarter ellipse\n"
+      "#declare lb_barthe_r = function(lbLA, lbLB, lbLD) { lbLD / (lbLB + sqrt(max(0, lbLB * lbLB "
+      "- lbLA * lbLD))) }\n"
+      "#declare lb_barthe_in = function(lbLx, lbLy, lbLp, lbLq) { lb_barthe_r(pow(1 - lbLq, 2) * "
+      "lbLp * lbLp + pow(1 - lbLp, 2) * lbLq * lbLq - pow(1 - lbLp, 2) * pow(1 - lbLq, 2), "
+      "pow(1 - lbLq, 2) * lbLp * lbLx + pow(1 - lbLp, 2) * lbLq * lbLy, pow(1 - lbLq, 2) * lbLx * "
+      "lbLx + pow(1 - lbLp, 2) * lbLy * lbLy) }\n"
+      "#declare lb_barthe = function(lbLx, lbLy, lbLp, lbLq) { select(min(lbLy - lbLq * lbLx, "
+      "lbLx - lbLp * lbLy), max(lbLx, lbLy), max(lbLx, lbLy), lb_barthe_in(lbLx, lbLy, lbLp, "
+      "lbLq)) }\n\n");
+    w("// U = (1 - beta) UC + beta UB, beta = v^n (0 <= v <= 1, n >= 1)\n"
+      "#declare lb_local_mixb = function(lbLuc, lbLub, lbLb) { lbLuc + lbLb * (lbLub - lbLuc) }\n"
+      "#declare lb_local_mix = function(lbLuc, lbLub, lbLv, lbLn) { lb_local_mixb(lbLuc, lbLub, "
+      "pow(max(0, lbLv), lbLn)) }\n"
+      "// the blending volume's field: Wyvill's kernel of a = distance / R (0 for a >= 1)\n"
+      "#declare lb_local_kernel = function(lbLa) { select(lbLa - 1, 1 + lbLa * lbLa * (-4 / 9 * "
+      "pow(lbLa, 4) + 17 / 9 * lbLa * lbLa - 22 / 9), 0) }\n"
+      "// one component's blend at a = distance / R: UC where a >= 1\n"
+      "#declare lb_local_at = function(lbLg1, lbLg2, lbLa, lbLp, lbLq, lbLn, lbLuc) { "
+      "select(lbLa - 1, lb_local_mix(lbLuc, lb_barthe(lbLg1, lbLg2, lbLp, lbLq), "
+      "lb_local_kernel(lbLa), lbLn), lbLuc) }\n\n");
+    w("// blending-volume distances (the exporter writes each curve's hierarchy of\n"
+      "// boxes and segments with these): squared distance to a box, to a segment\n"
+      "// from A along D (IL = 1 / |D|^2, 0 for a point)\n"
+      "#declare lb_box2 = function(lbLx, lbLy, lbLz, lbLlx, lbLly, lbLlz, lbLhx, lbLhy, lbLhz) { "
+      "pow(max(lbLlx - lbLx, 0, lbLx - lbLhx), 2) + pow(max(lbLly - lbLy, 0, lbLy - lbLhy), 2) + "
+      "pow(max(lbLlz - lbLz, 0, lbLz - lbLhz), 2) }\n"
+      "#declare lb_seg2t = function(lbLx, lbLy, lbLz, lbLdx, lbLdy, lbLdz, lbLt) { pow(lbLx - lbLt "
+      "* lbLdx, 2) + pow(lbLy - lbLt * lbLdy, 2) + pow(lbLz - lbLt * lbLdz, 2) }\n"
+      "#declare lb_seg2r = function(lbLx, lbLy, lbLz, lbLdx, lbLdy, lbLdz, lbLil) { "
+      "lb_seg2t(lbLx, lbLy, lbLz, lbLdx, lbLdy, lbLdz, min(1, max(0, (lbLx * lbLdx + lbLy * lbLdy "
+      "+ lbLz * lbLdz) * lbLil))) }\n"
+      "#declare lb_seg2 = function(lbLx, lbLy, lbLz, lbLax, lbLay, lbLaz, lbLdx, lbLdy, lbLdz, "
+      "lbLil) { lb_seg2r(lbLx - lbLax, lbLy - lbLay, lbLz - lbLaz, lbLdx, lbLdy, lbLdz, lbLil) "
+      "}\n\n");
+    w("// A clean union of two soft fields (iso 0.5) as a function(x, y, z); A1, A2 the\n"
+      "// convolution weights (0 for finite support)\n"
+      "#macro LB_CleanUnion(F1, F2, A1, A2)\n"
+      "  function(x, y, z) { max(0, lb_clean_uc(F1(x, y, z), F2(x, y, z), 0.5, A1, A2)) }\n#end\n"
+      "// the same for zero-convention fields, mapped to g = 0.5 (1 - f / S) and back\n"
+      "#macro LB_CleanUnionZero(F1, F2, A1, A2, S)\n"
+      "  function(x, y, z) { S * (1 - lb_clean_uc(0.5 * (1 - F1(x, y, z) / S), 0.5 * (1 - F2(x, "
+      "y, z) / S), 0.5, A1, A2) / 0.5) }\n#end\n\n");
+}
+
 int main(int argc, char **argv) {
     if (argc != 2) {
         fprintf(stderr, "usage: povgen OUT.inc\n");
@@ -1293,6 +1371,7 @@ int main(int argc, char **argv) {
     soft_hyper(ssteps);
     soft_conic(csteps);
     bulge(steps);
+    local_blend();
     w("#version LB_INC_TEMP;\n#end\n");
     if (fclose(out) != 0 || rename(tmp, argv[1]) != 0) {
         perror(argv[1]);
