@@ -7,6 +7,8 @@
 
 #include "scenelist.h"
 
+#include "../libblend/src/evaluation/tape.h"
+
 static int setup(void **state) {
     (void)state;
     return collect_scenes();
@@ -56,6 +58,26 @@ static size_t make_points(const loaded *L, rng_t *g, size_t nrand, size_t grid, 
 #define NG 24
 #define NP (NR + NG * NG * NG)
 
+/* scenes with local unions: the first random points go near the curves'
+ * vertices (within each component's support R), where the blend acts */
+static size_t near_curves(const loaded *L, rng_t *g, size_t n, double *x, double *y, double *z) {
+    size_t m = 0;
+    for (size_t w = 0; m < n; ++w) {
+        const struct lb__curves *C = lb__local_nth(L->ev, w);
+        if (!C) break;
+        for (size_t c = 0; c < C->ncomp && m < n; ++c) {
+            const lb__component *K = &C->comp[c];
+            for (size_t i = 0; i < 120 && m < n; ++i, ++m) {
+                const double *P = C->pts + 3 * (K->first + rng_int(g, 0, K->count - 1));
+                x[m] = P[0] + rng_range(g, -1.2, 1.2) * K->R;
+                y[m] = P[1] + rng_range(g, -1.2, 1.2) * K->R;
+                z[m] = P[2] + rng_range(g, -1.2, 1.2) * K->R;
+            }
+        }
+    }
+    return m;
+}
+
 static double X[NP], Y[NP], Z[NP], V[NP], GX[NP], GY[NP], GZ[NP];
 static double V2[NP], GX2[NP], GY2[NP], GZ2[NP];
 
@@ -70,13 +92,14 @@ static void test_compiled_matches_reference(void **state) {
         loaded L;
         load(scene_paths[s], &L);
         const size_t n = make_points(&L, &g, NR, NG, X, Y, Z);
+        near_curves(&L, &g, NR / 2, X, Y, Z);
         lb_error e = {LB_OK, ""};
         if (lb_evaluator_eval(L.ev, n, X, Y, Z, V, GX, GY, GZ, 1, &e))
             fail_msg("%s: %s", scene_paths[s], e.message);
         for (size_t i = 0; i < n; ++i) {
             const double P[3] = {X[i], Y[i], Z[i]};
             double v, gr[3];
-            if (lb_scene_eval_reference(L.sc, P, &v, gr, &e))
+            if (lb__scene_eval_walk(L.sc, L.ev, P, &v, gr, &e))
                 fail_msg("%s: %s", scene_paths[s], e.message);
             const double gc[3] = {GX[i], GY[i], GZ[i]};
             int ok = fabs(V[i] - v) <= 1e-11 * (1.0 + fabs(v));

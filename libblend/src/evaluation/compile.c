@@ -298,6 +298,8 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
     } else {
         int fail = 0;
         in->code = LB__I_OP;
+        in->A = A; /* world -> this node's frame (the POV-Ray export of local blends) */
+        in->node = n;
         in->op = *n;
         in->op.args = in->op.bounds = NULL;
         in->op.r = dup_array(n->r, n->k, &fail);

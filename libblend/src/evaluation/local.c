@@ -966,6 +966,31 @@ void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv 
         hi[a] = g[0] < g[1] ? g[1] : g[0];
     }
     const double C = LB__LOCAL_ISO, K = 2.0 - sqrt(2.0);
+    const double w0 = hi[0] - lo[0], w1 = hi[1] - lo[1];
+    if (br[0] == 0.0 && br[1] == 0.0 && br[2] == 0.0 && w0 <= 1e-9 * (1.0 + fabs(lo[0])) &&
+        w1 <= 1e-9 * (1.0 + fabs(lo[1]))) {
+        /* a point, its children known to rounding: the value at the middle,
+         * padded by the slope times the children's widths (the tests' point
+         * boxes are exact; the hull below is for boxes) */
+        const double m[2] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])};
+        double gu[2], gb[2], u = lb__clean_eval(LB_CLEAN_UC, m, C, nd->lp.alpha, gu);
+        double slope = fabs(gu[0]) * w0 + fabs(gu[1]) * w1;
+        uint32_t c = 0;
+        double Q[3], dist = 0.0;
+        const double a = nd->family == LB__F_LOCAL ? nearest(in->curves, bc, &c, Q, &dist) : 1.0;
+        if (a < 1.0) {
+            const lb__component *P = &in->curves->comp[c];
+            double dw, gm[3];
+            const double ub = lb__barthe_eval(m, P->p, P->q, gb);
+            slope += fabs(gb[0]) * w0 + fabs(gb[1]) * w1;
+            if (lb_local_mix(u, ub, wyvill(a, &dw), nd->lp.exponent, &u, gm, NULL)) u = ub;
+        }
+        const double pad = 2.0 * slope + 1e-12 * (1.0 + fabs(u));
+        const double o1 = lb__local_out(nd, conv, u - pad), o2 = lb__local_out(nd, conv, u + pad);
+        out->lo = o1 < o2 ? o1 : o2;
+        out->hi = o1 < o2 ? o2 : o1;
+        return;
+    }
     /* max is always among the convex combination's ends */
     double ulo = lo[0] > lo[1] ? lo[0] : lo[1], uhi = hi[0] > hi[1] ? hi[0] : hi[1];
     if (ulo < C) { /* outside both can occur: UC2 is increasing in both */

@@ -30,7 +30,7 @@ typedef struct lb__instr {
     uint32_t dst; /* output register */
     /* primitives */
     lb_primitive prim;
-    lb__affine A; /* world -> primitive frame */
+    lb__affine A; /* world -> primitive frame (operators: -> the node's frame) */
     int identity;
     /* operators: a copy of the node (args/bounds NULL) and source registers */
     lb__node op;
@@ -43,6 +43,7 @@ typedef struct lb__instr {
     uint32_t ncone[2];
     double cost;               /* instruction runs per point, reruns included (the cost model) */
     struct lb__curves *curves; /* local_union: intersection curves, blending volumes */
+    const lb__node *node;      /* the scene node (compared, never followed: exports) */
     int fast;                  /* LB__FAST_* */
     int mode;                  /* exponent mode for the fast kernels */
     double lip;                /* primitives: Lipschitz factor of rho in the primitive frame */
@@ -138,6 +139,13 @@ LB_INTERNAL lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in,
 /* An interval containing the node over the box, from its children's. */
 LB_INTERNAL void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv x[2],
                                   const double bc[3], const double br[3], lb__iv *out);
+
+/* The reference walk (lb_scene_eval_reference) that also walks local
+ * unions: inside their blending volumes it takes the curves ev (compiled
+ * from s) found, by brute force over every segment (tests). */
+LB_INTERNAL lb_status lb__scene_eval_walk(const lb_scene *s, const lb_evaluator *ev,
+                                          const double X[3], double *value, double grad[3],
+                                          lb_error *err);
 
 /* lb_evaluator_bounds without its coordinate limit: the mesher's closing
  * layer lies half a cell beyond a region that may reach the limit. */
