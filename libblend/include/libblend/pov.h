@@ -11,6 +11,11 @@
  * LBn1, ...) and user text appears only in comments, stripped of anything
  * but printable ASCII.
  *
+ * Local unions: each use (node and world frame) is written with its
+ * blending volumes as data, the curve's segments in a tree of functions
+ * mirroring the evaluator's box hierarchy, so POV-Ray's field equals the
+ * evaluator's to rounding; clean unions are one call of lb_clean_uc.
+ *
  * Limits of the include: displacement blends take any number of arguments
  * (past LB_POV_MAX_ARITY each solver step evaluates the arguments again, so
  * they render slower); scale, bounded and soft hyper blends take at most

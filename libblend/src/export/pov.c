@@ -2,7 +2,7 @@
  * functions built with povray_include/libblend.inc, one isosurface, camera,
  * lights and material. */
 #define _POSIX_C_SOURCE 200809L
-#include "../scene/scene_internal.h"
+#include "../evaluation/tape.h"
 #include "libblend/output.h"
 
 #include <libblend/pov.h>
@@ -70,8 +70,39 @@ typedef struct pctx {
     size_t ndone, cap;
     int next;
     double eps; /* central-difference step of the bulge macros */
+    const lb_evaluator *ev;
+    lb__affine A;            /* world -> the parent frame of the node being written */
+    lb__affine *doneA;       /* the frame each written node was written for */
+    const lb__node **lnodes; /* nodes known to hold a local_union (or not: lflag) */
+    int *lflag;
+    size_t nl, lcap;
     lb_error *err;
 } pctx;
+
+/* Does the subtree hold a local_union? (memoised: scenes are DAGs) Such
+ * subtrees are written once per world frame they are used in, because each
+ * use has blending volumes of its own. */
+static int has_local(pctx *c, const lb__node *n) {
+    if (n->family == LB__F_LOCAL) return 1;
+    if (n->family == LB__F_PRIMITIVE) return 0;
+    for (size_t i = 0; i < c->nl; ++i)
+        if (c->lnodes[i] == n) return c->lflag[i];
+    int f = 0;
+    for (size_t i = 0; i < n->k && !f; ++i)
+        f = has_local(c, n->args[i]) || (n->bounds && has_local(c, n->bounds[i]));
+    if (c->nl == c->lcap) {
+        const size_t nc = c->lcap ? 2 * c->lcap : 64;
+        const lb__node **a = realloc(c->lnodes, nc * sizeof *a);
+        if (a) c->lnodes = a;
+        int *q = a ? realloc(c->lflag, nc * sizeof *q) : NULL;
+        if (q) c->lflag = q;
+        if (!a || !q) return f; /* not remembered: found again next time */
+        c->lcap = nc;
+    }
+    c->lnodes[c->nl] = n;
+    c->lflag[c->nl++] = f;
+    return f;
+}
 
 static void arr(sbuf *b, size_t k, const double *v, double fallback) {
     sb(b, "array[%zu] {", k);
@@ -93,24 +124,213 @@ static lb_status emit_args(pctx *c, const lb__node *n, lb__node *const *args, in
     return LB_OK;
 }
 
+/* ---- local_union: the blending volumes as data, distances unrolled ----
+ *
+ * Each component's blending volume becomes a tree of functions mirroring
+ * the evaluator's hierarchy of segment boxes: a node returns
+ * a = distance / R clamped at 1, and skips its subtree (select is lazy in
+ * POV-Ray) when its box is R or farther from the point. The node's value
+ * then picks the component with the smallest a, as the evaluator does. */
+
+/* does the subtree under node i hold a segment of component k? */
+static int bvh_has(const struct lb__curves *C, uint32_t i, size_t k) {
+    const bvh_node *N = &C->bvh[i];
+    if (!N->leaf) return bvh_has(C, N->left, k) || bvh_has(C, N->right, k);
+    for (uint32_t j = 0; j < N->right; ++j)
+        if (C->segc[N->left + j] == k) return 1;
+    return 0;
+}
+
+/* declares the function of node i for component k; *fn receives its number */
+static void bvh_emit(pctx *c, const struct lb__curves *C, uint32_t i, size_t k, int id, int *next,
+                     int *fn) {
+    const bvh_node *N = &C->bvh[i];
+    const double R = C->comp[k].R;
+    sbuf *b = c->b;
+    if (!N->leaf) {
+        const int l = bvh_has(C, N->left, k), r = bvh_has(C, N->right, k);
+        int fl = -1, fr = -1;
+        if (l) bvh_emit(c, C, N->left, k, id, next, &fl);
+        if (r) bvh_emit(c, C, N->right, k, id, next, &fr);
+        if (!l || !r) { /* one side only: its function is this node's */
+            *fn = l ? fl : fr;
+            return;
+        }
+        *fn = (*next)++;
+        sb(b,
+           "#declare LBv%d_%d = function(x, y, z) { select(lb_box2(x, y, z, %.17g, %.17g, %.17g, "
+           "%.17g, %.17g, %.17g) - %.17g, min(LBv%d_%d(x, y, z), LBv%d_%d(x, y, z)), 1) }\n",
+           id, *fn, N->lo[0], N->lo[1], N->lo[2], N->hi[0], N->hi[1], N->hi[2], R * R, id, fl, id,
+           fr);
+        return;
+    }
+    *fn = (*next)++;
+    sb(b,
+       "#declare LBv%d_%d = function(x, y, z) { select(lb_box2(x, y, z, %.17g, %.17g, %.17g, "
+       "%.17g, %.17g, %.17g) - %.17g, min(1, sqrt(min(1e300",
+       id, *fn, N->lo[0], N->lo[1], N->lo[2], N->hi[0], N->hi[1], N->hi[2], R * R);
+    for (uint32_t j = 0; j < N->right; ++j) {
+        const uint32_t sg = N->left + j;
+        if (C->segc[sg] != k) continue;
+        const double *pa = C->pts + 3 * C->seg[2 * sg], *pb = C->pts + 3 * C->seg[2 * sg + 1];
+        const double dx = pb[0] - pa[0], dy = pb[1] - pa[1], dz = pb[2] - pa[2];
+        const double ll = dx * dx + dy * dy + dz * dz;
+        sb(b, ", lb_seg2(x, y, z, %.17g, %.17g, %.17g, %.17g, %.17g, %.17g, %.17g)", pa[0], pa[1],
+           pa[2], dx, dy, dz, ll > 0.0 ? 1.0 / ll : 0.0);
+    }
+    sb(b, ")) / %.17g), 1) }\n", R);
+}
+
+/* the inverse of y = M x + t */
+static int affine_invert(const lb__affine *A, lb__affine *I) {
+    const double *m = A->M;
+    const double c00 = m[4] * m[8] - m[5] * m[7], c01 = m[5] * m[6] - m[3] * m[8],
+                 c02 = m[3] * m[7] - m[4] * m[6];
+    const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+    if (!(fabs(det) > 0.0)) return -1;
+    const double id = 1.0 / det;
+    double *o = I->M;
+    o[0] = c00 * id;
+    o[1] = (m[2] * m[7] - m[1] * m[8]) * id;
+    o[2] = (m[1] * m[5] - m[2] * m[4]) * id;
+    o[3] = c01 * id;
+    o[4] = (m[0] * m[8] - m[2] * m[6]) * id;
+    o[5] = (m[2] * m[3] - m[0] * m[5]) * id;
+    o[6] = c02 * id;
+    o[7] = (m[1] * m[6] - m[0] * m[7]) * id;
+    o[8] = (m[0] * m[4] - m[1] * m[3]) * id;
+    for (int r = 0; r < 3; ++r)
+        I->t[r] = -(o[3 * r] * A->t[0] + o[3 * r + 1] * A->t[1] + o[3 * r + 2] * A->t[2]);
+    return 0;
+}
+
+static lb_status emit_local(pctx *c, const lb__node *n, int id, const char *name, int a, int d) {
+    sbuf *b = c->b;
+    const int zero = c->sc->convention == LB_CONVENTION_ZERO;
+    const double S = n->lp.zero_scale, *al = n->lp.alpha;
+    char in1[128], in2[128];
+    if (zero) {
+        snprintf(in1, sizeof in1, "0.5 * (1 - LBn%d(x, y, z) / %.17g)", a, S);
+        snprintf(in2, sizeof in2, "0.5 * (1 - LBn%d(x, y, z) / %.17g)", d, S);
+    } else {
+        snprintf(in1, sizeof in1, "LBn%d(x, y, z)", a);
+        snprintf(in2, sizeof in2, "LBn%d(x, y, z)", d);
+    }
+    /* this use's instruction: the node in this world frame */
+    const lb__instr *ins = NULL;
+    for (size_t i = 0; n->family == LB__F_LOCAL && c->ev && i < c->ev->n && !ins; ++i) {
+        const lb__instr *q = &c->ev->ins[i];
+        if (q->code == LB__I_OP && q->node == n && memcmp(&q->A, &c->A, sizeof c->A) == 0) ins = q;
+    }
+    if (n->family == LB__F_LOCAL && !ins)
+        return lb__fail(c->err, LB_ERR_INTERNAL,
+                        "%s: %s: the evaluator has no instruction for this "
+                        "use of the local union (was ev compiled from this scene?)",
+                        FN, n->path);
+    const struct lb__curves *C = ins ? ins->curves : NULL;
+    if (n->family == LB__F_LOCAL)
+        sb(b, "// %s: local union, %zu blending volume%s\n", n->path[0] ? n->path : "root",
+           C ? C->ncomp : 0, C && C->ncomp == 1 ? "" : "s");
+    if (!C || !C->nseg) { /* no intersection: the clean union everywhere */
+        sb(b,
+           "#declare LBt%d = function(x, y, z, lbLg1, lbLg2) { lb_clean_uc(lbLg1, lbLg2, 0.5, "
+           "%.17g, %.17g) }\n",
+           id, al[0], al[1]);
+    } else {
+        lb__affine W; /* node frame -> world, where the curves live */
+        if (affine_invert(&ins->A, &W))
+            return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT, "%s: %s: a singular transform", FN,
+                            n->path);
+        const int ident = lb__affine_is_identity(&W);
+        const size_t K = C->ncomp;
+        int next = 0;
+        sb(b,
+           "#declare LBk%d_%zu = function(x, y, z, lbLg1, lbLg2, lbLa, lbLp, lbLq, lbLuc) { "
+           "lb_local_at(lbLg1, lbLg2, lbLa, lbLp, lbLq, %.17g, lbLuc) }\n",
+           id, K, n->lp.exponent);
+        for (size_t k = K; k-- > 0;) {
+            int root = -1;
+            if (bvh_has(C, 0, k)) bvh_emit(c, C, 0, k, id, &next, &root);
+            char dist[1024];
+            if (root < 0)
+                snprintf(dist, sizeof dist, "1");
+            else if (ident)
+                snprintf(dist, sizeof dist, "LBv%d_%d(x, y, z)", id, root);
+            else {
+                const double *M = W.M, *t = W.t;
+                snprintf(dist, sizeof dist,
+                         "LBv%d_%d(%.17g * x + %.17g * y + %.17g * z + %.17g, %.17g * x + %.17g * "
+                         "y + %.17g * z + %.17g, %.17g * x + %.17g * y + %.17g * z + %.17g)",
+                         id, root, M[0], M[1], M[2], t[0], M[3], M[4], M[5], t[1], M[6], M[7], M[8],
+                         t[2]);
+            }
+            const lb__component *P = &C->comp[k];
+            sb(b,
+               "#declare LBh%d_%zu = function(x, y, z, lbLg1, lbLg2, lbLa, lbLp, lbLq, lbLuc, "
+               "lbLc) { LBk%d_%zu(x, y, z, lbLg1, lbLg2, min(lbLc, lbLa), select(lbLc - lbLa, "
+               "%.17g, lbLp), select(lbLc - lbLa, %.17g, lbLq), lbLuc) }\n"
+               "#declare LBk%d_%zu = function(x, y, z, lbLg1, lbLg2, lbLa, lbLp, lbLq, lbLuc) { "
+               "LBh%d_%zu(x, y, z, lbLg1, lbLg2, lbLa, lbLp, lbLq, lbLuc, %s) }\n",
+               id, k, id, k + 1, P->p, P->q, id, k, id, k, dist);
+        }
+        sb(b,
+           "#declare LBt%d = function(x, y, z, lbLg1, lbLg2) { LBk%d_0(x, y, z, lbLg1, lbLg2, 1, "
+           "0, 0, lb_clean_uc(lbLg1, lbLg2, 0.5, %.17g, %.17g)) }\n",
+           id, id, al[0], al[1]);
+    }
+    if (zero)
+        sb(b, "#declare %s%d = function(x, y, z) { %.17g * (1 - LBt%d(x, y, z, %s, %s) / 0.5) }\n",
+           name, id, S, id, in1, in2);
+    else
+        sb(b, "#declare %s%d = function(x, y, z) { max(0, LBt%d(x, y, z, %s, %s)) }\n", name, id,
+           id, in1, in2);
+    return b->oom ? lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN) : LB_OK;
+}
+
+static lb_status emit_node(pctx *c, const lb__node *n, int id);
+
+/* One declaration per node (per node and world frame under a local_union):
+ * shared defs stay shared. */
 static lb_status emit(pctx *c, const lb__node *n, int *out) {
+    const lb__affine saved = c->A;
+    lb__affine A = saved;
+    if (n->has_transform) lb__affine_compose(&n->to_local, &saved, &A);
+    const int keyed = has_local(c, n);
     for (size_t i = 0; i < c->ndone; ++i)
-        if (c->done[i] == n) {
+        if (c->done[i] == n && (!keyed || memcmp(&c->doneA[i], &A, sizeof A) == 0)) {
             *out = c->ids[i];
             return LB_OK;
         }
-    sbuf *b = c->b;
     const int id = c->next++;
+    c->A = A;
+    lb_status s = emit_node(c, n, id);
+    c->A = saved;
+    if (s) return s;
+    if (c->ndone == c->cap) {
+        const size_t nc = c->cap ? 2 * c->cap : 64;
+        const lb__node **d = realloc(c->done, nc * sizeof *d);
+        if (d) c->done = d;
+        int *q = d ? realloc(c->ids, nc * sizeof *q) : NULL;
+        if (q) c->ids = q;
+        lb__affine *fa = q ? realloc(c->doneA, nc * sizeof *fa) : NULL;
+        if (fa) c->doneA = fa;
+        if (!fa) return lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        c->cap = nc;
+    }
+    c->done[c->ndone] = n;
+    c->doneA[c->ndone] = A;
+    c->ids[c->ndone++] = id;
+    *out = id;
+    return c->b->oom ? lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN) : LB_OK;
+}
+
+static lb_status emit_node(pctx *c, const lb__node *n, int id) {
+    sbuf *b = c->b;
     const char *name = n->has_transform ? "LBl" : "LBn";
     /* LB_Displacement takes any k (past 16 it re-evaluates its arguments per
      * step); these three are limited to the include's 16 */
     const int k16 =
         n->family == LB__F_SCALE || n->family == LB__F_BOUNDED || n->family == LB__F_SOFT_HYPER;
-    if (n->family == LB__F_LOCAL || n->family == LB__F_CLEAN)
-        return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
-                        "%s: %s: %s has no POV-Ray form yet; allowed in POV-Ray: the other "
-                        "blends (mesh the scene with blendtool mesh instead)",
-                        FN, n->path, n->type);
     if (k16 && n->k > LB_POV_MAX_ARITY)
         return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
                         "%s: %s: a %s blend of %zu arguments; allowed in POV-Ray: at most %d "
@@ -156,6 +376,10 @@ static lb_status emit(pctx *c, const lb__node *n, int *out) {
         if (P->kernel != LB_KERNEL_NONE)
             sb(b, "#declare %s%d = function(x, y, z) { %s(LBr%d(x, y, z) + 1) }\n", name, id,
                P->kernel == LB_KERNEL_WYVILL ? "LB_Wyvill" : "LB_Blinn", id);
+    } else if (n->family == LB__F_LOCAL || n->family == LB__F_CLEAN) {
+        int a, d;
+        if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
+        if ((s = emit_local(c, n, id, name, a, d))) return s;
     } else if (n->family == LB__F_GROUP) {
         int a;
         if ((s = emit(c, n->args[0], &a))) return s;
@@ -251,19 +475,7 @@ static lb_status emit(pctx *c, const lb__node *n, int *out) {
                M[3 * r + 1], M[3 * r + 2], t[r]);
         sb(b, ") }\n");
     }
-    if (c->ndone == c->cap) {
-        const size_t nc = c->cap ? 2 * c->cap : 64;
-        const lb__node **d = realloc(c->done, nc * sizeof *d);
-        int *q = realloc(c->ids, nc * sizeof *q);
-        if (d) c->done = d;
-        if (q) c->ids = q;
-        if (!d || !q) return lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-        c->cap = nc;
-    }
-    c->done[c->ndone] = n;
-    c->ids[c->ndone++] = id;
-    *out = id;
-    return b->oom ? lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN) : LB_OK;
+    return LB_OK;
 }
 
 void lb_pov_camera(const lb_scene *scene, double aspect, double loc[3], double at[3],
@@ -332,7 +544,9 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
     for (int d = 0; d < 3; ++d) diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
     diag = sqrt(diag);
     sbuf b = {NULL, 0, 0, 0};
-    pctx c = {&b, scene, NULL, NULL, 0, 0, 0, 1e-5 * diag, err};
+    pctx c = {&b, scene,      NULL, NULL, 0,    0, 0, 1e-5 * diag,
+              ev, {{0}, {0}}, NULL, NULL, NULL, 0, 0, err};
+    lb__affine_identity(&c.A);
     sb(&b, "// written by libblend %d.%d.%d (blendtool pov)\n", LB_VERSION_MAJOR, LB_VERSION_MINOR,
        LB_VERSION_PATCH);
     sb_comment(&b, "scene", scene->name);
@@ -379,6 +593,9 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
     }
     free(c.done);
     free(c.ids);
+    free(c.doneA);
+    free(c.lnodes);
+    free(c.lflag);
     if (!s && b.oom) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     if (s) {
         free(b.s);
