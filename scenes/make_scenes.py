@@ -183,15 +183,7 @@ write("default.json", scene(
     "scaled copy of the same cube (a shared def)",
     "zero", root, ([-2.2, -4.0, -2.2], [2.2, 2.2, 2.2]), defs={"cube": cube}))
 
-# ---- local blending (Bernhardt, Barthe, Cani, Wyvill 2010), in scenes/local/
-LOCAL = os.path.join(HERE, "local")
-os.makedirs(LOCAL, exist_ok=True)
-
-
-def write_local(name, s):
-    with open(os.path.join(LOCAL, name), "w") as f:
-        json.dump(s, f, indent=2)
-        f.write("\n")
+# ---- local blending (Bernhardt, Barthe, Cani, Wyvill 2010): bernhardt-*.json
 
 
 def soft_sphere(c, r):
@@ -207,7 +199,7 @@ DROP_BOUNDS = ([-1.5, -1.0, -1.5], [1.5, 1.6, 1.5])
 # the drop (radius 0.5) from well above the water to half under it: no blend
 # before it touches (y > 0.5), then a blend that grows with the penetration
 for i, y in enumerate([1.0, 0.8, 0.6, 0.52, 0.48, 0.42, 0.36, 0.3, 0.24, 0.18, 0.12, 0.06]):
-    write_local("bernhardt-drop-%02d.json" % i, scene(
+    write("bernhardt-drop-%02d.json" % i, scene(
         "bernhardt2010 drop on water, position %d of 12 (drop centre y = %g)" % (i + 1, y),
         "a drop of radius 0.5 over water whose surface is at y = 0, under a local union: it "
         "blends only once it touches, more as it goes deeper (seed Fig. 8)",
@@ -215,7 +207,7 @@ for i, y in enumerate([1.0, 0.8, 0.6, 0.52, 0.48, 0.42, 0.36, 0.3, 0.24, 0.18, 0
         DROP_BOUNDS))
 
 # a hand next to the body: closer than any classic blend range, not touching
-write_local("bernhardt-hand-near-body.json", scene(
+write("bernhardt-hand-near-body.json", scene(
     "bernhardt2010 hand near the body: no blend",
     "an arm's capsule 0.04 from the body's: the local union is their exact union",
     "soft", {"type": "local_union", "args": [
@@ -224,7 +216,7 @@ write_local("bernhardt-hand-near-body.json", scene(
     ([-1.0, -2.0, -1.0], [1.2, 2.0, 1.0])))
 
 # several convolution-like primitives blended locally (the paper's dancer)
-write_local("bernhardt-figure.json", scene(
+write("bernhardt-figure.json", scene(
     "bernhardt2010 a figure of capsules blended locally",
     "body, head, arms and legs as soft capsules, a left fold of local unions: each limb "
     "blends only where it enters the body",
@@ -238,24 +230,24 @@ write_local("bernhardt-figure.json", scene(
 
 # the same pair three ways: the classic soft sum, Hsu's BT blend, the local blend
 PAIR_BOUNDS = ([-1.6, -1.6, -1.6], [2.8, 1.6, 1.6])
-write_local("bernhardt-compare-sum.json", scene(
+write("bernhardt-compare-sum.json", scene(
     "comparison: a sphere and a smaller one, soft sum",
     "the classic soft union: the spheres swell toward each other",
     "soft", {"type": "soft_sum", "args": [soft_sphere((0, 0, 0), 1.0),
                                           soft_sphere((1.5, 0, 0), 0.6)]}, PAIR_BOUNDS))
-write_local("bernhardt-compare-bt.json", scene(
+write("bernhardt-compare-bt.json", scene(
     "comparison: the same pair, Hsu's BT_2 blend (r = 0.3)",
     "a displacement blend: the fillet follows the contact, but the range acts at a distance",
     "zero", {"type": "displacement", "op": "union", "r": 0.3, "p": 2, "args": [
         {"type": "sphere", "center": [0, 0, 0], "radius": 1.0},
         {"type": "sphere", "center": [1.5, 0, 0], "radius": 0.6}]}, PAIR_BOUNDS))
-write_local("bernhardt-compare-local.json", scene(
+write("bernhardt-compare-local.json", scene(
     "comparison: the same pair, local union",
     "blends only around the intersection circle; the exact union elsewhere",
     "soft", {"type": "local_union", "alpha": [0.05, 0.05],
              "args": [soft_sphere((0, 0, 0), 1.0), soft_sphere((1.5, 0, 0), 0.6)]},
     PAIR_BOUNDS))
-write_local("bernhardt-drop-zero.json", scene(
+write("bernhardt-drop-zero.json", scene(
     "drop on water in the zero convention",
     "the same local union with distance-like children (zero_scale 1)",
     "zero", {"type": "local_union", "support_factor": 0.3, "args": [

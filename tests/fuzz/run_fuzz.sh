@@ -8,7 +8,7 @@ WORK=$3
 SECONDS_MAX=$4
 rm -rf "$WORK"
 mkdir -p "$WORK/corpus" "$WORK/artifacts"
-cp "$SRC"/scenes/*.json "$SRC"/tests/data/scenes/*.json "$SRC"/scenes/local/*.json "$WORK/corpus/"
+cp "$SRC"/scenes/*.json "$SRC"/tests/data/scenes/*.json "$WORK/corpus/"
 # -timeout: one input may not take more than 10 s; -rss_limit_mb: nor 2 GB
 exec "$FUZZER" "$WORK/corpus" -dict="$SRC/tests/fuzz/scene.dict" \
   -max_total_time="$SECONDS_MAX" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The shipped local-blending scenes (scenes/local/, written by
+"""The shipped local-blending scenes (scenes/bernhardt-*.json, written by
 scenes/make_scenes.py) through blendtool: each validates and meshes closed,
 oriented and 2-manifold at two resolutions (independent numpy reader); the
 drop sweep has no curve before contact and a support R that grows with every
@@ -45,7 +45,7 @@ def curves(path):
             for m in re.finditer(r"curve \d+: \w+, (\d+) vertices, .*? R ([0-9.e+-]+),", text)]
 
 
-scenes = sorted(glob.glob(os.path.join(SRC, "scenes", "local", "*.json")))
+scenes = sorted(glob.glob(os.path.join(SRC, "scenes", "bernhardt-*.json")))
 if len(scenes) < 17:
     fail("only %d local scenes" % len(scenes))
 for path in scenes:
@@ -66,7 +66,7 @@ for path in scenes:
             fail("%s at %d: %s" % (name, res, c))
 
 # the drop sweep: apart, then touching and deeper
-drops = sorted(glob.glob(os.path.join(SRC, "scenes", "local", "bernhardt-drop-[0-9]*.json")))
+drops = sorted(glob.glob(os.path.join(SRC, "scenes", "bernhardt-drop-[0-9]*.json")))
 if len(drops) < 10:
     fail("the drop sweep has %d positions (want >= 10)" % len(drops))
 last_r, touching = 0.0, 0
@@ -85,7 +85,7 @@ if touching < 6:
     fail("only %d touching positions" % touching)
 
 # the hand near the body: no curve, the clean union's mesh byte for byte
-hand = os.path.join(SRC, "scenes", "local", "bernhardt-hand-near-body.json")
+hand = os.path.join(SRC, "scenes", "bernhardt-hand-near-body.json")
 if curves(hand):
     fail("the hand near the body has an intersection curve")
 sc = json.load(open(hand))
