@@ -909,7 +909,12 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
             gf[1][d] = lb__reg(regs, r1, 1 + d)[j];
         }
         double g[2], guc[2];
-        lb__local_in(nd, conv, f, g);
+        if (conv == LB_CONVENTION_SOFT) { /* the children as they are (lb__local_in, inline) */
+            g[0] = f[0];
+            g[1] = f[1];
+        } else {
+            lb__local_in(nd, conv, f, g);
+        }
         if (!(fabs(g[0]) <= LB_MAX_ABS_ARG && fabs(g[1]) <= LB_MAX_ABS_ARG))
             return lb__fail(err, LB_ERR_NOT_FINITE,
                             "%s: a child's value %g, %g is not finite or beyond 1e100", nd->path,
@@ -937,7 +942,7 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
         }
         /* back to the scene's convention: zero f = s (1 - U / C) */
         const double out_k = conv == LB_CONVENTION_ZERO ? -nd->lp.zero_scale / LB__LOCAL_ISO : 1.0;
-        ov[j] = lb__local_out(nd, conv, u);
+        ov[j] = conv == LB_CONVENTION_SOFT ? (u > 0.0 ? u : 0.0) : lb__local_out(nd, conv, u);
         double gg[3];
         for (int d = 0; d < 3; ++d)
             gg[d] = out_k * (k * (du[0] * gf[0][d] + du[1] * gf[1][d]) + dv[d]);

@@ -15,7 +15,8 @@
 
 /* UR(x, y) = x + y + sqrt(x^2 + y^2) and its gradient */
 static double ur(double x, double y, double g[2]) {
-    const double q = hypot(x, y);
+    /* |x|, |y| <= 1e100 (the callers' limit): the squares cannot overflow */
+    const double q = sqrt(x * x + y * y);
     if (q > 0.0) {
         g[0] = 1.0 + x / q;
         g[1] = 1.0 + y / q;
@@ -43,10 +44,10 @@ static double weight(const double f[2], const double a[2], double g[2]) {
         g[0] = g[1] = 0.0;
         return 0.0;
     }
-    const double s = u + v, su = u / s, sv = v / s;
+    const double is = 1.0 / (u + v), su = u * is, sv = v * is;
     const double t = 4.0 * su * sv, t3 = t * t * t;
     /* dt/du = 4 v (v - u) / s^3, dt/dv = 4 u (u - v) / s^3 */
-    const double dtu = 4.0 * sv * (sv - su) / s, dtv = 4.0 * su * (su - sv) / s;
+    const double dtu = 4.0 * sv * (sv - su) * is, dtv = 4.0 * su * (su - sv) * is;
     const double du = 4.0 * t3 * dtu, dv = 4.0 * t3 * dtv;
     g[0] = du - a[1] * dv; /* du/df1 = 1, dv/df1 = -a2 */
     g[1] = dv - a[0] * du; /* du/df2 = -a1, dv/df2 = 1 */
@@ -67,7 +68,7 @@ double lb__clean_eval(lb_clean_kind kind, const double f[2], double C, const dou
         V = uc2(f, C, gv); /* UC3 everywhere; UC outside both */
     } else if (!(f[0] < C) && !(f[1] < C)) {
         /* inside both: Barthe's clean union, no inner contraction */
-        const double x = f[0] - C, y = f[1] - C, q = hypot(x, y);
+        const double x = f[0] - C, y = f[1] - C, q = sqrt(x * x + y * y);
         V = C + q;
         gv[0] = q > 0.0 ? x / q : SQRT1_2;
         gv[1] = q > 0.0 ? y / q : SQRT1_2;
