@@ -14,6 +14,11 @@ PACKAGES=(
   povray                     # tests: the generated POV-Ray include, run by POV-Ray itself
   openimageio-tools          # tests: idiff compares POV-Ray renders with libblend silhouettes
   blender                    # tests: the add-on in headless Blender (blender_addon_c/)
+  libopenimageio-dev         # blendtool's image writer (tools/imageio, C++): PNG, EXR, contact sheets
+  libxxhash-dev              # content hashes of batch tasks (resume manifests)
+  fonts-dejavu-core          # the contact sheets' labels
+  slurm-wlm munge            # tests: batch jobs on a single-node Slurm cluster (scripts/slurm-cluster.sh)
+  parallel                   # tests: batch task lists through GNU parallel
 )
 
 # `install-deps.sh bench`: also what the benchmarks compare against

@@ -28,7 +28,7 @@ TSAN_OPTIONS=halt_on_error=1 \
   ctest --test-dir build-tsan --output-on-failure -R '^(test_threads|test_scene_eval|test_mesh)$'
 
 echo "== build-fuzz (clang, libFuzzer, ASan + UBSan)"
-CC=clang cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_FUZZ=ON \
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_FUZZ=ON \
   -DLIBBLEND_BENCH=OFF -DLIBBLEND_FUZZ_SECONDS="${LIBBLEND_FUZZ_SECONDS:-60}"
 cmake --build build-fuzz -j "$JOBS" --target fuzz_scene
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

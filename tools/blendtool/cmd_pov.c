@@ -37,7 +37,10 @@ static int parse_int(const char *cmd, const char *opt, const char *v, long lo, l
 
 typedef struct povargs {
     const char *scene, *out;
-    int include_only, width, height, threads, quality, silhouette;
+    int include_only, width, height, threads, quality, silhouette, bits, alpha;
+    const char *pixel;
+    bt_set sets[BT_MAX_SETS];
+    size_t nsets;
 } povargs;
 
 static int parse(const char *cmd, int argc, char **argv, povargs *a, int render) {
@@ -56,8 +59,31 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
             if (r < 0 || bt_parse_threads(cmd, v, &a->threads)) return -1;
         } else if (render && (r = bt_option(cmd, argc, argv, &i, "--quality", &v))) {
             if (r < 0 || parse_int(cmd, "--quality", v, 0, 11, &a->quality)) return -1;
+        } else if (render && (r = bt_option(cmd, argc, argv, &i, "--bits", &v))) {
+            if (r < 0) return -1;
+            if (strcmp(v, "8") && strcmp(v, "16")) {
+                bt_error(cmd, "--bits %s; allowed: 8 or 16 (PNG)", v);
+                return -1;
+            }
+            a->bits = atoi(v);
+        } else if (render && (r = bt_option(cmd, argc, argv, &i, "--pixel", &v))) {
+            if (r < 0) return -1;
+            if (strcmp(v, "half") && strcmp(v, "float")) {
+                bt_error(cmd, "--pixel %s; allowed: half or float (EXR)", v);
+                return -1;
+            }
+            a->pixel = v;
+        } else if (render && strcmp(argv[i], "--alpha") == 0) {
+            a->alpha = 1;
         } else if (!render && strcmp(argv[i], "--include-only") == 0) {
             a->include_only = 1;
+        } else if ((r = bt_option(cmd, argc, argv, &i, "--set", &v))) {
+            if (r < 0) return -1;
+            if (a->nsets == BT_MAX_SETS) {
+                bt_error(cmd, "more than %d --set overrides", BT_MAX_SETS);
+                return -1;
+            }
+            if (bt_set_parse(cmd, v, &a->sets[a->nsets++])) return -1;
         } else if (strcmp(argv[i], "--silhouette") == 0) {
             a->silhouette = 1;
         } else if (argv[i][0] == '-' && argv[i][1]) {
@@ -78,10 +104,12 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
     return 0;
 }
 
-/* load, compile, write the .pov to an open output */
-static int export(const char *cmd, const povargs *a, FILE *f, const char *out_name) {
+/* load, compile, write the .pov to an open output; hash (may be NULL)
+ * receives the resolved scene's hash */
+static int export(const char *cmd, const povargs *a, FILE *f, const char *out_name,
+                  uint64_t hash[2]) {
     lb_scene *sc = NULL;
-    int rc = bt_load_scene(cmd, a->scene, &sc);
+    int rc = bt_load_scene_set(cmd, a->scene, a->sets, a->nsets, &sc, hash);
     if (rc) return rc;
     lb_error e = {LB_OK, ""};
     lb_evaluator *ev = NULL;
@@ -104,11 +132,11 @@ static int export(const char *cmd, const povargs *a, FILE *f, const char *out_na
 }
 
 static int run_pov(int argc, char **argv) {
-    povargs a = {NULL, NULL, 0, 640, 480, 0, 9, 0};
+    povargs a = {.width = 640, .height = 480, .quality = 9};
     if (parse("pov", argc, argv, &a, 0)) return BT_EXIT_BAD_INPUT;
     bt_out w;
     int rc = bt_output_open("pov", a.out, &w);
-    if (!rc) rc = export("pov", &a, w.f, a.out);
+    if (!rc) rc = export("pov", &a, w.f, a.out, NULL);
     if (!rc) rc = bt_output_commit("pov", &w);
     bt_output_discard(&w);
     return rc;
@@ -123,7 +151,8 @@ static const char *tmp_root(void) {
 
 /* what a render folder holds: the scene, the image, and the state file
  * povray writes when it is stopped mid-render */
-static const char *const RENDER_FILES[] = {"scene.pov", "image.png", "image.pov-state"};
+static const char *const RENDER_FILES[] = {"scene.pov", "image.png", "image.pov-state",
+                                           "povray.log"};
 
 static void remove_stale_renders(void) {
     DIR *d = opendir(tmp_root());
@@ -137,7 +166,7 @@ static void remove_stale_renders(void) {
         if (pid <= 0 || !end || *end != '-') continue;
         if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
         char path[4096];
-        for (int i = 0; i < 3; ++i) {
+        for (int i = 0; i < 4; ++i) {
             snprintf(path, sizeof path, "%s/%s/%s", tmp_root(), e->d_name, RENDER_FILES[i]);
             unlink(path);
         }
@@ -147,15 +176,14 @@ static void remove_stale_renders(void) {
     closedir(d);
 }
 
-/* povray on the exported scene; returns an exit code */
-static int povray(const povargs *a, const char *pov, const char *png) {
+int bt_povray(const char *scene_name, const char *pov, const char *png, int width, int height,
+              int threads, int quality, int deep, const char *log) {
     char inc[4096], outw[64], outh[64], th[64], q[32], in[4300], out[4300];
     snprintf(inc, sizeof inc, "+L%s", include_dir());
-    snprintf(outw, sizeof outw, "+W%d", a->width);
-    snprintf(outh, sizeof outh, "+H%d", a->height);
-    snprintf(th, sizeof th, "+WT%d",
-             a->threads > 0 ? a->threads : (int)sysconf(_SC_NPROCESSORS_ONLN));
-    snprintf(q, sizeof q, "+Q%d", a->quality);
+    snprintf(outw, sizeof outw, "+W%d", width);
+    snprintf(outh, sizeof outh, "+H%d", height);
+    snprintf(th, sizeof th, "+WT%d", threads > 0 ? threads : (int)sysconf(_SC_NPROCESSORS_ONLN));
+    snprintf(q, sizeof q, "+Q%d", quality);
     snprintf(in, sizeof in, "+I%s", pov);
     snprintf(out, sizeof out, "+O%s", png);
     const pid_t pid = fork();
@@ -163,9 +191,21 @@ static int povray(const povargs *a, const char *pov, const char *png) {
         /* povray ends with blendtool, even when blendtool is killed */
         prctl(PR_SET_PDEATHSIG, SIGTERM);
         if (getppid() == 1) _exit(127);
-        /* povray's own progress goes to stderr: the user sees it stream */
-        execlp("povray", "povray", in, out, inc, outw, outh, th, q, "-D", "+FN", "-V",
-               (char *)NULL);
+        /* povray's own progress goes to stderr: the user sees it stream;
+         * or into log (batch), shown when povray fails */
+        if (log) {
+            FILE *lf = fopen(log, "w");
+            if (lf) {
+                dup2(fileno(lf), STDERR_FILENO);
+                dup2(fileno(lf), STDOUT_FILENO);
+            }
+        }
+        if (deep) /* 16-bit PNG with alpha, for the OpenImageIO writer */
+            execlp("povray", "povray", in, out, inc, outw, outh, th, q, "-D", "+FN16", "+UA", "-V",
+                   (char *)NULL);
+        else
+            execlp("povray", "povray", in, out, inc, outw, outh, th, q, "-D", "+FN", "-V",
+                   (char *)NULL);
         fprintf(stderr,
                 "blendtool render: cannot run povray (%s); allowed: install POV-Ray 3.7 (Debian "
                 "package povray)\n",
@@ -184,93 +224,150 @@ static int povray(const povargs *a, const char *pov, const char *png) {
         return BT_EXIT_INTERNAL;
     }
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        FILE *lf = log ? fopen(log, "r") : NULL;
+        if (lf) { /* its last lines */
+            char buf[8192];
+            const long at = fseek(lf, 0, SEEK_END) == 0 ? ftell(lf) : 0;
+            fseek(lf, at > (long)sizeof buf - 1 ? at - (long)sizeof buf + 1 : 0, SEEK_SET);
+            const size_t n = fread(buf, 1, sizeof buf - 1, lf);
+            buf[n] = '\0';
+            fclose(lf);
+            fprintf(stderr, "%s", buf);
+        }
         if (!(WIFEXITED(status) && WEXITSTATUS(status) == 127))
             bt_error("render", "povray failed (%s %d) on %s; its messages are above",
                      WIFEXITED(status) ? "exit status" : "signal",
-                     WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), a->scene);
+                     WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status), scene_name);
         return BT_EXIT_INTERNAL;
     }
     return BT_EXIT_OK;
 }
 
-/* copy the rendered image into the open output */
-static int copy_image(const char *png, bt_out *w) {
-    FILE *f = fopen(png, "rb");
-    if (!f) {
-        bt_error("render", "povray wrote no image (%s)", strerror(errno));
-        return BT_EXIT_INTERNAL;
-    }
-    char buf[65536];
-    size_t n;
-    int ok = 1;
-    while (ok && (n = fread(buf, 1, sizeof buf, f)) > 0) ok = fwrite(buf, 1, n, w->f) == n;
-    ok = ok && !ferror(f);
-    fclose(f);
-    if (!ok) {
-        bt_error("render", "%s: copying the image failed (%s); nothing was written", w->path,
-                 strerror(errno));
-        return BT_EXIT_INTERNAL;
-    }
-    return BT_EXIT_OK;
-}
-
-static int run_render(int argc, char **argv) {
-    povargs a = {NULL, NULL, 0, 640, 480, 0, 9, 0};
-    if (parse("render", argc, argv, &a, 1)) return BT_EXIT_BAD_INPUT;
-    const size_t ol = strlen(a.out);
-    if ((ol < 5 || strcmp(a.out + ol - 4, ".png") != 0) && !bt_is_stream(a.out)) {
-        bt_error("render", "%s: allowed: an output name ending in .png (or a device or FIFO)",
-                 a.out);
-        return BT_EXIT_BAD_INPUT;
-    }
+int bt_render_dir_open(bt_render_dir *r) {
     remove_stale_renders();
-    char dir[4096];
-    snprintf(dir, sizeof dir, "%s/blendtool-render-%ld-XXXXXX", tmp_root(), (long)getpid());
-    if (!mkdtemp(dir)) {
+    snprintf(r->dir, sizeof r->dir, "%s/blendtool-render-%ld-XXXXXX", tmp_root(), (long)getpid());
+    if (!mkdtemp(r->dir)) {
         bt_error("render", "%s: cannot create a temporary folder: %s", tmp_root(), strerror(errno));
         return BT_EXIT_INTERNAL;
     }
-    char pov[4200], png[4200], state[4200];
-    snprintf(pov, sizeof pov, "%s/%s", dir, RENDER_FILES[0]);
-    snprintf(png, sizeof png, "%s/%s", dir, RENDER_FILES[1]);
-    snprintf(state, sizeof state, "%s/%s", dir, RENDER_FILES[2]);
+    snprintf(r->pov, sizeof r->pov, "%s/%s", r->dir, RENDER_FILES[0]);
+    snprintf(r->png, sizeof r->png, "%s/%s", r->dir, RENDER_FILES[1]);
+    snprintf(r->state, sizeof r->state, "%s/%s", r->dir, RENDER_FILES[2]);
+    snprintf(r->log, sizeof r->log, "%s/%s", r->dir, RENDER_FILES[3]);
     /* registered before they exist: the handler removes what is there */
-    const int s1 = bt_signals_temp(pov), s2 = bt_signals_temp(png), s3 = bt_signals_temp(state);
-    bt_signals_temp_dir(dir);
+    r->slot[0] = bt_signals_temp(r->pov);
+    r->slot[1] = bt_signals_temp(r->png);
+    r->slot[2] = bt_signals_temp(r->state);
+    r->slot[3] = bt_signals_temp(r->log);
+    bt_signals_temp_dir(r->dir);
+    return BT_EXIT_OK;
+}
+
+void bt_render_dir_close(bt_render_dir *r) {
+    remove(r->pov);
+    remove(r->png);
+    remove(r->state);
+    remove(r->log);
+    rmdir(r->dir);
+    for (int i = 0; i < 4; ++i) bt_signals_untemp(r->slot[i]);
+    bt_signals_temp_dir(NULL);
+}
+
+int bt_image_format(const char *cmd, const char *out, int bits, const char *pixel) {
+    const size_t ol = strlen(out);
+    const int exr = ol > 4 && strcmp(out + ol - 4, ".exr") == 0;
+    const int png = ol > 4 && strcmp(out + ol - 4, ".png") == 0;
+    if (!exr && !png && !bt_is_stream(out)) {
+        bt_error(cmd,
+                 "%s: allowed: an image name ending in .png or .exr (or a device or FIFO, "
+                 "written as PNG)",
+                 out);
+        return -1;
+    }
+    if (exr && bits) {
+        bt_error(cmd, "%s: --bits is for PNG; allowed for EXR: --pixel half|float", out);
+        return -1;
+    }
+    if (!exr && pixel) {
+        bt_error(cmd, "%s: --pixel is for EXR; allowed for PNG: --bits 8|16", out);
+        return -1;
+    }
+    if (exr) return pixel && strcmp(pixel, "float") == 0 ? LBI_EXR_FLOAT : LBI_EXR_HALF;
+    return bits == 16 ? LBI_PNG16 : LBI_PNG8;
+}
+
+void bt_hash_hex(const uint64_t h[2], char out[33]) {
+    snprintf(out, 33, "%016llx%016llx", (unsigned long long)h[0], (unsigned long long)h[1]);
+}
+
+static int run_render(int argc, char **argv) {
+    povargs a = {.width = 640, .height = 480, .quality = 9};
+    if (parse("render", argc, argv, &a, 1)) return BT_EXIT_BAD_INPUT;
+    const int fmt = bt_image_format("render", a.out, a.bits, a.pixel);
+    if (fmt < 0) return BT_EXIT_BAD_INPUT;
+    bt_render_dir R;
+    if (bt_render_dir_open(&R)) return BT_EXIT_INTERNAL;
     bt_out w;
+    uint64_t hash[2] = {0, 0};
     int rc = bt_output_open("render", a.out, &w);
     if (!rc) {
-        FILE *f = fopen(pov, "wb");
+        FILE *f = fopen(R.pov, "wb");
         if (!f) {
-            bt_error("render", "%s: cannot write the scene (%s)", pov, strerror(errno));
+            bt_error("render", "%s: cannot write the scene (%s)", R.pov, strerror(errno));
             rc = BT_EXIT_INTERNAL;
         } else {
-            rc = export("render", &a, f, pov);
+            rc = export("render", &a, f, R.pov, hash);
             if (fclose(f) != 0 && !rc) {
-                bt_error("render", "%s: cannot write the scene (%s)", pov, strerror(errno));
+                bt_error("render", "%s: cannot write the scene (%s)", R.pov, strerror(errno));
                 rc = BT_EXIT_INTERNAL;
             }
         }
     }
-    if (!rc) rc = povray(&a, pov, png);
-    if (!rc) rc = copy_image(png, &w);
+    if (!rc)
+        rc = bt_povray(a.scene, R.pov, R.png, a.width, a.height, a.threads, a.quality, 1, NULL);
+    unsigned char *img = NULL;
+    size_t len = 0;
+    if (!rc) {
+        char hex[33], settings[128], params[4096],
+            err[1024] = "the image writer is not available (above)";
+        const bt_imageio *io = NULL;
+        bt_hash_hex(hash, hex);
+        snprintf(settings, sizeof settings, "%dx%d quality %d%s", a.width, a.height, a.quality,
+                 a.silhouette ? " silhouette" : "");
+        size_t o = 0;
+        params[0] = '\0';
+        for (size_t i = 0; i < a.nsets && o + 1 < sizeof params; ++i) {
+            const int n =
+                snprintf(params + o, sizeof params - o, "%s%s", i ? " " : "", a.sets[i].path);
+            if (n > 0) o += (size_t)n;
+        }
+        const lbi_meta meta[4] = {{"libblend:scene_hash", hex},
+                                  {"libblend:version", BT_VERSION},
+                                  {"libblend:render", settings},
+                                  {"libblend:parameters", params}};
+        if (!(io = bt_imageio_get("render")) ||
+            io->convert(R.png, (lbi_format)fmt, a.alpha, meta, 4, &img, &len, err, sizeof err)) {
+            bt_error("render", "%s: writing the image failed: %s", a.out, err);
+            rc = BT_EXIT_INTERNAL;
+        }
+    }
+    if (!rc && fwrite(img, 1, len, w.f) != len) {
+        bt_error("render", "%s: writing the image failed (%s); nothing was written", a.out,
+                 strerror(errno));
+        rc = BT_EXIT_INTERNAL;
+    }
+    free(img);
     if (!rc) rc = bt_output_commit("render", &w);
     bt_output_discard(&w);
-    remove(pov);
-    remove(png);
-    remove(state);
-    rmdir(dir);
-    bt_signals_untemp(s1);
-    bt_signals_untemp(s2);
-    bt_signals_untemp(s3);
-    bt_signals_temp_dir(NULL);
+    bt_render_dir_close(&R);
     return rc;
 }
 
 const bt_command bt_cmd_pov = {
     "pov", "the scene as a POV-Ray 3.7 file (isosurface with a computed max_gradient)",
     "usage: blendtool pov SCENE -o OUT.pov [--include-only] [--silhouette] [--width W --height "
-    "H]\n\n"
+    "H]\n"
+    "                     [--set PATH=VALUE]...\n\n"
     "Writes a complete POV-Ray 3.7 scene: the field as functions built with\n"
     "libblend.inc, one isosurface over the scene's bounds with a max_gradient\n"
     "computed by libblend, camera, lights and material from the scene's render\n"
@@ -279,6 +376,7 @@ const bt_command bt_cmd_pov = {
     "  --include-only  only the function declarations (the field is LB_Field)\n"
     "  --silhouette    a white object on black, unshaded (for comparisons)\n"
     "  --width, --height  the image's aspect ratio for the camera (640 x 480)\n"
+    "  --set PATH=VALUE  override a scene value first (VALUE is JSON); repeatable\n"
     "Exit status: 0 success, 2 bad scene (or one POV-Ray cannot express) or options, 1\n"
     "internal failure or failure writing OUT, 130 / 143 / 129 ended by SIGINT / SIGTERM /\n"
     "SIGHUP (nothing written).\n",
@@ -286,15 +384,24 @@ const bt_command bt_cmd_pov = {
 
 const bt_command bt_cmd_render = {
     "render", "render the scene with POV-Ray into a PNG",
-    "usage: blendtool render SCENE -o OUT.png [--width W] [--height H] [--threads N]\n"
-    "                        [--quality Q] [--silhouette]\n\n"
+    "usage: blendtool render SCENE -o OUT.{png,exr} [--width W] [--height H] [--threads N]\n"
+    "                        [--quality Q] [--silhouette] [--bits 8|16] [--pixel half|float]\n"
+    "                        [--alpha] [--set PATH=VALUE]...\n\n"
     "Exports the scene (as blendtool pov) and runs povray on it; povray's progress\n"
-    "streams to standard error. OUT.png appears only when the render succeeded.\n"
+    "streams to standard error. The image is written by OpenImageIO: PNG (8 or 16\n"
+    "bits) or OpenEXR (half or float), RGB or with --alpha RGBA, with the scene's\n"
+    "hash, libblend's version and the render settings as metadata and no time\n"
+    "stamp: the same scene and options give the same bytes. OUT appears only when\n"
+    "the render succeeded.\n"
     "libblend.inc is taken from $LIBBLEND_POVRAY_INCLUDE or " LIBBLEND_POVRAY_DIR ".\n"
     "  --width, --height  image size (640 x 480)\n"
     "  --threads N        render threads (0 = one per CPU)\n"
     "  --quality Q        POV-Ray quality 0..11 (9)\n"
     "  --silhouette       a white object on black, unshaded\n"
+    "  --bits 8|16        PNG channel depth (8)\n"
+    "  --pixel half|float EXR pixel type (half)\n"
+    "  --alpha            keep the alpha channel (transparent background)\n"
+    "  --set PATH=VALUE   override a scene value first (VALUE is JSON); repeatable\n"
     "A signal (SIGINT, SIGTERM, SIGHUP) ends povray too and removes the temporary\n"
     "folder ($TMPDIR or /tmp/blendtool-render-PID-*); a folder left by a killed run is\n"
     "removed by the next render.\n"

@@ -9,8 +9,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static const bt_command *const COMMANDS[] = {&bt_cmd_validate, &bt_cmd_info, &bt_cmd_eval,
-                                             &bt_cmd_mesh,     &bt_cmd_pov,  &bt_cmd_render};
+static const bt_command *const COMMANDS[] = {&bt_cmd_validate, &bt_cmd_info,   &bt_cmd_eval,
+                                             &bt_cmd_mesh,     &bt_cmd_pov,    &bt_cmd_render,
+                                             &bt_cmd_batch,    &bt_cmd_compare};
 #define NCOMMANDS (sizeof COMMANDS / sizeof COMMANDS[0])
 
 int bt_exit_for(lb_status s) {
@@ -20,12 +21,20 @@ int bt_exit_for(lb_status s) {
 
 /* One line whatever the arguments hold (file names, option values): control
  * characters are written as \n, \t, \r or \xNN, as the library does. */
+/* the last message, for batch's JSON log (one process, one thread) */
+static char last_error[4096];
+
+const char *bt_last_error(void) {
+    return last_error;
+}
+
 void bt_error(const char *cmd, const char *fmt, ...) {
     char raw[4096];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(raw, sizeof raw, fmt, ap);
     va_end(ap);
+    snprintf(last_error, sizeof last_error, "%s", raw);
     fprintf(stderr, "blendtool %s: ", cmd);
     for (const unsigned char *c = (const unsigned char *)raw; *c; ++c) {
         if (*c == '\n' || *c == '\t' || *c == '\r')
