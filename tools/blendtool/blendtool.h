@@ -17,9 +17,16 @@
 #include <libblend/libblend.h>
 
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include <sys/types.h>
+
+#define BT_STR2(x) #x
+#define BT_STR(x) BT_STR2(x)
+/* libblend's version as text, e.g. "0.1.0" */
+#define BT_VERSION                                                                                 \
+    BT_STR(LB_VERSION_MAJOR) "." BT_STR(LB_VERSION_MINOR) "." BT_STR(LB_VERSION_PATCH)
 
 enum { BT_EXIT_OK = 0, BT_EXIT_INTERNAL = 1, BT_EXIT_BAD_INPUT = 2 };
 
@@ -36,6 +43,9 @@ int bt_exit_for(lb_status s);
 /* Print "blendtool CMD: message" to stderr. */
 void bt_error(const char *cmd, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
+/* The text of the last bt_error message ("" before any). */
+const char *bt_last_error(void);
+
 /* Option parsing shared by the subcommands: `--name VALUE` or
  * `--name=VALUE`. Returns 1 and sets *value when argv[*i] is that option
  * (advancing *i past the value), 0 when it is not, -1 (after printing an
@@ -49,6 +59,28 @@ int bt_parse_threads(const char *cmd, const char *text, int *threads);
 /* Load a scene, printing the library's message on failure. Returns the exit
  * code (0 on success). */
 int bt_load_scene(const char *cmd, const char *path, lb_scene **scene);
+
+/* ---- scene overrides (overrides.c) ---- */
+
+#define BT_MAX_SETS 64
+
+/* One `--set PATH=VALUE`: the path (plen bytes of it) and a JSON value. */
+typedef struct bt_set {
+    const char *path; /* PATH=VALUE as given (the path is its first plen bytes) */
+    size_t plen;
+    const char *value; /* JSON text */
+} bt_set;
+
+/* Parse "PATH=VALUE" (VALUE must be JSON). Returns 0, or -1 after printing
+ * an error naming the argument. */
+int bt_set_parse(const char *cmd, const char *arg, bt_set *out);
+
+/* Load a scene with overrides applied in order: a path that does not exist
+ * and a scene the overrides make invalid are bad input (exit 2) with the
+ * scene's own message and the overrides named. hash (may be NULL) receives
+ * the 128-bit XXH3 hash of the resolved scene text. Returns an exit code. */
+int bt_load_scene_set(const char *cmd, const char *path, const bt_set *sets, size_t nsets,
+                      lb_scene **scene, uint64_t hash[2]);
 
 /* An output being written: an lb_output, or standard output for "-". */
 typedef struct bt_out {
@@ -87,10 +119,54 @@ void bt_signals_temp_dir(const char *dir); /* NULL: none */
 void bt_signals_child(pid_t pid);          /* 0: none */
 void bt_signals_commit(void);              /* hold the signals from here to exit */
 
+/* ---- rendering (cmd_pov.c) ---- */
+
+/* A private render folder in $TMPDIR (or /tmp): the scene, povray's image
+ * and its state file, all registered with the signal handler (removed on
+ * SIGINT / SIGTERM / SIGHUP; a folder of a killed run is removed by the
+ * next render). */
+typedef struct bt_render_dir {
+    char dir[4096], pov[4200], png[4200], state[4200], log[4200];
+    int slot[4];
+} bt_render_dir;
+int bt_render_dir_open(bt_render_dir *r); /* exit code */
+void bt_render_dir_close(bt_render_dir *r);
+
+/* povray on pov into png (deep: a 16-bit PNG with alpha); its messages
+ * stream to stderr, or go to log (not NULL) and are shown only when it
+ * fails. Returns an exit code, after printing a message naming scene_name
+ * on failure. */
+int bt_povray(const char *scene_name, const char *pov, const char *png, int width, int height,
+              int threads, int quality, int deep, const char *log);
+
+/* The lbi_format for an image name (.png: --bits 8|16, .exr: --pixel
+ * half|float; 0 / NULL: the defaults), or -1 after printing why. */
+int bt_image_format(const char *cmd, const char *out, int bits, const char *pixel);
+/* 32 hex digits of a 128-bit hash */
+void bt_hash_hex(const uint64_t h[2], char out[33]);
+
+/* ---- images (imageio_load.c): OpenImageIO, loaded on first use ---- */
+
+#include "lbimageio.h"
+
+typedef struct bt_imageio {
+    int (*convert)(const char *in, lbi_format format, int alpha, const lbi_meta *meta, size_t nmeta,
+                   unsigned char **data, size_t *size, char *err, size_t errlen);
+    int (*contact_sheet)(const char *const *images, const char *const *labels, size_t n,
+                         int columns, int cell_w, int cell_h, lbi_format format,
+                         const lbi_meta *meta, size_t nmeta, unsigned char **data, size_t *size,
+                         char *err, size_t errlen);
+    int (*compare)(const char *a, const char *b, double fail, double *max_error, double *mean_error,
+                   double *fail_percent, char *err, size_t errlen);
+} bt_imageio;
+
+/* The image functions, or NULL after printing why they cannot be loaded. */
+const bt_imageio *bt_imageio_get(const char *cmd);
+
 /* Is help requested anywhere in argv? */
 int bt_wants_help(int argc, char **argv);
 
 extern const bt_command bt_cmd_validate, bt_cmd_info, bt_cmd_eval, bt_cmd_mesh, bt_cmd_pov,
-    bt_cmd_render;
+    bt_cmd_render, bt_cmd_batch, bt_cmd_compare;
 
 #endif

@@ -57,6 +57,8 @@ static int run(int argc, char **argv) {
     lb_mesh_options_init(&o);
     int have_bounds = 0, quiet = 0, have_res = 0;
     lb_mesh_format format = LB_MESH_FORMAT_AUTO;
+    bt_set sets[BT_MAX_SETS];
+    size_t nsets = 0;
     for (int i = 1; i < argc; ++i) {
         int r;
         if ((r = bt_option(CMD, argc, argv, &i, "-o", &val)) ||
@@ -104,6 +106,13 @@ static int run(int argc, char **argv) {
                 bt_error(CMD, "--format %s; allowed: ply, obj, stl or glb", val);
                 return BT_EXIT_BAD_INPUT;
             }
+        } else if ((r = bt_option(CMD, argc, argv, &i, "--set", &val))) {
+            if (r < 0) return BT_EXIT_BAD_INPUT;
+            if (nsets == BT_MAX_SETS) {
+                bt_error(CMD, "more than %d --set overrides", BT_MAX_SETS);
+                return BT_EXIT_BAD_INPUT;
+            }
+            if (bt_set_parse(CMD, val, &sets[nsets++])) return BT_EXIT_BAD_INPUT;
         } else if (strcmp(argv[i], "--open") == 0) {
             o.flags |= LB_MESH_OPEN_BOUNDARY;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
@@ -137,7 +146,7 @@ static int run(int argc, char **argv) {
         return BT_EXIT_BAD_INPUT;
     }
     lb_scene *scene = NULL;
-    int rc = bt_load_scene(CMD, scene_path, &scene);
+    int rc = bt_load_scene_set(CMD, scene_path, sets, nsets, &scene, NULL);
     if (rc) return rc;
     if (!have_bounds && !lb_scene_bounds(scene, o.bmin, o.bmax)) {
         bt_error(CMD,
@@ -197,7 +206,7 @@ const bt_command bt_cmd_mesh = {
     "mesh", "a closed triangle mesh of the scene (PLY, OBJ, STL, glTF binary)",
     "usage: blendtool mesh SCENE -o OUT.{ply,obj,stl,glb} [--resolution N | --cell-size H]\n"
     "                      [--bounds x0,y0,z0,x1,y1,z1] [--open] [--threads N] [--quiet]\n"
-    "                      [--format ply|obj|stl|glb]\n\n"
+    "                      [--format ply|obj|stl|glb] [--set PATH=VALUE]...\n\n"
     "Meshes the scene's surface inside the region (the scene's bounds, or --bounds):\n"
     "closed and manifold, vertices on the surface with normals from the analytic\n"
     "gradient. Where the region cuts the solid the mesh is closed on the region's\n"
@@ -208,6 +217,8 @@ const bt_command bt_cmd_mesh = {
     "  --threads N     0 = one per CPU (default), 1 = single-threaded; the mesh is the\n"
     "                  same for every thread count\n"
     "  --quiet         no progress bar (shown only on a terminal) and no summary line\n"
+    "  --set PATH=VALUE  override a scene value first (VALUE is JSON), e.g.\n"
+    "                  --set root.args[0].radius=0.5; repeatable, applied in order\n"
     "OUT may be a symbolic link (its target is replaced), a device or a FIFO (written\n"
     "directly); a new file gets mode 0666 less the umask, an existing one keeps its mode.\n"
     "Ctrl-C (SIGINT), SIGTERM and SIGHUP cancel at any phase: nothing is written. The\n"
