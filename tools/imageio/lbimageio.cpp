@@ -37,7 +37,12 @@ int write_buf(const ImageBuf &buf, lbi_format format, const lbi_meta *meta, size
     ImageSpec spec(src.width, src.height, src.nchannels, type);
     spec.channelnames = src.channelnames;
     spec.alpha_channel = src.alpha_channel;
-    if (format == LBI_EXR_HALF || format == LBI_EXR_FLOAT) spec.attribute("compression", "zip");
+    if (format == LBI_EXR_HALF || format == LBI_EXR_FLOAT) {
+        spec.attribute("compression", "zip");
+        // OpenImageIO's EXR writer stamps the current time as capDate unless
+        // DateTime is set: an empty one keeps the bytes the same every run
+        spec.attribute("DateTime", "");
+    }
     if (format == LBI_PNG8 || format == LBI_PNG16) spec.attribute("png:compressionLevel", 9);
     spec.attribute("Software", "libblend");
     for (size_t i = 0; i < nmeta; ++i)
