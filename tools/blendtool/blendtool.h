@@ -71,6 +71,10 @@ typedef struct bt_set {
     const char *value; /* JSON text */
 } bt_set;
 
+/* A whole file, NUL-terminated (malloc'd; *len without the NUL), or NULL
+ * with why (strerror, or "larger than max bytes"). */
+char *bt_read_file(const char *path, size_t max, size_t *len, char *why, size_t whylen);
+
 /* Parse "PATH=VALUE" (VALUE must be JSON). Returns 0, or -1 after printing
  * an error naming the argument. */
 int bt_set_parse(const char *cmd, const char *arg, bt_set *out);

@@ -402,31 +402,6 @@ static int parse_outputs(job *J, const cJSON *o) {
     return 0;
 }
 
-static char *read_text(const char *path, size_t *len) {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    size_t cap = 65536, n = 0;
-    char *b = malloc(cap + 1);
-    while (b) {
-        n += fread(b + n, 1, cap - n, f);
-        if (n < cap || cap >= (16u << 20)) break;
-        char *q = realloc(b, 2 * cap + 1);
-        if (!q) {
-            free(b);
-            b = NULL;
-        } else {
-            b = q;
-            cap *= 2;
-        }
-    }
-    fclose(f);
-    if (b) {
-        b[n] = '\0';
-        *len = n;
-    }
-    return b;
-}
-
 static void relative(const job *J, const char *p, char *out, size_t len) {
     if (p[0] == '/')
         snprintf(out, len, "%s", p);
@@ -445,9 +420,12 @@ static int parse_job(job *J, const char *file) {
     else
         strcpy(J->dir, ".");
     size_t len = 0;
-    char *text = read_text(file, &len);
+    char why[256];
+    char *text = bt_read_file(file, 16u << 20, &len, why, sizeof why);
     if (!text) {
-        bt_error(CMD, "%s: cannot read the job file (%s)", file, strerror(errno));
+        bt_error(CMD,
+                 "%s: cannot read the job file (%s); allowed: a readable file of at most 16 MiB",
+                 file, why);
         return BT_EXIT_BAD_INPUT;
     }
     const char *end = NULL;
@@ -795,7 +773,8 @@ static int task_done(const job *J, const task *T, const char *ident) {
     char mp[8192];
     manifest_path(J, T, mp, sizeof mp);
     size_t len = 0;
-    char *text = read_text(mp, &len);
+    char why[256];
+    char *text = bt_read_file(mp, 1u << 20, &len, why, sizeof why);
     if (!text) return 0;
     cJSON *m = cJSON_Parse(text);
     free(text);

@@ -13,8 +13,7 @@
 #include <string.h>
 #include <xxhash.h>
 
-/* the scene file's bytes (at most LB_SCENE_MAX_BYTES), NUL-terminated */
-static char *read_all(const char *path, size_t *len, char *why, size_t whylen) {
+char *bt_read_file(const char *path, size_t max, size_t *len, char *why, size_t whylen) {
     FILE *f = fopen(path, "rb");
     if (!f) {
         snprintf(why, whylen, "%s", strerror(errno));
@@ -26,8 +25,8 @@ static char *read_all(const char *path, size_t *len, char *why, size_t whylen) {
         const size_t r = fread(buf + n, 1, cap - n, f);
         n += r;
         if (n < cap) break;
-        if (cap >= (size_t)LB_SCENE_MAX_BYTES) {
-            snprintf(why, whylen, "larger than %d bytes", LB_SCENE_MAX_BYTES);
+        if (cap >= max) {
+            snprintf(why, whylen, "larger than %zu bytes", max);
             free(buf);
             buf = NULL;
             break;
@@ -179,7 +178,7 @@ int bt_load_scene_set(const char *cmd, const char *path, const bt_set *sets, siz
     if (!nsets && !hash) return bt_load_scene(cmd, path, scene);
     char why[1024];
     size_t len = 0;
-    char *text = read_all(path, &len, why, sizeof why);
+    char *text = bt_read_file(path, LB_SCENE_MAX_BYTES, &len, why, sizeof why);
     if (!text) { /* the library says why, in its words (missing, folder, too large) */
         const int rc = bt_load_scene(cmd, path, scene);
         if (!rc) {
