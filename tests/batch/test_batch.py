@@ -86,6 +86,15 @@ for j in (BASE,):
     except jsonschema.ValidationError as e:
         fail("schema rejects a good job: %s" % e.message)
 
+# ---- the shipped example jobs: valid, and their task lists expand
+for p in sorted(glob.glob(os.path.join(SRC, "scenes", "jobs", "*.json"))):
+    try:
+        jsonschema.validate(json.load(open(p)), SCHEMA)
+    except jsonschema.ValidationError as e:
+        fail("%s: the schema rejects it: %s" % (p, e.message))
+    r = bt("batch", p, "--list")
+    check(r.returncode == 0 and len(r.stdout.splitlines()) >= 10, "%s --list: %s" % (p, r.stderr))
+
 # ---- the task list: deterministic, independent of the folder it runs from
 d1 = os.path.join(WORK, "a")
 os.makedirs(d1)
