@@ -180,11 +180,12 @@ def _region(output):
     return tuple(s.bounds_min), tuple(s.bounds_max)
 
 
-def prepare(output, resolution):
+def prepare(output, resolution, depsgraph=None):
     """Read the tree (main thread) into a _Job; raises tree.TreeError or
-    binding.LibraryError."""
+    binding.LibraryError. With a depsgraph the values are that depsgraph's
+    (a render's frame), else the objects' own."""
     lib = library()
-    text, paths = tree.to_json(output)
+    text, paths = tree.to_json(output, depsgraph)
     bmin, bmax = _region(output)
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
                 output.libblend.open_boundary, threads(), paths)
@@ -210,7 +211,7 @@ def _finish(output, st, job, t_start, defer_normals=False):
     return True
 
 
-def update_now(output, final=False):
+def update_now(output, final=False, depsgraph=None):
     """Mesh the output synchronously on this thread; returns (ok, message)."""
     st = _state(output.name)
     t0 = time.perf_counter()
@@ -218,7 +219,7 @@ def update_now(output, final=False):
         st.job.cancel.cancel()
     try:
         job = prepare(output, output.libblend.render_resolution if final
-                      else output.libblend.preview_resolution)
+                      else output.libblend.preview_resolution, depsgraph)
     except (tree.TreeError, binding.LibraryError) as e:
         st.status, st.error = str(e), True
         return False, str(e)
@@ -357,24 +358,49 @@ def on_load(*_):
     _structure.clear()
 
 
-_render_swapped = []
+_render = {"active": False, "meshed": []}
 
 
 @bpy.app.handlers.persistent
 def on_render_init(scene, *_):
-    """Final renders use each field's render resolution."""
+    """Final renders use each field's render resolution (the first frame)."""
+    _render["active"] = True
     for obj in scene.objects:
-        s = obj.libblend
-        if s.kind == "OUTPUT" and s.render_resolution != s.preview_resolution:
+        if obj.libblend.kind == "OUTPUT" and not obj.hide_render:
             ok, _msg = update_now(obj, final=True)
-            if ok:
-                _render_swapped.append(obj.name)
+            if ok and obj.name not in _render["meshed"]:
+                _render["meshed"].append(obj.name)
+
+
+@bpy.app.handlers.persistent
+def on_frame_change(scene, depsgraph=None):
+    """A frame change. During a render (F12 animation, blender -b -a / -f,
+    frame ranges) each frame's values live only in the render's depsgraph
+    (the objects themselves still hold the previous frame's): every field is
+    remeshed synchronously from that depsgraph at render resolution before
+    the frame renders. Otherwise (playback, scrubbing, frame_set in
+    scripts) the fields are marked dirty and remesh at preview resolution
+    by the live rules."""
+    outputs = [o for o in scene.objects if o.libblend.kind == "OUTPUT"]
+    if _render["active"]:
+        for obj in outputs:
+            if obj.hide_render:  # not in the render: left as it is
+                continue
+            ok, _msg = update_now(obj.original, final=True, depsgraph=depsgraph)
+            if ok and obj.name not in _render["meshed"]:
+                _render["meshed"].append(obj.name)
+        return
+    for obj in outputs:
+        if obj.libblend.live:
+            mark_dirty(obj)
 
 
 @bpy.app.handlers.persistent
 def on_render_done(scene, *_):
-    while _render_swapped:
-        obj = bpy.data.objects.get(_render_swapped.pop())
+    """After a render: back to the preview mesh of the current frame."""
+    _render["active"] = False
+    while _render["meshed"]:
+        obj = bpy.data.objects.get(_render["meshed"].pop())
         if obj is not None:
             update_now(obj)
 
@@ -382,7 +408,7 @@ def on_render_done(scene, *_):
 _HANDLERS = [("depsgraph_update_post", on_depsgraph), ("depsgraph_update_post", on_structure),
              ("undo_post", on_undo), ("redo_post", on_undo), ("load_post", on_load),
              ("render_init", on_render_init), ("render_complete", on_render_done),
-             ("render_cancel", on_render_done)]
+             ("render_cancel", on_render_done), ("frame_change_post", on_frame_change)]
 
 
 def register():

@@ -74,10 +74,13 @@ def is_node(obj):
     return obj is not None and obj.libblend.kind in ("PRIMITIVE", "BLEND")
 
 
-def children(obj, role="ARG"):
-    """The node children of obj with the given role, in argument order."""
-    return sorted((c for c in obj.children if is_node(c) and c.libblend.role == role),
+def children(obj, role="ARG", depsgraph=None):
+    """The node children of obj with the given role, in argument order; with a
+    depsgraph, their evaluated copies (the values at that depsgraph's frame:
+    keyframes, drivers, constraints)."""
+    kids = sorted((c for c in obj.original.children if is_node(c) and c.libblend.role == role),
                   key=lambda c: (c.libblend.order, c.name))
+    return [c.evaluated_get(depsgraph) for c in kids] if depsgraph is not None else kids
 
 
 def output_of(obj):
@@ -142,7 +145,7 @@ def _per_arg(blend, args, key):
     return vals[0] if all(v == vals[0] for v in vals) else vals
 
 
-def _node(obj, path, paths, convention, depth):
+def _node(obj, path, paths, convention, depth, dg=None):
     if depth > 64:
         raise TreeError("object '%s': the tree is nested deeper than 64 levels; allowed: 64 "
                         "(docs/scene-format.md, Limits)" % obj.name)
@@ -156,7 +159,7 @@ def _node(obj, path, paths, convention, depth):
         if convention == "soft":
             out["kernel"] = s.kernel
         _transform(obj, out, True)
-        if children(obj):
+        if children(obj, "ARG", dg):
             raise TreeError("object '%s': a primitive cannot have arguments (child '%s'). Fix: "
                             "parent '%s' to a blend node instead"
                             % (obj.name, children(obj)[0].name, children(obj)[0].name))
@@ -164,7 +167,7 @@ def _node(obj, path, paths, convention, depth):
     t = s.blend_type
     if t not in BLEND_KEYS:
         raise TreeError("object '%s': unknown operator %r" % (obj.name, t))
-    args = children(obj)
+    args = children(obj, "ARG", dg)
     if not args:
         raise TreeError("object '%s': the %s blend has no arguments. Fix: parent primitives or "
                         "blends to it (or delete it)" % (obj.name, t))
@@ -205,25 +208,29 @@ def _node(obj, path, paths, convention, depth):
                                 % obj.name) from None
             out.update({k: v for k, v in extra.items() if k in LOCAL_EXTRA})
     _transform(obj, out, False)
-    out["args"] = [_node(a, "%s.args[%d]" % (path, i), paths, convention, depth + 1)
+    out["args"] = [_node(a, "%s.args[%d]" % (path, i), paths, convention, depth + 1, dg)
                    for i, a in enumerate(args)]
     if "bounds" in keys:
         bounds = []
         for i, a in enumerate(args):
-            b = children(a, "BOUND")
+            b = children(a, "BOUND", dg)
             if len(b) != 1:
                 raise TreeError("object '%s': argument '%s' of the bounded blend needs exactly one "
                                 "bounding solid, found %d. Fix: select it and use Add Bounding "
                                 "Solid" % (obj.name, a.name, len(b)))
-            bounds.append(_node(b[0], "%s.bounds[%d]" % (path, i), paths, convention, depth + 1))
+            bounds.append(_node(b[0], "%s.bounds[%d]" % (path, i), paths, convention, depth + 1,
+                                dg))
         out["bounds"] = bounds
     return out
 
 
-def to_scene(output):
-    """(scene dict, {json path: object name}) for an OUTPUT object."""
+def to_scene(output, depsgraph=None):
+    """(scene dict, {json path: object name}) for an OUTPUT object; with a
+    depsgraph, every value as that depsgraph evaluated it (its frame)."""
+    if depsgraph is not None:
+        output = output.evaluated_get(depsgraph)
     s = output.libblend
-    roots = children(output)
+    roots = children(output, "ARG", depsgraph)
     if len(roots) != 1:
         raise TreeError("field '%s' has %d root nodes; allowed: exactly one. Fix: %s"
                         % (output.name, len(roots),
@@ -242,7 +249,7 @@ def to_scene(output):
         scene["description"] = s.description
     scene["convention"] = s.convention
     scene["bounds"] = {"min": lo, "max": hi}
-    scene["root"] = _node(roots[0], "$.root", paths, s.convention, 0)
+    scene["root"] = _node(roots[0], "$.root", paths, s.convention, 0, depsgraph)
     if s.render_json:
         try:
             scene["render"] = json.loads(s.render_json)
@@ -252,8 +259,8 @@ def to_scene(output):
     return scene, paths
 
 
-def to_json(output):
-    scene, paths = to_scene(output)
+def to_json(output, depsgraph=None):
+    scene, paths = to_scene(output, depsgraph)
     return json.dumps(scene, indent=2), paths
 
 

@@ -461,5 +461,75 @@ check("libblend.update_mesh" not in Recorder.drawn, "no meshing buttons without 
 del os.environ["LIBBLEND_LIBRARY"]
 check(live.reload_library()[0], "library back")
 
+# ---------------------------------------------------------------- an animation renders right
+# a keyframed r and a moving primitive, rendered as 3 frames: each frame's mesh
+# is blendtool's mesh of the scene exported at that frame, and the frames differ
+sc = bpy.context.scene
+bpy.ops.libblend.add_field(convention="zero", with_sphere=False)
+anim = active()
+anim.libblend.live = False
+anim.libblend.bounds_min, anim.libblend.bounds_max = (-2, -1.5, -1.5), (2.5, 1.5, 1.5)
+anim.libblend.preview_resolution, anim.libblend.render_resolution = 24, 40
+bpy.ops.libblend.add_blend(blend_type="displacement", op="union", wrap_selected=False)
+ab = active()
+ab.libblend.r = 0.05
+ab.keyframe_insert("libblend.r", frame=1)
+ab.libblend.r = 1.5
+ab.keyframe_insert("libblend.r", frame=3)
+bpy.ops.libblend.add_primitive(prim_type="sphere")
+s1 = active()
+activate(ab)
+bpy.ops.libblend.add_primitive(prim_type="sphere")
+s2 = active()
+s2.location = (1.2, 0, 0)
+s2.keyframe_insert("location", frame=1)
+s2.location = (1.8, 0.3, 0)
+s2.keyframe_insert("location", frame=3)
+for o in sc.objects:  # only this field in the render
+    if o.libblend.kind == "OUTPUT" and o != anim:
+        o.hide_render = True
+sc.frame_start, sc.frame_end = 1, 3
+sc.render.engine = "CYCLES"
+sc.cycles.samples = 1
+sc.cycles.use_denoising = False
+sc.render.resolution_x, sc.render.resolution_y = 64, 48
+sc.render.filepath = os.path.join(WORK, "anim_")
+sc.frame_set(1)
+rendered = {}
+
+
+def grab(scene, *_):
+    V, F = blender_mesh(anim)
+    rendered[scene.frame_current] = meshcheck.check(V, F)
+
+
+bpy.app.handlers.render_post.append(grab)
+bpy.ops.render.render(animation=True)
+bpy.app.handlers.render_post.remove(grab)
+check(sorted(rendered) == [1, 2, 3], "three frames rendered: %s" % sorted(rendered))
+for f in (1, 2, 3):
+    sc.frame_set(f)
+    text, _ = tree.to_json(anim, bpy.context.evaluated_depsgraph_get())
+    js = os.path.join(WORK, "anim-%d.json" % f)
+    open(js, "w").write(text)
+    r_f = json.loads(text)["root"]["r"]
+    check(abs(r_f - {1: 0.05, 2: 0.775, 3: 1.5}[f]) < 1e-6, "frame %d's export holds the keyed r: %s"
+          % (f, r_f))
+    ply = os.path.join(WORK, "anim-%d.ply" % f)
+    subprocess.run([BLENDTOOL, "mesh", js, "-o", ply, "--resolution", "40", "--quiet"], check=True)
+    Vb, _Nb, Fb = meshcheck.read(ply)
+    ib, ir = meshcheck.check(Vb, Fb), rendered[f]
+    print("animation frame %d: rendered %d vertices, volume %.7f; blendtool %d, %.7f"
+          % (f, ir["vertices"], ir["volume"], ib["vertices"], ib["volume"]))
+    check(ir["vertices"] == ib["vertices"] and abs(ir["volume"] - ib["volume"]) <= 1e-6 * ib["volume"],
+          "frame %d renders the mesh of that frame's scene" % f)
+check(len({round(rendered[f]["volume"], 6) for f in (1, 2, 3)}) == 3, "the three frames' meshes differ")
+imgs = [os.path.join(WORK, "anim_%04d.png" % f) for f in (1, 2, 3)]
+for a, b in ((0, 1), (1, 2), (0, 2)):
+    r = subprocess.run([BLENDTOOL, "compare", imgs[a], imgs[b]], capture_output=True, text=True)
+    check(r.returncode == 3, "rendered frames %d and %d differ: %s" % (a + 1, b + 1, r.stdout))
+check(len(anim.data.vertices) == meshcheck.check(*blender_mesh(anim))["vertices"],
+      "after the render the field is back at its preview mesh")
+
 addon_utils.disable("libblend_blender")
 print("test_addon: %d checks passed" % checks)
