@@ -113,10 +113,12 @@ static int get_int(const job *J, const cJSON *o, const char *key, const char *pa
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
     if (!v) return 0;
     if (!cJSON_IsNumber(v) || v->valuedouble != floor(v->valuedouble) || v->valuedouble < lo ||
-        v->valuedouble > hi)
-        return bad(J, path, "\"%s\" is %s%s%s; allowed: an integer from %ld to %ld", key, kind(v),
-                   cJSON_IsNumber(v) ? " " : "", cJSON_IsNumber(v) ? cJSON_PrintUnformatted(v) : "",
-                   lo, hi);
+        v->valuedouble > hi) {
+        char num[64] = "";
+        if (cJSON_IsNumber(v)) snprintf(num, sizeof num, " %.17g", v->valuedouble);
+        return bad(J, path, "\"%s\" is %s%s; allowed: an integer from %ld to %ld", key, kind(v),
+                   num, lo, hi);
+    }
     *out = (long)v->valuedouble;
     return 0;
 }
@@ -660,8 +662,7 @@ static int make_task(const job *J, size_t id, task *T) {
     const size_t fi = id % nf, ci = id / nf % nc;
     T->scene = id / nf / nc;
     T->combo = ci;
-    T->frame = J->has_frames ? J->first + (long)fi : (long)(id % (nc * J->nscenes) % nc);
-    if (!J->has_frames) T->frame = (long)ci;
+    T->frame = J->has_frames ? J->first + (long)fi : (long)ci; /* a sweep: its index */
     for (size_t i = 0; i < J->nfixed; ++i) {
         T->set_text[T->nsets] = dupstr(J->fixed[i].path);
         T->sets[T->nsets] = J->fixed[i];
