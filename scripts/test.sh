@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The whole test suite: install what is missing, then a Release build and a
+# The whole test suite: install what is missing (and the Debian 13 root with
+# Blender 4.3, scripts/blender4-root.sh), then a Release build and a
 # sanitizer (ASan + UBSan) build, each run by ctest (the sanitizer build also
 # runs random valid scenes through every command for 60 s); the threaded
 # tests under ThreadSanitizer; then the scene parser under libFuzzer (clang,
@@ -7,6 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
+bash scripts/blender4-root.sh ensure   # Blender 4.3 for test_blender4 (cached after the first run)
 JOBS=$(nproc)
 for cfg in "build-release:-DCMAKE_BUILD_TYPE=Release" \
            "build-asan:-DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_SANITIZE=ON"; do

@@ -1,6 +1,6 @@
 """libblend for Blender: the blend operators of libblend (k-ary blends with
 per-primitive range, curvature and subsequent-blend parameters, bounded
-blends, bulge elimination) as a tree of primitives under a field object,
+blends, bulge elimination, local blends) as a tree of primitives under a field object,
 meshed live by the C library through ctypes. See README.md next to this
 package."""
 
@@ -16,13 +16,14 @@ bl_info = {
 
 if "bpy" in locals():  # F8 / script reload
     import importlib
-    for _m in ("binding", "props", "tree", "live", "ops", "ui"):
+    for _m in ("compat", "binding", "props", "tree", "bake", "render_section", "live", "ops",
+               "ui"):
         if _m in locals():
             importlib.reload(locals()[_m])
 
 import bpy  # noqa: E402
 
-from . import binding, live, ops, props, tree, ui  # noqa: E402,F401
+from . import bake, binding, compat, live, ops, props, render_section, tree, ui  # noqa: E402,F401
 
 
 def register():

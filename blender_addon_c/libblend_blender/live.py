@@ -15,13 +15,15 @@ smooth normals; libblend's analytic normals (custom split normals, the
 costly part) follow once the field has been idle for NORMALS_IDLE. The
 library never calls back into Python.
 """
+import hashlib
+import json
 import os
 import threading
 import time
 
 import bpy
 
-from . import binding, tree
+from . import bake, binding, compat, tree
 
 TICK = 0.005          # timer period while work is pending
 CANCEL_AFTER = 0.2    # a run this old is cancelled when newer edits wait
@@ -44,6 +46,7 @@ class _State:
         self.last = {}  # timings of the last update (seconds)
         self.normals = None  # analytic normals waiting to be set (live updates)
         self.t_applied = 0.0
+        self.applied_key = None  # mesh_key of the mesh in the Blender mesh now
 
 
 class _Job:
@@ -55,6 +58,7 @@ class _Job:
         self.lib, self.text, self.name = lib, text, name
         self.bmin, self.bmax, self.resolution = bmin, bmax, resolution
         self.open_boundary, self.threads, self.paths = open_boundary, threads, paths
+        self.key = mesh_key(text, bmin, bmax, resolution, open_boundary)
         self.cancel = binding.CancelToken()
         self.mesh = None
         self.error = None
@@ -130,10 +134,7 @@ def wants_analytic(normals, ntriangles):
 
 def set_normals(me, normals):
     """libblend's normals (one per vertex) as custom split normals."""
-    if hasattr(me, "use_auto_smooth"):  # Blender < 4.1
-        me.use_auto_smooth = True
-        me.auto_smooth_angle = 3.14159
-    me.normals_split_custom_set_from_vertices(normals)
+    compat.set_custom_normals(me, normals)
 
 
 def set_mesh_data(me, mesh, normals="AUTO"):
@@ -148,21 +149,26 @@ def set_mesh_data(me, mesh, normals="AUTO"):
         me.loops.add(3 * nt)
         me.loops.foreach_set("vertex_index", mesh.triangles.astype(np.int32).ravel())
         me.polygons.add(nt)
-        me.polygons.foreach_set("loop_start", np.arange(0, 3 * nt, 3, dtype=np.int32))
-        try:  # Blender < 4.0 needs loop_total; later versions derive it
-            me.polygons.foreach_set("loop_total", np.full(nt, 3, dtype=np.int32))
-        except (AttributeError, TypeError, RuntimeError):
-            pass
+        compat.set_triangles(me, nt)
         me.update(calc_edges=True)
         me.polygons.foreach_set("use_smooth", np.ones(nt, dtype=bool))
         if wants_analytic(normals, nt):
             set_normals(me, mesh.normals)
-        elif hasattr(me, "use_auto_smooth"):
-            me.use_auto_smooth = False
+        else:
+            compat.clear_custom_normals(me)
     me.update()
 
 
 # --------------------------------------------------------------------------- jobs
+
+def mesh_key(text, bmin, bmax, resolution, open_boundary):
+    """What a mesh is a function of: the scene text, the region, the
+    resolution and the boundary mode. Equal keys, equal meshes; so a field
+    whose key did not change is not meshed again (frames where nothing
+    moved, a driver that did not change its value, a render's first frame)."""
+    h = hashlib.sha256(json.dumps([text, list(bmin), list(bmax), int(resolution),
+                                   bool(open_boundary)]).encode())
+    return h.hexdigest()[:32]
 
 def _state(name):
     st = _states.get(name)
@@ -185,7 +191,7 @@ def prepare(output, resolution, depsgraph=None):
     binding.LibraryError. With a depsgraph the values are that depsgraph's
     (a render's frame), else the objects' own."""
     lib = library()
-    text, paths = tree.to_json(output, depsgraph)
+    text, paths = tree.to_json(output, depsgraph, render=False)
     bmin, bmax = _region(output)
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
                 output.libblend.open_boundary, threads(), paths)
@@ -202,6 +208,7 @@ def _finish(output, st, job, t_start, defer_normals=False):
         st.normals = job.mesh.normals
         mode = "FACES"
     set_mesh_data(output.data, job.mesh, mode)
+    st.applied_key = job.key
     st.t_applied = time.perf_counter()
     st.last = {"mesh": job.seconds, "apply": time.perf_counter() - t0,
                "total": time.perf_counter() - t_start}
@@ -211,8 +218,10 @@ def _finish(output, st, job, t_start, defer_normals=False):
     return True
 
 
-def update_now(output, final=False, depsgraph=None):
-    """Mesh the output synchronously on this thread; returns (ok, message)."""
+def update_now(output, final=False, depsgraph=None, force=True):
+    """Mesh the output synchronously on this thread; returns (ok, message).
+    force=False skips the meshing when the mesh in Blender already is this
+    state's (same mesh_key)."""
     st = _state(output.name)
     t0 = time.perf_counter()
     if st.job:
@@ -223,10 +232,118 @@ def update_now(output, final=False, depsgraph=None):
     except (tree.TreeError, binding.LibraryError) as e:
         st.status, st.error = str(e), True
         return False, str(e)
+    if not force and job.key == st.applied_key and st.normals is None and not st.error:
+        st.dirty = False
+        return True, st.status
     job.run()
     ok = _finish(output, st, job, t0)
     st.dirty = False
     return ok, st.status
+
+
+def _frame(scene, depsgraph):
+    return depsgraph.scene_eval.frame_current if depsgraph is not None else scene.frame_current
+
+
+def cached_key(output, depsgraph=None):
+    """The mesh_key a baked frame of this state must have (render resolution);
+    needs no library."""
+    s = output.libblend
+    text, _paths = tree.to_json(output, depsgraph, render=False)
+    bmin, bmax = _region(output)
+    return mesh_key(text, bmin, bmax, s.render_resolution, s.open_boundary)
+
+
+def from_cache(output, frame, depsgraph=None):
+    """Apply the baked mesh of frame when the field uses its bake and the
+    frame's file is there and current. Returns (used, note): note says why
+    not (for the status line and render logs), "" when there is no bake."""
+    s = output.libblend
+    if not s.use_bake:
+        return False, ""
+    st = _state(output.name)
+    t0 = time.perf_counter()
+    try:
+        key = cached_key(output, depsgraph)
+        if key == st.applied_key and not st.error:
+            return True, ""
+        path = bake.frame_path(bake.folder(output), frame)
+        mesh = bake.read(path, key)
+    except (tree.TreeError, bake.CacheError) as e:
+        return False, str(e)
+    if mesh is None:
+        return False, ("field '%s': frame %d is not in its bake (%s) or the field changed since "
+                       "the bake: meshed instead" % (output.name, frame, os.path.dirname(path)))
+    if st.job:
+        st.job.cancel.cancel()
+        st.job = None
+    t1 = time.perf_counter()
+    set_mesh_data(output.data, mesh, output.libblend.normals)
+    st.normals, st.dirty, st.error = None, False, False
+    st.applied_key, st.t_applied = key, time.perf_counter()
+    st.last = {"mesh": 0.0, "read": t1 - t0, "apply": st.t_applied - t1,
+               "total": st.t_applied - t0}
+    st.status = "%d triangles, frame %d from the bake, %.0f ms" % (
+        len(mesh.triangles), frame, 1000 * st.last["total"])
+    return True, ""
+
+
+def frame_update(output, frame, depsgraph=None, final=True):
+    """The field at a frame, synchronously: its baked mesh when it uses one
+    and has that frame, else meshed (skipped when already current).
+    Returns (ok, message); a bake that could not be used is reported on
+    standard output (render logs) and in the status line."""
+    used, note = from_cache(output, frame, depsgraph)
+    if used:
+        return True, _state(output.name).status
+    ok, msg = update_now(output, final=final, depsgraph=depsgraph, force=False)
+    if note:
+        print("libblend:", note)
+        if ok:
+            st = _state(output.name)
+            st.status = msg = st.status + " (" + note.split(": ", 1)[-1] + ")"
+    return ok, msg
+
+
+_baking = {"active": False}
+
+
+def bake_frames(output, scene, frames, wm=None):
+    """Bake: mesh output at render resolution at each frame (the scene is
+    stepped through them with frame_set, then put back), write each file
+    atomically, and switch the field to its bake. Returns (files, seconds).
+    Raises bake.CacheError, tree.TreeError, binding.LibblendError, OSError."""
+    folder = bake.folder(output)
+    frames = list(frames)
+    keep = scene.frame_current, scene.frame_subframe
+    t0 = time.perf_counter()
+    _baking["active"] = True
+    if wm is not None:
+        wm.progress_begin(0, len(frames))
+    try:
+        for i, f in enumerate(frames):
+            scene.frame_set(f)
+            dg = bpy.context.evaluated_depsgraph_get()
+            job = prepare(output, output.libblend.render_resolution, dg)
+            job.run()
+            if job.error:
+                raise binding.LibblendError("frame %d: %s" % (f, job.error))
+            bake.write(bake.frame_path(folder, f), job.mesh, job.key, f, job.resolution,
+                       output.name)
+            if wm is not None:
+                wm.progress_update(i + 1)
+    finally:
+        _baking["active"] = False
+        if wm is not None:
+            wm.progress_end()
+        scene.frame_set(keep[0], subframe=keep[1])
+    seconds = time.perf_counter() - t0
+    s = output.libblend
+    s.bake_info = "frames %d-%d (%d files, %d cells) in %.1f s: %s" % (
+        frames[0], frames[-1], len(frames), s.render_resolution, seconds, folder)
+    s.use_bake = True
+    from_cache(output, scene.frame_current)
+    return len(frames), seconds
 
 
 def mark_dirty(obj):
@@ -274,16 +391,21 @@ def tick():
                 continue
         if st.dirty:
             st.dirty = False
+            if out.libblend.use_bake and from_cache(out, bpy.context.scene.frame_current)[0]:
+                continue  # scrubbing a baked field: its frame's file
             try:
                 job = prepare(out, out.libblend.preview_resolution)
             except (tree.TreeError, binding.LibraryError) as e:
                 st.status, st.error = str(e), True
                 continue
-            job.t_start = st.t_edit
-            st.job = job
-            threading.Thread(target=job.run, name="libblend-mesh", daemon=True).start()
-            pending = True
-        elif st.normals is not None:
+            if job.key != st.applied_key or st.error:
+                job.t_start = st.t_edit
+                st.job = job
+                threading.Thread(target=job.run, name="libblend-mesh", daemon=True).start()
+                pending = True
+                continue
+            # else: an update that changed nothing the mesh depends on
+        if st.normals is not None:
             if now - st.t_applied >= NORMALS_IDLE:
                 set_normals(out.data, st.normals)
                 out.data.update()
@@ -308,11 +430,15 @@ def cancel_all():
 
 @bpy.app.handlers.persistent
 def on_depsgraph(scene, depsgraph):
+    """A node changed: its transform (G / R / S, constraints, parents), or a
+    setting through a driver or keyframe (which call no update callback).
+    The field is marked dirty; the timer meshes it only when its scene text
+    changed (mesh_key), so updates that change nothing cost one tree walk."""
     for u in depsgraph.updates:
         idb = u.id
         if isinstance(idb, bpy.types.Object):
             obj = idb.original
-            if tree.is_node(obj) and u.is_updated_transform:
+            if tree.is_node(obj):
                 mark_dirty(obj)
 
 
@@ -346,6 +472,8 @@ def _signature(out):
 @bpy.app.handlers.persistent
 def on_undo(*_):
     cancel_all()
+    for st in _states.values():
+        st.applied_key = None  # undo restored some earlier mesh: mesh again
     for obj in bpy.data.objects:
         if obj.libblend.kind == "OUTPUT":
             mark_dirty(obj)
@@ -361,15 +489,22 @@ def on_load(*_):
 _render = {"active": False, "meshed": []}
 
 
+def _render_frame(obj, frame, depsgraph=None):
+    ok, _msg = frame_update(obj, frame, depsgraph, final=True)
+    if ok and obj.name not in _render["meshed"]:
+        _render["meshed"].append(obj.name)
+
+
 @bpy.app.handlers.persistent
 def on_render_init(scene, *_):
-    """Final renders use each field's render resolution (the first frame)."""
+    """A final render starts (F12, blender -b -f / -a): each rendered field
+    at render resolution (or from its bake) for the current frame. An
+    animation's first frame change then finds it current (mesh_key) unless
+    the range starts elsewhere."""
     _render["active"] = True
     for obj in scene.objects:
         if obj.libblend.kind == "OUTPUT" and not obj.hide_render:
-            ok, _msg = update_now(obj, final=True)
-            if ok and obj.name not in _render["meshed"]:
-                _render["meshed"].append(obj.name)
+            _render_frame(obj, scene.frame_current)
 
 
 @bpy.app.handlers.persistent
@@ -377,32 +512,34 @@ def on_frame_change(scene, depsgraph=None):
     """A frame change. During a render (F12 animation, blender -b -a / -f,
     frame ranges) each frame's values live only in the render's depsgraph
     (the objects themselves still hold the previous frame's): every field is
-    remeshed synchronously from that depsgraph at render resolution before
-    the frame renders. Otherwise (playback, scrubbing, frame_set in
-    scripts) the fields are marked dirty and remesh at preview resolution
-    by the live rules."""
-    outputs = [o for o in scene.objects if o.libblend.kind == "OUTPUT"]
+    brought to that frame synchronously, before the frame renders, from
+    that depsgraph at render resolution (or read from its bake). Otherwise
+    (playback, scrubbing, frame_set in scripts) a baked field reads its
+    frame's file at once, and the others are marked dirty and remesh at
+    preview resolution by the live rules."""
+    if _baking["active"]:
+        return  # a bake steps through frames itself
+    outputs = [o.original for o in scene.objects if o.libblend.kind == "OUTPUT"]
     if _render["active"]:
         for obj in outputs:
-            if obj.hide_render:  # not in the render: left as it is
-                continue
-            ok, _msg = update_now(obj.original, final=True, depsgraph=depsgraph)
-            if ok and obj.name not in _render["meshed"]:
-                _render["meshed"].append(obj.name)
+            if not obj.hide_render:  # a field left out of the render is left as it is
+                _render_frame(obj, _frame(scene, depsgraph), depsgraph)
         return
     for obj in outputs:
+        if obj.libblend.use_bake and from_cache(obj, _frame(scene, depsgraph), depsgraph)[0]:
+            continue
         if obj.libblend.live:
             mark_dirty(obj)
 
 
 @bpy.app.handlers.persistent
 def on_render_done(scene, *_):
-    """After a render: back to the preview mesh of the current frame."""
+    """After a render: back to the viewport's mesh of the current frame."""
     _render["active"] = False
     while _render["meshed"]:
         obj = bpy.data.objects.get(_render["meshed"].pop())
         if obj is not None:
-            update_now(obj)
+            frame_update(obj, scene.frame_current, final=False)
 
 
 _HANDLERS = [("depsgraph_update_post", on_depsgraph), ("depsgraph_update_post", on_structure),

@@ -6,11 +6,11 @@ import shutil
 import tempfile
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 from mathutils import Matrix
 
-from . import binding, live, props, tree
+from . import bake, binding, live, props, render_section, tree
 
 
 def _active(context):
@@ -130,49 +130,87 @@ class LIBBLEND_OT_add_primitive(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class LIBBLEND_OT_add_blend(bpy.types.Operator):
-    """Add a libblend blend node; selected sibling nodes become its arguments"""
-    bl_idname = "libblend.add_blend"
-    bl_label = "Add libblend Blend"
-    bl_options = {"REGISTER", "UNDO"}
-
+class _BlendOperator:
     blend_type: EnumProperty(name="Operator", items=_blend_items)
     op: EnumProperty(name="Set Operation", items=props.OPS)
-    wrap_selected: BoolProperty(name="Blend Selected", default=True,
-                                description="make the selected nodes its arguments")
 
     def execute(self, context):
         a = _active(context)
         if a is None or tree.output_of(a) is None:
             self.report({"ERROR"}, "select a libblend field or one of its nodes first")
             return {"CANCELLED"}
-        sel = [o for o in _selected(context) if tree.is_node(o)] if self.wrap_selected else []
-        if sel == [a] and a.libblend.kind == "BLEND":
-            sel = []  # a lone active blend: the new blend becomes its argument
-        if sel:
-            parent = sel[0].parent
-            if any(o.parent != parent for o in sel):
-                self.report({"ERROR"}, "the selected nodes have different parents; select "
-                                       "siblings to blend them")
+        if self.wrap_selected:
+            sel = [o for o in _selected(context) if tree.is_node(o)]
+            if not sel:
+                self.report({"ERROR"}, "select the nodes to blend (primitives or blends of one "
+                                       "field)")
                 return {"CANCELLED"}
-            order = min(o.libblend.order for o in sel)
-        else:
-            parent = a if a.libblend.kind in ("OUTPUT", "BLEND") else a.parent
-            if _root_taken(self, parent, "select it to blend it with new nodes"):
-                return {"CANCELLED"}
-            order = _next_order(parent)
+            return self._wrap(context, sel)
+        parent = a if a.libblend.kind in ("OUTPUT", "BLEND") else a.parent
+        if _root_taken(self, parent, "select it and use Blend Selected to blend it with new "
+                                     "nodes"):
+            return {"CANCELLED"}
+        obj = self._new(context, parent, _next_order(parent), "ARG")
+        _make_active(context, obj)
+        live.mark_dirty(obj)
+        return {"FINISHED"}
+
+    def _new(self, context, parent, order, role):
         obj = _new_node(context, parent, self.blend_type, "PLAIN_AXES")
         s = obj.libblend
-        s.kind, s.blend_type, s.op, s.order = "BLEND", self.blend_type, self.op, order
-        for i, o in enumerate(sorted(sel, key=lambda o: (o.libblend.order, o.name))):
+        s.kind, s.blend_type, s.op, s.order, s.role = "BLEND", self.blend_type, self.op, order, role
+        return obj
+
+    def _wrap(self, context, sel):
+        """The new blend takes the selected nodes' place (parent, position,
+        role, and a lone node's own r / p / m there); they become its
+        arguments, in their order, where they are in the world."""
+        parent = sel[0].parent
+        if any(o.parent != parent for o in sel):
+            self.report({"ERROR"}, "the selected nodes have different parents; select siblings "
+                                   "to blend them")
+            return {"CANCELLED"}
+        if len({o.libblend.role for o in sel}) > 1:
+            self.report({"ERROR"}, "the selection mixes arguments and a bounding solid; select "
+                                   "arguments only, or the bounding solid alone")
+            return {"CANCELLED"}
+        sel = sorted(sel, key=lambda o: (o.libblend.order, o.name))
+        obj = self._new(context, parent, sel[0].libblend.order, sel[0].libblend.role)
+        if len(sel) == 1:  # the blend stands where the node stood, as the same argument
+            src, dst = sel[0].libblend, obj.libblend
+            dst.arg_override, dst.arg_r, dst.arg_p, dst.arg_m = \
+                src.arg_override, src.arg_r, src.arg_p, src.arg_m
+            src.arg_override = False
+        for i, o in enumerate(sel):
             w = o.matrix_world.copy()
             o.parent = obj
             o.matrix_parent_inverse = Matrix.Identity(4)
             o.matrix_world = w
-            o.libblend.order = i
+            o.libblend.order, o.libblend.role = i, "ARG"
         _make_active(context, obj)
         live.mark_dirty(obj)
         return {"FINISHED"}
+
+
+class LIBBLEND_OT_add_blend(_BlendOperator, bpy.types.Operator):
+    """Add a libblend blend node under the active blend (or field); with Blend Selected, the
+    selected nodes become its arguments instead"""
+    bl_idname = "libblend.add_blend"
+    bl_label = "Add libblend Blend"
+    bl_options = {"REGISTER", "UNDO"}
+
+    wrap_selected: BoolProperty(name="Blend Selected", default=False,
+                                description="wrap the selected nodes in the new blend, at their "
+                                "place in the tree")
+
+
+class LIBBLEND_OT_blend_selected(_BlendOperator, bpy.types.Operator):
+    """Wrap the selected nodes in a new blend at their place in the tree"""
+    bl_idname = "libblend.blend_selected"
+    bl_label = "Blend Selected"
+    bl_options = {"REGISTER", "UNDO"}
+
+    wrap_selected: BoolProperty(name="Blend Selected", default=True, options={"HIDDEN"})
 
 
 class LIBBLEND_OT_add_bound(bpy.types.Operator):
@@ -285,6 +323,9 @@ class LIBBLEND_OT_import_scene(bpy.types.Operator, ImportHelper):
     bl_options = {"REGISTER", "UNDO"}
     filename_ext = ".json"
     filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+    with_render: BoolProperty(name="Camera, Lights, Material", default=True,
+                              description="create what the scene's render section describes "
+                              "(and make its camera the scene's camera)")
 
     def execute(self, context):
         try:
@@ -298,6 +339,8 @@ class LIBBLEND_OT_import_scene(bpy.types.Operator, ImportHelper):
             return {"CANCELLED"}
         name = scene.get("title") or os.path.splitext(os.path.basename(self.filepath))[0]
         out = tree.from_scene(scene, context.collection, name)
+        if self.with_render and "render" in scene:
+            render_section.create(out, scene["render"], context.collection, context.scene)
         _make_active(context, out)
         ok, msg = live.update_now(out)
         self.report({"INFO"} if ok else {"WARNING"}, msg)
@@ -329,6 +372,117 @@ class LIBBLEND_OT_export_scene(bpy.types.Operator, ExportHelper):
             self.report({"ERROR"}, "cannot write %s: %s" % (self.filepath, e.strerror))
             return {"CANCELLED"}
         self.report({"INFO"}, "wrote %s" % self.filepath)
+        return {"FINISHED"}
+
+
+class LIBBLEND_OT_bake(bpy.types.Operator):
+    """Mesh the active field at render resolution for every frame of a range into its bake
+    folder (one file per frame), and use the bake for renders and frame changes"""
+    bl_idname = "libblend.bake"
+    bl_label = "Bake libblend Field"
+
+    frame_start: IntProperty(name="Start", default=-1, description="first frame (-1: the "
+                             "scene's start)")
+    frame_end: IntProperty(name="End", default=-1, description="last frame (-1: the scene's end)")
+    frame_step: IntProperty(name="Step", default=1, min=1)
+
+    def execute(self, context):
+        out = _output(context, self)
+        if out is None:
+            return {"CANCELLED"}
+        sc = context.scene
+        a = sc.frame_start if self.frame_start < 0 else self.frame_start
+        b = sc.frame_end if self.frame_end < 0 else self.frame_end
+        if b < a:
+            self.report({"ERROR"}, "frame range %d - %d is empty; allowed: start <= end" % (a, b))
+            return {"CANCELLED"}
+        try:
+            n, seconds = live.bake_frames(out, sc, range(a, b + 1, self.frame_step),
+                                          context.window_manager)
+        except (bake.CacheError, tree.TreeError, binding.LibblendError) as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        except OSError as e:
+            self.report({"ERROR"}, "cannot write the bake of '%s': %s" % (out.name, e))
+            return {"CANCELLED"}
+        self.report({"INFO"}, out.libblend.bake_info)
+        return {"FINISHED"}
+
+
+class LIBBLEND_OT_bake_clear(bpy.types.Operator):
+    """Delete the active field's baked frames and stop using them"""
+    bl_idname = "libblend.bake_clear"
+    bl_label = "Clear libblend Bake"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        out = _output(context, self)
+        if out is None:
+            return {"CANCELLED"}
+        try:
+            n = bake.clear(bake.folder(out))
+        except (bake.CacheError, OSError) as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        out.libblend.use_bake = False
+        out.libblend.bake_info = ""
+        live.update_now(out)
+        self.report({"INFO"}, "deleted %d baked frames of '%s'" % (n, out.name))
+        return {"FINISHED"}
+
+
+class LIBBLEND_OT_apply(bpy.types.Operator):
+    """Convert the active field to a plain mesh object (its current state, meshed at a chosen
+    resolution); the blend tree is removed unless Keep Field is on"""
+    bl_idname = "libblend.apply"
+    bl_label = "Apply libblend Field"
+    bl_options = {"REGISTER", "UNDO"}
+
+    resolution: IntProperty(name="Resolution", default=0, min=0, max=8192,
+                            description="cells along the region's longest side (0: the field's "
+                            "render resolution)")
+    keep_field: BoolProperty(name="Keep Field", default=False,
+                             description="keep the field and its tree next to the new mesh")
+
+    def execute(self, context):
+        out = _output(context, self)
+        if out is None:
+            return {"CANCELLED"}
+        res = self.resolution or out.libblend.render_resolution
+        paths = {}
+        try:
+            job = live.prepare(out, res)
+            paths = job.paths
+            job.run()
+            if job.error:
+                raise binding.LibblendError(job.error)
+        except tree.TreeError as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        except binding.LibblendError as e:
+            self.report({"ERROR"}, tree.explain(str(e), paths))
+            return {"CANCELLED"}
+        name = out.name
+        me = bpy.data.meshes.new(name)
+        live.set_mesh_data(me, job.mesh, out.libblend.normals)
+        for m in out.data.materials:
+            me.materials.append(m)
+        obj = bpy.data.objects.new(name + " mesh", me)
+        for c in out.users_collection:
+            c.objects.link(obj)
+        obj.matrix_world = out.matrix_world.copy()
+        if not self.keep_field:
+            for o in sorted(out.children_recursive, key=lambda o: -len(o.name)):
+                if tree.is_node(o):
+                    bpy.data.objects.remove(o)
+            old = out.data
+            bpy.data.objects.remove(out)
+            if old.users == 0:
+                bpy.data.meshes.remove(old)
+            obj.name = name
+        _make_active(context, obj)
+        self.report({"INFO"}, "'%s': %d triangles at %d cells" % (obj.name, len(job.mesh.triangles),
+                                                                  res))
         return {"FINISHED"}
 
 
@@ -382,6 +536,7 @@ class LIBBLEND_OT_export_pov(bpy.types.Operator, ExportHelper):
 
 
 CLASSES = [LIBBLEND_OT_add_field, LIBBLEND_OT_add_primitive, LIBBLEND_OT_add_blend,
-           LIBBLEND_OT_add_bound, LIBBLEND_OT_move_argument, LIBBLEND_OT_update_mesh,
-           LIBBLEND_OT_reload_library, LIBBLEND_OT_import_scene, LIBBLEND_OT_export_scene,
+           LIBBLEND_OT_blend_selected, LIBBLEND_OT_add_bound, LIBBLEND_OT_bake,
+           LIBBLEND_OT_bake_clear, LIBBLEND_OT_apply, LIBBLEND_OT_move_argument,
+           LIBBLEND_OT_update_mesh, LIBBLEND_OT_reload_library, LIBBLEND_OT_import_scene, LIBBLEND_OT_export_scene,
            LIBBLEND_OT_export_pov]

@@ -14,8 +14,8 @@ BOUND is the bounding solid of its parent when that parent is an argument of
 a `bounded` blend.
 """
 import bpy
-from bpy.props import (BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty,
-                       IntProperty, PointerProperty, StringProperty)
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
+                       FloatVectorProperty, IntProperty, PointerProperty, StringProperty)
 
 
 def _changed(self, context):
@@ -62,6 +62,10 @@ OPS = [("union", "Union", ""), ("intersection", "Intersection", ""),
        ("difference", "Difference", "the first argument minus the others")]
 
 
+class LB_ObjectRef(bpy.types.PropertyGroup):
+    obj: PointerProperty(type=bpy.types.Object)
+
+
 class LB_ObjectSettings(bpy.types.PropertyGroup):
     kind: EnumProperty(name="Kind", items=[
         ("NONE", "None", ""), ("OUTPUT", "Field Output", ""),
@@ -96,6 +100,17 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
         ("ANALYTIC", "Analytic", "libblend's exact normals as custom split normals"),
         ("FACES", "Blender", "Blender's smooth normals from the faces (fastest)")],
         default="AUTO", update=_changed)
+    use_bake: BoolProperty(name="Use Baked Cache", description="renders and frame changes read "
+                           "each frame's mesh from the bake folder (frames not baked, or "
+                           "changed since, are meshed)", default=False, update=_changed)
+    bake_dir: StringProperty(name="Bake Folder", subtype="DIR_PATH", description="where Bake "
+                             "writes one file per frame (empty: //libblend_cache/<field name>/, "
+                             "next to the .blend)")
+    bake_info: StringProperty(name="Baked", description="what the last bake wrote")
+    render_camera: PointerProperty(type=bpy.types.Object, name="Camera", description="the "
+                                   "camera exported as the scene's render camera")
+    render_lights: CollectionProperty(type=LB_ObjectRef, name="Lights", description="the lights "
+                                      "exported as the scene's render lights")
     title: StringProperty(name="Title")
     description: StringProperty(name="Description")
     render_json: StringProperty(name="Render Section", description="the scene file's render "
@@ -165,6 +180,7 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
 
 
 def register():
+    bpy.utils.register_class(LB_ObjectRef)
     bpy.utils.register_class(LB_ObjectSettings)
     bpy.types.Object.libblend = PointerProperty(type=LB_ObjectSettings)
 
@@ -172,3 +188,4 @@ def register():
 def unregister():
     del bpy.types.Object.libblend
     bpy.utils.unregister_class(LB_ObjectSettings)
+    bpy.utils.unregister_class(LB_ObjectRef)

@@ -83,6 +83,46 @@ def children(obj, role="ARG", depsgraph=None):
     return [c.evaluated_get(depsgraph) for c in kids] if depsgraph is not None else kids
 
 
+#: operators whose result no later blend's values can see through: a sharp
+#: min / max (or a complement) of values keeps each argument's zero set
+#: whatever the scale of its values, so m below them changes nothing
+VALUE_BLIND = ("min", "max", "complement")
+
+
+def m_has_effect(blend):
+    """Whether the subsequent-blend parameter m of `blend`'s arguments can
+    change the surface: m scales the blend's values outside its blending
+    region and its zero set never moves (docs/operators.md), so it acts only
+    through a later blend that uses those values, an ancestor that is not a
+    sharp min / max / complement."""
+    o = blend.parent
+    while o is not None and is_node(o):
+        if o.libblend.kind == "BLEND" and o.libblend.blend_type not in VALUE_BLIND:
+            return True
+        o = o.parent
+    return False
+
+
+def m_note(obj, as_argument=False):
+    """The panel's warning when obj sets an m that has no effect, else "":
+    a blend's own m, or (as_argument) obj's own m override as an argument."""
+    s = obj.libblend
+    if not as_argument:
+        if s.kind == "BLEND" and "m" in BLEND_KEYS.get(s.blend_type, ()) and s.m != 1.0 \
+                and not m_has_effect(obj):
+            return ("m = %g has no effect: no later blend uses the values of '%s' (it is not "
+                    "inside another blend). Fix: blend it with something, or leave m at 1"
+                    % (s.m, obj.name))
+        return ""
+    p = obj.parent
+    if s.arg_override and s.arg_m != 1.0 and p is not None and p.libblend.kind == "BLEND" \
+            and "m" in BLEND_KEYS.get(p.libblend.blend_type, ()) and not m_has_effect(p):
+        return ("own m = %g has no effect: no later blend uses the values of '%s' (it is not "
+                "inside another blend). Fix: blend it with something, or leave m at 1"
+                % (s.arg_m, p.name))
+    return ""
+
+
 def output_of(obj):
     """The OUTPUT object obj belongs to (obj itself for an output), or None."""
     while obj is not None:
@@ -224,7 +264,7 @@ def _node(obj, path, paths, convention, depth, dg=None):
     return out
 
 
-def to_scene(output, depsgraph=None):
+def to_scene(output, depsgraph=None, render=True):
     """(scene dict, {json path: object name}) for an OUTPUT object; with a
     depsgraph, every value as that depsgraph evaluated it (its frame)."""
     if depsgraph is not None:
@@ -250,17 +290,18 @@ def to_scene(output, depsgraph=None):
     scene["convention"] = s.convention
     scene["bounds"] = {"min": lo, "max": hi}
     scene["root"] = _node(roots[0], "$.root", paths, s.convention, 0, depsgraph)
-    if s.render_json:
-        try:
-            scene["render"] = json.loads(s.render_json)
-        except ValueError:
-            raise TreeError("field '%s': its stored render section is not JSON; clear it in the "
-                            "panel" % output.name) from None
+    if render:
+        from . import render_section
+        section = render_section.to_section(output.original)
+        if section:
+            scene["render"] = section
     return scene, paths
 
 
-def to_json(output, depsgraph=None):
-    scene, paths = to_scene(output, depsgraph)
+def to_json(output, depsgraph=None, render=True):
+    """The scene as JSON text; render=False leaves the render section out
+    (meshing: a moved camera changes no mesh)."""
+    scene, paths = to_scene(output, depsgraph, render)
     return json.dumps(scene, indent=2), paths
 
 

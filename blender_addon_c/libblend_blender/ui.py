@@ -48,6 +48,16 @@ def _wrap(text, width):
     return lines
 
 
+def _note(layout, text):
+    """A warning box (an m that has no effect, ...): red, wrapped."""
+    if not text:
+        return
+    box = layout.box()
+    box.alert = True
+    for i, line in enumerate(_wrap(text, 50)):
+        box.label(text=line, icon="ERROR" if i == 0 else "NONE")
+
+
 class LIBBLEND_PT_panel(bpy.types.Panel):
     bl_label = "libblend"
     bl_space_type = "VIEW_3D"
@@ -101,6 +111,19 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
         layout.prop(s, "live")
         layout.prop(s, "normals")
         layout.prop(s, "open_boundary")
+        box = layout.box()
+        box.label(text="Bake (render resolution, one file per frame)")
+        box.prop(s, "bake_dir")
+        row = box.row(align=True)
+        row.operator("libblend.bake", icon="FILE_CACHE")
+        row.operator("libblend.bake_clear", text="Clear", icon="TRASH")
+        box.prop(s, "use_bake")
+        if s.bake_info:
+            for line in _wrap(s.bake_info, 50):
+                box.label(text=line)
+        row = layout.row(align=True)
+        row.prop(s, "render_camera")
+        layout.operator("libblend.apply", icon="MESH_DATA")
         self._tree(layout, obj)
 
     def _tree(self, layout, out):
@@ -118,6 +141,7 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
         row = box.row(align=True)
         row.operator_menu_enum("libblend.add_primitive", "prim_type", text="Primitive")
         row.operator_menu_enum("libblend.add_blend", "blend_type", text="Blend")
+        row.operator_menu_enum("libblend.blend_selected", "blend_type", text="Blend Selected")
 
     def _primitive(self, layout, obj):
         s = obj.libblend
@@ -133,7 +157,7 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
         else:
             layout.operator("libblend.add_bound", icon="SHADING_BBOX")
         row = layout.row(align=True)
-        row.operator_menu_enum("libblend.add_blend", "blend_type", text="Blend Selected")
+        row.operator_menu_enum("libblend.blend_selected", "blend_type", text="Blend Selected")
 
     def _blend(self, layout, obj):
         s = obj.libblend
@@ -145,6 +169,7 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
         for k in ("r", "p", "m"):
             if k in keys:
                 layout.prop(s, k)
+        _note(layout, tree.m_note(obj))
         if "conic_p" in keys:
             layout.prop(s, "conic_p")
         if "n" in keys:
@@ -185,6 +210,7 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
                 row = box.row(align=True)
                 for k in own:
                     row.prop(s, "arg_" + k)
+                _note(box, tree.m_note(obj, as_argument=True))
 
 
 class LIBBLEND_MT_add(bpy.types.Menu):
@@ -207,8 +233,11 @@ class LIBBLEND_MT_object(bpy.types.Menu):
         layout = self.layout
         layout.operator("libblend.update_mesh", text="Update Mesh").final = False
         layout.operator("libblend.update_mesh", text="Update Mesh at Render Resolution").final = True
-        layout.operator_menu_enum("libblend.add_blend", "blend_type", text="Blend Selected")
+        layout.operator_menu_enum("libblend.blend_selected", "blend_type", text="Blend Selected")
         layout.operator("libblend.add_bound")
+        layout.operator("libblend.bake")
+        layout.operator("libblend.bake_clear")
+        layout.operator("libblend.apply")
         layout.operator("libblend.move_argument", text="Move Argument Up").direction = "UP"
         layout.operator("libblend.move_argument", text="Move Argument Down").direction = "DOWN"
         layout.separator()

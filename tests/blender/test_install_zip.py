@@ -42,7 +42,7 @@ bpy.ops.ed.undo_push(message="radius")
 out.select_set(False)
 sph.select_set(True)
 bpy.context.view_layer.objects.active = sph
-bpy.ops.libblend.add_blend(blend_type="displacement", op="union")  # wraps the selected sphere
+bpy.ops.libblend.blend_selected(blend_type="displacement", op="union")  # wraps the sphere
 assert bpy.context.view_layer.objects.active.libblend.kind == "BLEND"
 bpy.ops.ed.undo_push(message="blend")  # what the UNDO flag does after an operator in the UI
 n_objects = len(bpy.data.objects)

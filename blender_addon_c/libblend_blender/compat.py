@@ -1,0 +1,71 @@
+"""Every difference between the Blender versions the add-on supports (3.4
+to 4.3, tested on 3.4 and 4.3) handled here, and only here. The rest of the
+add-on (and its tests) call these functions instead of testing versions.
+
+  version            what changed                        handled by
+  4.0                Mesh polygons' loop_total read-only  set_triangles
+  4.0                Principled BSDF renamed inputs       principled_inputs
+                     (Specular -> Specular IOR Level)
+  4.1                auto smooth removed (custom normals  set_custom_normals,
+                     work without it); calc_normals_split clear_custom_normals,
+                     removed (corner_normals instead)     corner_normals
+  4.2                add-ons become extensions: the       (nothing to do: the
+                     package is bl_ext.<repo>.libblend,   add-on names itself
+                     blender_manifest.toml replaces        by __package__;
+                     bl_info                               is_extension says)
+  4.2                EEVEE is BLENDER_EEVEE_NEXT          eevee_engine
+"""
+import bpy
+
+VERSION = bpy.app.version
+
+
+def is_extension():
+    """True when the add-on runs as a 4.2+ extension (bl_ext.<repo>.<id>)."""
+    return __package__.startswith("bl_ext.")
+
+
+def set_triangles(me, nt):
+    """Mark me's polygons as nt triangles whose loops are consecutive."""
+    import numpy as np
+    me.polygons.foreach_set("loop_start", np.arange(0, 3 * nt, 3, dtype=np.int32))
+    if VERSION < (4, 0, 0):  # later versions derive loop_total from loop_start
+        me.polygons.foreach_set("loop_total", np.full(nt, 3, dtype=np.int32))
+
+
+def set_custom_normals(me, normals):
+    """One normal per vertex as the mesh's custom split normals."""
+    if VERSION < (4, 1, 0):
+        me.use_auto_smooth = True
+        me.auto_smooth_angle = 3.14159
+    me.normals_split_custom_set_from_vertices(normals)
+
+
+def clear_custom_normals(me):
+    """Blender's own smooth normals on a mesh just refilled after
+    clear_geometry (which drops custom normals in every version)."""
+    if VERSION < (4, 1, 0):
+        me.use_auto_smooth = False
+
+
+def corner_normals(me):
+    """The shading normal of every loop (face corner), as a flat float32 array."""
+    import numpy as np
+    out = np.empty(3 * len(me.loops), dtype=np.float32)
+    if VERSION < (4, 1, 0):
+        me.calc_normals_split()
+        me.loops.foreach_get("normal", out)
+    else:
+        me.corner_normals.foreach_get("vector", out)
+    return out
+
+
+def principled_inputs():
+    """Names of the Principled BSDF inputs the render section maps to."""
+    if VERSION < (4, 0, 0):
+        return {"color": "Base Color", "specular": "Specular", "roughness": "Roughness"}
+    return {"color": "Base Color", "specular": "Specular IOR Level", "roughness": "Roughness"}
+
+
+def eevee_engine():
+    return "BLENDER_EEVEE" if VERSION < (4, 2, 0) else "BLENDER_EEVEE_NEXT"

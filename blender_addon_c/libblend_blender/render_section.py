@@ -1,0 +1,165 @@
+"""A scene file's render section (camera, lights, material;
+docs/scene-format.md) as Blender objects, and back.
+
+Import (create): the camera becomes a camera object looking at `look_at`
+with the scene's horizontal field of view, made the scene's camera; each
+light a sun lamp at its location aimed at the region's centre (POV-Ray's
+point lights do not fade with distance; a sun does not either); the
+material a Principled BSDF on the field with the section's colour and
+specular. The field keeps the objects it made (render_camera,
+render_lights) and the section itself (render_json: keys Blender has no
+place for, such as ambient and diffuse, and the values as written).
+
+Export (to_section): the section as the objects now say. A camera, light or
+material nobody changed since import is written exactly as it was read
+(Blender stores float32 and a camera's orientation, not its look_at point);
+a changed one is written from the object. Deleted objects drop out.
+
+Conventions: the camera's up direction is +y (POV-Ray's `up y`, what
+`blendtool pov` writes), so Blender frames the field as POV-Ray does; POV-Ray
+is left-handed, so its image is the mirror image of Blender's.
+"""
+import json
+import math
+
+import bpy
+from mathutils import Vector
+
+from . import compat, tree
+
+SUN_STRENGTH = 3.0  # W/m^2 of a sun lamp for a POV-Ray light of colour 1
+
+
+def _centre(output):
+    s = output.libblend
+    return output.matrix_world @ ((Vector(s.bounds_min) + Vector(s.bounds_max)) / 2)
+
+
+def _aim(obj, target, up="Y"):
+    d = Vector(target) - obj.location
+    if d.length == 0:
+        return
+    # looking along the up axis itself: take z as up instead
+    axis = {"Y": Vector((0, 1, 0)), "Z": Vector((0, 0, 1))}[up]
+    if abs(d.normalized().dot(axis)) > 0.999:
+        up = "Z" if up == "Y" else "Y"
+    obj.rotation_mode = "QUATERNION"
+    obj.rotation_quaternion = d.to_track_quat("-Z", up)
+
+
+def _same_vec(a, b, tol=1e-6):
+    return len(a) == len(b) and all(abs(x - y) <= tol * max(1.0, abs(y)) for x, y in zip(a, b))
+
+
+def create(output, section, collection, scene):
+    """Make the section's camera, lights and material for output."""
+    s = output.libblend
+    s.render_lights.clear()
+    cam = section.get("camera")
+    if cam:
+        data = bpy.data.cameras.new(output.name + " camera")
+        data.lens_unit = "FOV"
+        data.sensor_fit = "HORIZONTAL"
+        data.angle = math.radians(cam.get("angle", 40))
+        obj = bpy.data.objects.new(output.name + " camera", data)
+        collection.objects.link(obj)
+        obj.location = cam["location"]
+        _aim(obj, cam.get("look_at", [0, 0, 0]))
+        data.clip_end = max(data.clip_end, 4 * (Vector(cam["location"]) - _centre(output)).length)
+        s.render_camera = obj
+        scene.camera = obj
+    for i, li in enumerate(section.get("lights", [])):
+        data = bpy.data.lights.new("%s light %d" % (output.name, i + 1), "SUN")
+        c = li.get("color", [1, 1, 1])
+        k = max(1.0, max(c))
+        data.color = [v / k for v in c]
+        data.energy = SUN_STRENGTH * k
+        data.angle = 0.0
+        obj = bpy.data.objects.new(data.name, data)
+        collection.objects.link(obj)
+        obj.location = li["location"]
+        _aim(obj, _centre(output), "Z")
+        s.render_lights.add().obj = obj
+    mat = section.get("material")
+    if mat:
+        m = bpy.data.materials.new(output.name + " material")
+        m.use_nodes = True
+        bsdf = m.node_tree.nodes.get("Principled BSDF")
+        names = compat.principled_inputs()
+        c = mat.get("color", [0.8, 0.8, 0.8])
+        bsdf.inputs[names["color"]].default_value = list(c) + [1.0]
+        bsdf.inputs[names["specular"]].default_value = mat.get("specular", 0.0)
+        bsdf.inputs[names["roughness"]].default_value = 0.4
+        m.diffuse_color = list(c) + [1.0]  # the viewport's solid colour
+        output.data.materials.clear()
+        output.data.materials.append(m)
+
+
+def _alive(obj):
+    try:
+        return obj is not None and obj.name in bpy.data.objects
+    except ReferenceError:
+        return False
+
+
+def to_section(output):
+    """The render section for export (a dict), or None when there is none."""
+    s = output.libblend
+    try:
+        stored = json.loads(s.render_json) if s.render_json else {}
+    except ValueError:
+        raise tree.TreeError("field '%s': its stored render section is not JSON; clear it in the "
+                             "panel" % output.name) from None
+    made = bool(s.render_camera) or len(s.render_lights) > 0
+    out = {k: v for k, v in stored.items() if k not in ("camera", "lights", "material")}
+    # camera
+    cam = s.render_camera if _alive(s.render_camera) and s.render_camera.type == "CAMERA" else None
+    old = stored.get("camera")
+    if cam is not None:
+        loc = tree.vec(cam.matrix_world.translation)
+        fwd = (cam.matrix_world.to_quaternion() @ Vector((0, 0, -1))).normalized()
+        angle = math.degrees(cam.data.angle_x)
+        if old and _same_vec(loc, old["location"]) and abs(angle - old.get("angle", 40)) < 1e-4:
+            target = Vector(old.get("look_at", [0, 0, 0])) - Vector(old["location"])
+            if target.length == 0 or fwd.dot(target.normalized()) > 1 - 1e-9:
+                cam = None
+                out["camera"] = old
+        if cam is not None:
+            dist = (Vector(old.get("look_at", [0, 0, 0])) - Vector(old["location"])).length \
+                if old else (_centre(output) - cam.matrix_world.translation).length
+            out["camera"] = {"location": loc,
+                             "look_at": tree.vec(cam.matrix_world.translation + fwd * max(dist, 1e-3)),
+                             "angle": tree.f32(angle)}
+    elif old and not made:
+        out["camera"] = old
+    # lights
+    old_lights = stored.get("lights", [])
+    lights = []
+    refs = [r.obj for r in s.render_lights if _alive(r.obj) and r.obj.type == "LIGHT"]
+    for i, obj in enumerate(refs):
+        loc = tree.vec(obj.matrix_world.translation)
+        col = tree.vec([c * obj.data.energy / SUN_STRENGTH for c in obj.data.color])
+        prev = old_lights[i] if i < len(old_lights) else None
+        if prev and _same_vec(loc, prev["location"]) and _same_vec(col, prev.get("color", [1, 1, 1])):
+            lights.append(prev)
+        else:
+            lights.append({"location": loc, "color": col})
+    if refs or (old_lights and not made):
+        out["lights"] = lights if refs else old_lights
+    # material
+    old_mat = stored.get("material")
+    m = output.active_material
+    bsdf = m.node_tree.nodes.get("Principled BSDF") if m and m.use_nodes and m.node_tree else None
+    if bsdf is not None:
+        names = compat.principled_inputs()
+        col = tree.vec(bsdf.inputs[names["color"]].default_value[:3])
+        spec = tree.f32(bsdf.inputs[names["specular"]].default_value)
+        mat = dict(old_mat or {})
+        if not (old_mat and _same_vec(col, old_mat.get("color", [0.8, 0.8, 0.8]))):
+            mat["color"] = col
+        if not (old_mat and abs(spec - old_mat.get("specular", 0.0)) < 1e-6):
+            mat["specular"] = min(1.0, max(0.0, spec))
+        out["material"] = mat
+    elif old_mat:
+        out["material"] = old_mat
+    return out or None
