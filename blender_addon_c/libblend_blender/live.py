@@ -516,11 +516,17 @@ def on_frame_change(scene, depsgraph=None):
     that depsgraph at render resolution (or read from its bake). Otherwise
     (playback, scrubbing, frame_set in scripts) a baked field reads its
     frame's file at once, and the others are marked dirty and remesh at
-    preview resolution by the live rules."""
+    preview resolution by the live rules. Motion blur's sub-frame steps
+    during a render are not meshed: the field's object motion blurs, its
+    shape is the frame's own (docs/blender.md, Animation)."""
     if _baking["active"]:
         return  # a bake steps through frames itself
     outputs = [o.original for o in scene.objects if o.libblend.kind == "OUTPUT"]
     if _render["active"]:
+        if depsgraph is not None and depsgraph.scene_eval.frame_subframe != 0.0:
+            # a motion-blur step: Cycles blurs a shape only between steps with the same
+            # vertices, which a remeshed field never has, so the frame's own mesh stays
+            return
         for obj in outputs:
             if not obj.hide_render:  # a field left out of the render is left as it is
                 _render_frame(obj, _frame(scene, depsgraph), depsgraph)

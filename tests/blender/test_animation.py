@@ -137,6 +137,14 @@ var.targets[0].id = ctl
 var.targets[0].data_path = '["m"]'
 
 
+# every setting that shapes a field takes keyframes and drivers
+shaping = [p for p in s.bl_rna.properties if p.type in ("FLOAT", "INT", "BOOLEAN", "ENUM")
+           and p.identifier not in ("kind", "role", "order", "live", "use_bake", "normals",
+                                    "preview_resolution", "render_resolution")]
+check(len(shaping) > 30 and all(p.is_animatable for p in shaping),
+      "not animatable: %s" % [p.identifier for p in shaping if not p.is_animatable])
+
+
 def expected(f):
     t = (f - 1) / 3.0
     return {"r": 0.05 + 1.2 * t, "x": 1.0 + 0.6 * t, "m": 1.0 - 0.6 * t}
@@ -264,6 +272,12 @@ check(sorted(part_i) == [2, 4] and sorted(part_m) == [2, 4], "-s 2 -e 4 -j 2: fr
       "only (%s)" % sorted(part_i))
 one_m, one_i, _ = render("single", ["-f", "3"])
 check(sorted(one_i) == [3], "-f 3: frame 3 only")
+# motion blur: Cycles steps through sub-frames 2.75 and 3.25; the frame renders the
+# frame's own shape (the field's object does not move, so nothing blurs)
+blur_m, blur_i, _ = render("blur", ["--python-expr", "import bpy; bpy.context.scene.render."
+                                    "use_motion_blur = True", "-f", "3"])
+check(blur_m[3]["vertices"] == full_m[3]["vertices"] and blur_m[3]["volume"] == full_m[3]["volume"],
+      "motion blur: frame 3 renders frame 3's mesh, not a sub-frame's")
 for f, (mm, ii) in {2: (part_m, part_i), 4: (part_m, part_i), 3: (one_m, one_i)}.items():
     check(mm[f]["vertices"] == full_m[f]["vertices"] and mm[f]["volume"] == full_m[f]["volume"],
           "frame %d: the same mesh in a range render" % f)
