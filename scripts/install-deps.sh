@@ -11,6 +11,7 @@ PACKAGES=(
   libjansson-dev             # strict RFC 8259 check of scene files (line:column)
   python3-jsonschema         # tests: scene files against docs/libblend-scene.schema.json
   python3-numpy              # tests: independent mesh readers and checks (tests/mesh/)
+  python3-skimage            # tests: marching cubes on the same grid, the mesher's reference
   povray                     # tests: the generated POV-Ray include, run by POV-Ray itself
   openimageio-tools          # tests: idiff compares POV-Ray renders with libblend silhouettes
   blender                    # tests: the add-on in headless Blender (blender_addon_c/)
@@ -21,10 +22,6 @@ PACKAGES=(
   parallel                   # tests: batch task lists through GNU parallel
 )
 
-# `install-deps.sh bench`: also what the benchmarks compare against
-if [ "${1:-}" = "bench" ]; then
-  PACKAGES+=(python3-skimage)
-fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

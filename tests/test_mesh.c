@@ -14,6 +14,7 @@
 #endif
 
 #include "scenelist.h"
+#include "../libblend/src/meshing/mesh_internal.h"
 
 /* ---- helpers ---- */
 
@@ -294,6 +295,124 @@ static void test_volumes_and_euler(void **state) {
     }
 }
 
+/* The cube cases, checked from their loops alone (the manifold argument of
+ * cubes.c): in every case each crossing edge (corners of opposite signs) is
+ * a vertex of exactly one loop and no other edge is; and for every pair of
+ * cells that share a face with the same corner signs on it, the segments the
+ * two draw on that face (consecutive loop vertices both on the face) are the
+ * same ones, in opposite directions. */
+static int on_face(int p, int q, int axis, int side) {
+    return ((p & axis) != 0) == side && ((q & axis) != 0) == side;
+}
+
+static int segments(const lb__mctable *t, int cfg, int axis, int side, int seg[][2]) {
+    const lb__mccase *c = &t->c[cfg];
+    int n = 0, off = 0;
+    for (int l = 0; l < c->nloop; ++l) {
+        for (int v = 0; v < c->len[l]; ++v) {
+            const int a = c->e[off + v], b = c->e[off + (v + 1) % c->len[l]];
+            int ap, aq, bp, bq;
+            lb__cube_edge(a, &ap, &aq);
+            lb__cube_edge(b, &bp, &bq);
+            if (on_face(ap, aq, axis, side) && on_face(bp, bq, axis, side)) {
+                seg[n][0] = a;
+                seg[n][1] = b;
+                ++n;
+            }
+        }
+        off += c->len[l];
+    }
+    return n;
+}
+
+/* the cube edge of a neighbour across the face (axis, 1) <-> (axis, 0) */
+static int across(int e, int axis) {
+    int p, q;
+    lb__cube_edge(e, &p, &q);
+    for (int f = 0; f < 12; ++f) {
+        int fp, fq;
+        lb__cube_edge(f, &fp, &fq);
+        if (fp == (p ^ axis) && fq == (q ^ axis)) return f;
+    }
+    return -1;
+}
+
+static void test_cube_cases(void **state) {
+    (void)state;
+    lb__mctable t;
+    lb__mctable_init(&t);
+    assert_int_equal(lb__mctable_check(&t), 1);
+    size_t pairs = 0, segs = 0;
+    int maxlen = 0, maxloops = 0;
+    for (int cfg = 0; cfg < 256; ++cfg) {
+        int seen[12] = {0}, off = 0;
+        for (int l = 0; l < t.c[cfg].nloop; ++l) {
+            if (t.c[cfg].len[l] > maxlen) maxlen = t.c[cfg].len[l];
+            for (int v = 0; v < t.c[cfg].len[l]; ++v) ++seen[t.c[cfg].e[off + v]];
+            off += t.c[cfg].len[l];
+        }
+        if (t.c[cfg].nloop > maxloops) maxloops = t.c[cfg].nloop;
+        for (int e = 0; e < 12; ++e) {
+            int p, q;
+            lb__cube_edge(e, &p, &q);
+            const int crossing = ((cfg >> p) & 1) != ((cfg >> q) & 1);
+            if (seen[e] != crossing)
+                fail_msg("case %d: cube edge %d appears %d times (crossing: %d)", cfg, e, seen[e],
+                         crossing);
+        }
+    }
+    for (int axis = 1; axis <= 4; axis <<= 1)
+        for (int a = 0; a < 256; ++a)
+            for (int b = 0; b < 256; ++b) {
+                /* a's corners on its +axis face equal b's on its -axis face */
+                int same = 1;
+                for (int o = 0; o < 8; ++o)
+                    if ((o & axis) && ((a >> o) & 1) != ((b >> (o ^ axis)) & 1)) same = 0;
+                if (!same) continue;
+                ++pairs;
+                int sa[12][2], sb[12][2];
+                const int na = segments(&t, a, axis, 1, sa), nb = segments(&t, b, axis, 0, sb);
+                if (na != nb)
+                    fail_msg("cases %d | %d (axis %d): %d and %d segments", a, b, axis, na, nb);
+                for (int i = 0; i < na; ++i) {
+                    int found = 0;
+                    for (int j = 0; j < nb; ++j)
+                        found += across(sa[i][0], axis) == sb[j][1] &&
+                                 across(sa[i][1], axis) == sb[j][0];
+                    if (found != 1)
+                        fail_msg("cases %d | %d (axis %d): segment %d -> %d not reversed once "
+                                 "across the face",
+                                 a, b, axis, sa[i][0], sa[i][1]);
+                }
+                segs += (size_t)na;
+            }
+    fprintf(stderr,
+            "  cube cases: %zu face-sharing pairs, %zu segments matched, loops of at most %d "
+            "vertices, at most %d per cell\n",
+            pairs, segs, maxlen, maxloops);
+    assert_true(maxlen <= LB__MAXPOLY && maxloops <= 4);
+}
+
+/* LB_MESH_TETRAHEDRA, the Kuhn split: every scene closed and manifold, with
+ * about three times the triangles of the cube polygons on the same grid. */
+static void test_tetrahedra_option(void **state) {
+    (void)state;
+    size_t ncube = 0, ntet = 0;
+    for (size_t s = 0; s < nscenes; ++s) {
+        built A, B;
+        build_file(scene_paths[s], 32, 0, 0, &A);
+        build_file(scene_paths[s], 32, LB_MESH_TETRAHEDRA, 0, &B);
+        expect_closed_manifold(scene_paths[s], B.m);
+        ncube += A.m->ntriangles;
+        ntet += B.m->ntriangles;
+        unbuild(&A);
+        unbuild(&B);
+    }
+    fprintf(stderr, "  every scene at 32 cells: %zu triangles (cubes), %zu (tetrahedra), %.2fx\n",
+            ncube, ntet, (double)ntet / (double)ncube);
+    assert_true(ntet > 2.5 * ncube && ntet < 4.0 * ncube);
+}
+
 /* Fields built to be ambiguous for marching cubes: spheres on every other
  * node of a checkerboard (every cell face has diagonal inside corners),
  * two spheres touching exactly at a grid node (phi = 0 there), and a thin
@@ -329,6 +448,10 @@ static void test_ambiguous_fields(void **state) {
     built B;
     build_text(text, &o, &B);
     expect_closed_manifold("checkerboard at cell size 1", B.m);
+    unbuild(&B);
+    o.flags = LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA;
+    build_text(text, &o, &B);
+    expect_closed_manifold("checkerboard at cell size 1, tetrahedra", B.m);
     unbuild(&B);
     /* and at cell sizes that cut the spheres anywhere */
     const double sizes[3] = {0.5, 0.37, 0.21};
@@ -770,6 +893,8 @@ int main(void) {
         cmocka_unit_test(test_scenes_closed_and_accurate),
         cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_volumes_and_euler),
+        cmocka_unit_test(test_cube_cases),
+        cmocka_unit_test(test_tetrahedra_option),
         cmocka_unit_test(test_ambiguous_fields),
         cmocka_unit_test(test_region_cap_and_open),
         cmocka_unit_test(test_no_self_intersections),

@@ -115,6 +115,8 @@ static int run(int argc, char **argv) {
             if (bt_set_parse(CMD, val, &sets[nsets++])) return BT_EXIT_BAD_INPUT;
         } else if (strcmp(argv[i], "--open") == 0) {
             o.flags |= LB_MESH_OPEN_BOUNDARY;
+        } else if (strcmp(argv[i], "--tetrahedra") == 0) {
+            o.flags |= LB_MESH_TETRAHEDRA;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
             quiet = 1;
         } else if (argv[i][0] == '-' && argv[i][1]) {
@@ -206,7 +208,7 @@ const bt_command bt_cmd_mesh = {
     "mesh", "a closed triangle mesh of the scene (PLY, OBJ, STL, glTF binary)",
     "usage: blendtool mesh SCENE -o OUT.{ply,obj,stl,glb} [--resolution N | --cell-size H]\n"
     "                      [--bounds x0,y0,z0,x1,y1,z1] [--open] [--threads N] [--quiet]\n"
-    "                      [--format ply|obj|stl|glb] [--set PATH=VALUE]...\n\n"
+    "                      [--format ply|obj|stl|glb] [--set PATH=VALUE]... [--tetrahedra]\n\n"
     "Meshes the scene's surface inside the region (the scene's bounds, or --bounds):\n"
     "closed and manifold, vertices on the surface with normals from the analytic\n"
     "gradient. Where the region cuts the solid the mesh is closed on the region's\n"
@@ -217,6 +219,8 @@ const bt_command bt_cmd_mesh = {
     "  --threads N     0 = one per CPU (default), 1 = single-threaded; the mesh is the\n"
     "                  same for every thread count\n"
     "  --quiet         no progress bar (shown only on a terminal) and no summary line\n"
+    "  --tetrahedra    split cells into six tetrahedra instead of cube polygons (about\n"
+    "                  3x the triangles; the zero set of one piecewise-linear field)\n"
     "  --set PATH=VALUE  override a scene value first (VALUE is JSON), e.g.\n"
     "                  --set root.args[0].radius=0.5; repeatable, applied in order\n"
     "OUT may be a symbolic link (its target is replaced), a device or a FIFO (written\n"

@@ -25,11 +25,13 @@
  * Method (docs/meshing.md): the grid is split into blocks of 8^3 cells; an
  * octree over the blocks skips every box whose interval bound
  * (lb_evaluator_bounds) excludes the surface, so the cost grows with the
- * surface area, not the volume. Each remaining cell is split into six
- * tetrahedra along its main diagonal (the Kuhn/Freudenthal triangulation,
- * the same split in every cell, so neighbouring cells agree on every shared
- * face): marching tetrahedra has no ambiguous cases, which is why the result
- * is always a closed 2-manifold. */
+ * surface area, not the volume. Each remaining cell gets one polygon per
+ * loop of its surface, with vertices on its 12 edges only; on a face whose
+ * inside corners are diagonal, those corners are cut off separately, a rule
+ * that depends on the face alone, so the two cells of a face agree and the
+ * result is always a closed 2-manifold. Polygons are cut into triangles
+ * through the cell's interior only. LB_MESH_TETRAHEDRA splits each cell
+ * into six tetrahedra instead (about 3x the triangles). */
 #ifndef LIBBLEND_MESH_H
 #define LIBBLEND_MESH_H
 
@@ -48,6 +50,10 @@ extern "C" {
 
 /* flags */
 #define LB_MESH_OPEN_BOUNDARY 1u /* do not close the mesh where the region cuts the solid */
+/* extract with the Kuhn split of each cell into six tetrahedra instead of
+ * the default cube polygons: about 3x the triangles, the zero set of one
+ * piecewise-linear function (docs/meshing.md, Method) */
+#define LB_MESH_TETRAHEDRA 2u
 
 /* Called on the calling thread with the fraction of work done, in [0, 1];
  * return non-zero to cancel the run (lb_mesh_create then fails with

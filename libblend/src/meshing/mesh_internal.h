@@ -17,7 +17,23 @@
 
 #include <stdint.h>
 
-#define LB__MB 8 /* cells per block side */
+#define LB__MB 8      /* cells per block side */
+#define LB__MAXPOLY 7 /* most vertices of one cell polygon (cubes: 7, tetrahedra: 4) */
+
+/* The cube cases (cubes.c): for each of the 256 inside/outside patterns of
+ * a cell's corners (bit o set: corner o inside; corner bits 1 = +x, 2 = +y,
+ * 4 = +z), the surface polygons as loops of cube edges (0..11), oriented
+ * counter-clockwise seen from outside. Built once per lb_mesh_create. */
+typedef struct lb__mccase {
+    uint8_t nloop;
+    uint8_t len[4];
+    uint8_t e[12];
+} lb__mccase;
+
+typedef struct lb__mctable {
+    lb__mccase c[256];
+    uint16_t share[12]; /* bit b of share[a]: cube edges a and b lie on a common face */
+} lb__mctable;
 
 typedef struct lb__grid {
     double origin[3]; /* node (0,0,0) */
@@ -27,6 +43,8 @@ typedef struct lb__grid {
     int closed;    /* phi_c = max(phi, box) */
     double bmin[3], bmax[3];
     int soft;
+    int tetrahedra; /* LB_MESH_TETRAHEDRA: the Kuhn split instead of cube polygons */
+    lb__mctable mc;
 } lb__grid;
 
 /* One block of LB__MB^3 cells (fewer at the far end of the grid). */
@@ -64,9 +82,10 @@ LB_INTERNAL void lb__block_box(const lb__grid *g, const lb__block *B, double bmi
 LB_INTERNAL double lb__mesh_phi(const lb__grid *g, const double X[3], double f, const double gf[3],
                                 double gphi[3]);
 
-/* Marching tetrahedra over one block whose node values are final: finds the
- * crossing edges, refines a vertex on each (lb__refine_edges) and writes the
- * block's vertices and triangles. */
+/* Surface extraction over one block whose node values are final (extract.c):
+ * finds the crossing edges cell by cell (cubes.c, or tetra.c with
+ * g->tetrahedra), refines a vertex on each (lb__refine_edges), triangulates
+ * the cell polygons and writes the block's vertices and triangles. */
 LB_INTERNAL lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B,
                                      lb_error *err);
 
@@ -79,5 +98,40 @@ LB_INTERNAL lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g
                                        const double *b, const double *pa, const double *pb,
                                        const double *ga, const double *gb, double *pos, double *nrm,
                                        lb_error *err);
+
+/* ---- the cell methods' side of extract.c */
+typedef struct lb__bctx lb__bctx;
+
+/* The vertex on the crossing edge between corners op and oq (op a subset of
+ * oq) of cell (i, j, k) of the block, c its 8 corner values: its index in the
+ * block, created on first use; -1 when out of memory. */
+LB_INTERNAL int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, int oq,
+                                  const double *c);
+
+/* Add a polygon of n (3..LB__MAXPOLY) vertices (indices from lb__cell_edge),
+ * counter-clockwise seen from outside; ce[i] is vertex i's cube edge (0..11)
+ * when diagonals on the cell's faces must be avoided, or NULL. 0 when out of
+ * memory. */
+LB_INTERNAL int lb__cell_polygon(lb__bctx *C, const uint32_t *e, const uint8_t *ce, uint32_t n);
+
+/* One cell (i, j, k) with corner values c (some inside, some outside): its
+ * polygons, by the cube cases or by the Kuhn split. 0 when out of memory. */
+LB_INTERNAL int lb__cube_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c);
+LB_INTERNAL int lb__tetra_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c);
+
+/* The grid of the block being extracted (cell methods read the cube cases). */
+LB_INTERNAL const lb__grid *lb__cell_grid(const lb__bctx *C);
+
+LB_INTERNAL void lb__mctable_init(lb__mctable *t);
+/* Cube edge e (0..11) runs from corner *p to corner *q. */
+LB_INTERNAL void lb__cube_edge(int e, int *p, int *q);
+/* 1 when every loop of every case is a polygon of 3..LB__MAXPOLY vertices
+ * with a triangulation off the cell's faces (the manifold argument in
+ * cubes.c needs it), else 0. */
+LB_INTERNAL int lb__mctable_check(const lb__mctable *t);
+
+static inline int lb__cube_edges_share_face(const lb__grid *g, int a, int b) {
+    return (g->mc.share[a] >> b) & 1;
+}
 
 #endif

@@ -81,6 +81,8 @@ static lb_status make_grid(const lb_evaluator *ev, const lb_mesh_options *o, lb_
         h = longest / o->resolution;
     }
     g->closed = !(o->flags & LB_MESH_OPEN_BOUNDARY);
+    g->tetrahedra = (o->flags & LB_MESH_TETRAHEDRA) != 0;
+    lb__mctable_init(&g->mc);
     g->soft = lb_evaluator_convention(ev) == LB_CONVENTION_SOFT;
     for (int d = 0; d < 3; ++d) {
         const double nf = ceil(ext[d] / h - 1e-9);
@@ -593,9 +595,11 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: threads = %d; allowed: 0 (one per CPU) or a positive count", FN,
                         opt->threads);
-    if (opt->flags & ~(unsigned)LB_MESH_OPEN_BOUNDARY)
+    if (opt->flags & ~(unsigned)(LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
-                        "%s: flags = %#x; allowed: 0 or LB_MESH_OPEN_BOUNDARY", FN, opt->flags);
+                        "%s: flags = %#x; allowed: 0 or LB_MESH_OPEN_BOUNDARY | "
+                        "LB_MESH_TETRAHEDRA",
+                        FN, opt->flags);
     lb__grid g;
     lb_status s = make_grid(ev, opt, &g, err);
     if (s) return s;

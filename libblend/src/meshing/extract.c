@@ -1,0 +1,262 @@
+/* Surface extraction over one block, shared by the two cell methods
+ * (cubes.c, the default, and tetra.c): the crossing grid edges (each once,
+ * keyed by node and axis mask), their vertices (lb__refine_edges), and the
+ * triangulation of each cell polygon once its vertices are placed.
+ *
+ * A cell method adds polygons (up to LB__MAXPOLY vertices, oriented
+ * counter-clockwise seen from outside the solid) through lb__cell_edge and
+ * lb__cell_polygon. A polygon is cut into triangles along diagonals of
+ * least total length, among the diagonals it allows: a cube polygon never
+ * uses a diagonal that lies in a face of its cell (where the neighbouring
+ * cell might place one too), a tetrahedron's quadrilateral may use either. */
+#include "mesh_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct face {
+    uint32_t e[LB__MAXPOLY];
+    uint8_t ce[LB__MAXPOLY]; /* cube edge of each vertex (cubes.c), 0xff: any diagonal */
+    uint32_t n;
+} face;
+
+struct lb__bctx {
+    const lb__grid *g;
+    lb__block *B;
+    int32_t *emap; /* local edge id -> crossing edge index */
+    size_t ne, cap;
+    double *ea, *eb, *pa, *pb; /* inside end, outside end, their phi */
+    double *ga, *gb;           /* and their gradients */
+    uint64_t *key;
+    face *faces;
+    size_t nf, fcap;
+};
+typedef lb__bctx bctx;
+
+static int grow(void **p, size_t *cap, size_t need, size_t elem) {
+    if (need <= *cap) return 1;
+    size_t nc = *cap ? 2 * *cap : 64;
+    while (nc < need) nc *= 2;
+    void *q = realloc(*p, nc * elem);
+    if (!q) return 0;
+    *p = q;
+    *cap = nc;
+    return 1;
+}
+
+static inline int corner_in(const double *c, int o) {
+    return c[o] < 0.0;
+}
+
+int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, int oq,
+                      const double *c) {
+    const lb__block *B = C->B;
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    const uint32_t li = i + (op & 1), lj = j + ((op >> 1) & 1), lk = k + ((op >> 2) & 1);
+    const int mask = op ^ oq;
+    const size_t lid = ((size_t)(lk * D1 + lj) * D0 + li) * 8 + (size_t)mask;
+    if (C->emap[lid] >= 0) return C->emap[lid];
+    size_t cap = C->cap;
+    if (C->ne + 1 > cap) {
+        size_t nc = cap ? 2 * cap : 256;
+        double *ea = realloc(C->ea, 3 * nc * sizeof *ea);
+        if (ea) C->ea = ea;
+        double *eb = realloc(C->eb, 3 * nc * sizeof *eb);
+        if (eb) C->eb = eb;
+        double *pa = realloc(C->pa, nc * sizeof *pa);
+        if (pa) C->pa = pa;
+        double *pb = realloc(C->pb, nc * sizeof *pb);
+        if (pb) C->pb = pb;
+        uint64_t *key = realloc(C->key, nc * sizeof *key);
+        if (key) C->key = key;
+        double *ga = realloc(C->ga, 3 * nc * sizeof *ga);
+        if (ga) C->ga = ga;
+        double *gb = realloc(C->gb, 3 * nc * sizeof *gb);
+        if (gb) C->gb = gb;
+        if (!ea || !eb || !pa || !pb || !key || !ga || !gb) return -1;
+        C->cap = nc;
+    }
+    const lb__grid *g = C->g;
+    const uint64_t gx = (uint64_t)B->b[0] * LB__MB + li, gy = (uint64_t)B->b[1] * LB__MB + lj,
+                   gz = (uint64_t)B->b[2] * LB__MB + lk;
+    double P[3], Q[3];
+    lb__node_pos(g, gx, gy, gz, P);
+    lb__node_pos(g, gx + (mask & 1), gy + ((mask >> 1) & 1), gz + ((mask >> 2) & 1), Q);
+    const size_t e = C->ne++;
+    const int pin = corner_in(c, op);
+    memcpy(C->ea + 3 * e, pin ? P : Q, sizeof P);
+    memcpy(C->eb + 3 * e, pin ? Q : P, sizeof P);
+    C->pa[e] = pin ? c[op] : c[oq];
+    C->pb[e] = pin ? c[oq] : c[op];
+    const uint32_t D0n = B->nc[0] + 1, D1n = B->nc[1] + 1;
+    const size_t np = ((size_t)lk * D1n + lj) * D0n + li;
+    const size_t nq = ((size_t)(lk + ((mask >> 2) & 1)) * D1n + (lj + ((mask >> 1) & 1))) * D0n +
+                      (li + (mask & 1));
+    memcpy(C->ga + 3 * e, B->grads + 3 * (pin ? np : nq), 3 * sizeof(double));
+    memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
+    C->key[e] = lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask;
+    C->emap[lid] = (int32_t)e;
+    return (int64_t)e;
+}
+
+const lb__grid *lb__cell_grid(const lb__bctx *C) {
+    return C->g;
+}
+
+int lb__cell_polygon(lb__bctx *C, const uint32_t *e, const uint8_t *ce, uint32_t n) {
+    if (!grow((void **)&C->faces, &C->fcap, C->nf + 1, sizeof *C->faces)) return 0;
+    face *f = &C->faces[C->nf++];
+    f->n = n;
+    memcpy(f->e, e, n * sizeof *e);
+    if (ce)
+        memcpy(f->ce, ce, n);
+    else
+        memset(f->ce, 0xff, n);
+    return 1;
+}
+
+/* The cosine of a triangle's smallest angle (1 for a degenerate one): the
+ * largest of its three corner cosines. */
+static double worst_cos(const double *A, const double *B, const double *C) {
+    const double *P[3] = {A, B, C};
+    double w = -1.0;
+    for (int q = 0; q < 3; ++q) {
+        const double *o = P[q], *u = P[(q + 1) % 3], *v = P[(q + 2) % 3];
+        const double a[3] = {u[0] - o[0], u[1] - o[1], u[2] - o[2]};
+        const double b[3] = {v[0] - o[0], v[1] - o[1], v[2] - o[2]};
+        const double la = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        const double lb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
+        const double den = sqrt(la * lb);
+        const double c = den > 0.0 ? (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / den : 1.0;
+        if (c > w) w = c;
+    }
+    return w;
+}
+
+/* Cut polygon f (vertices placed in pos) into f->n - 2 triangles along the
+ * allowed diagonals, choosing the triangulation whose smallest angle is
+ * largest (dynamic programming over sub-polygons on the cosine of the
+ * smallest angle; ties keep the later split). Every polygon a cell method
+ * emits has an allowed triangulation (cubes.c checks its table); a
+ * tetrahedron's quadrilateral allows both diagonals. */
+static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g, uint32_t *T) {
+    const uint32_t n = f->n;
+    if (n == 3) {
+        T[0] = f->e[0];
+        T[1] = f->e[1];
+        T[2] = f->e[2];
+        return T + 3;
+    }
+    double W[LB__MAXPOLY][LB__MAXPOLY];
+    uint8_t ok[LB__MAXPOLY][LB__MAXPOLY], K[LB__MAXPOLY][LB__MAXPOLY];
+    for (uint32_t a = 0; a < n; ++a)
+        for (uint32_t b = a + 1; b < n; ++b) {
+            const int edge = b == a + 1 || (a == 0 && b == n - 1);
+            ok[a][b] = (uint8_t)(edge || f->ce[a] == 0xff ||
+                                 !lb__cube_edges_share_face(g, f->ce[a], f->ce[b]));
+        }
+    for (uint32_t len = 2; len < n; ++len)
+        for (uint32_t a = 0; a + len < n; ++a) {
+            const uint32_t b = a + len;
+            double best = INFINITY; /* the largest smallest-angle cosine: lower is better */
+            uint8_t bk = (uint8_t)(a + 1);
+            for (uint32_t k = b - 1; k > a; --k) {
+                if (!ok[a][k] || !ok[k][b]) continue;
+                double w = worst_cos(pos + 3 * f->e[a], pos + 3 * f->e[k], pos + 3 * f->e[b]);
+                if (k - a >= 2 && W[a][k] > w) w = W[a][k];
+                if (b - k >= 2 && W[k][b] > w) w = W[k][b];
+                if (w < best) {
+                    best = w;
+                    bk = (uint8_t)k;
+                }
+            }
+            W[a][b] = best;
+            K[a][b] = bk;
+        }
+    /* emit: an explicit stack of sub-polygons (a, b) */
+    uint8_t st[2 * LB__MAXPOLY];
+    int sp = 0;
+    st[sp++] = 0;
+    st[sp++] = (uint8_t)(n - 1);
+    while (sp) {
+        const uint8_t b = st[--sp], a = st[--sp];
+        if (b - a < 2) continue;
+        const uint8_t k = K[a][b];
+        T[0] = f->e[a];
+        T[1] = f->e[k];
+        T[2] = f->e[b];
+        T += 3;
+        st[sp++] = a;
+        st[sp++] = k;
+        st[sp++] = k;
+        st[sp++] = b;
+    }
+    return T;
+}
+
+lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B, lb_error *err) {
+    bctx C;
+    memset(&C, 0, sizeof C);
+    C.g = g;
+    C.B = B;
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
+    const size_t nid = (size_t)D0 * D1 * D2 * 8;
+    C.emap = malloc(nid * sizeof *C.emap);
+    lb_status s = LB_OK;
+    if (!C.emap) {
+        s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+        goto done;
+    }
+    memset(C.emap, 0xff, nid * sizeof *C.emap);
+    for (uint32_t k = 0; k < B->nc[2]; ++k)
+        for (uint32_t j = 0; j < B->nc[1]; ++j)
+            for (uint32_t i = 0; i < B->nc[0]; ++i) {
+                if (!B->cmask[((size_t)k * B->nc[1] + j) * B->nc[0] + i]) continue;
+                double c[8];
+                int nin = 0;
+                for (int o = 0; o < 8; ++o) {
+                    const size_t idx =
+                        ((size_t)(k + ((o >> 2) & 1)) * D1 + (j + ((o >> 1) & 1))) * D0 +
+                        (i + (o & 1));
+                    c[o] = B->vals[idx];
+                    nin += c[o] < 0.0;
+                }
+                if (nin == 0 || nin == 8) continue;
+                if (!(g->tetrahedra ? lb__tetra_cell : lb__cube_cell)(&C, i, j, k, c)) {
+                    s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+                    goto done;
+                }
+            }
+    B->nv = C.ne;
+    if (C.ne) {
+        B->vkey = C.key;
+        C.key = NULL;
+        B->vpos = malloc(3 * C.ne * sizeof *B->vpos);
+        B->vnrm = malloc(3 * C.ne * sizeof *B->vnrm);
+        size_t nt = 0;
+        for (size_t f = 0; f < C.nf; ++f) nt += C.faces[f].n - 2;
+        B->tri = malloc(3 * (nt ? nt : 1) * sizeof *B->tri);
+        if (!B->vpos || !B->vnrm || !B->tri) {
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+            goto done;
+        }
+        s = lb__refine_edges(ev, g, B, C.ne, C.ea, C.eb, C.pa, C.pb, C.ga, C.gb, B->vpos, B->vnrm,
+                             err);
+        if (s) goto done;
+        uint32_t *T = B->tri;
+        for (size_t f = 0; f < C.nf; ++f) T = triangulate(&C.faces[f], B->vpos, g, T);
+        B->nt = nt;
+    }
+done:
+    free(C.emap);
+    free(C.ea);
+    free(C.eb);
+    free(C.pa);
+    free(C.pb);
+    free(C.ga);
+    free(C.gb);
+    free(C.key);
+    free(C.faces);
+    return s;
+}
