@@ -18,7 +18,8 @@ All in one run, on this machine:
     bench/mesh/blender_metaballs.py), polygonized at the same cell size
     (5 / 128) with each ball's radius keyframed so that every frame changes:
     seconds per frame of the depsgraph update a frame change makes;
- 4. baking the 24 frames (render resolution, files written).
+ 4. baking the 24 frames (render resolution, files written);
+ 5. the metaballs' own 24-frame Cycles render, animated and not.
 Prints one "BENCH {json}" line per measurement and a summary.
 """
 import json
@@ -183,6 +184,16 @@ for f in range(1, FRAMES + 1):
     times.append(time.perf_counter() - t0)
 meta = report(what="metaballs, frame change (depsgraph + polygonize)", seconds_per_frame=statistics.median(times),
               quads=nq)
+# what the metaballs add to the same Cycles frame: their animation rendered, then the same
+# balls without animation (polygonized once per frame all the same: Blender re-evaluates them)
+setup_render(sc)
+sc.frame_set(1)
+meta_anim = render_animation(sc)
+mb.animation_data_clear()
+sc.frame_set(1)
+meta_static = render_animation(sc)
+metar = report(what="metaballs, render 24 frames", animated_seconds_per_frame=meta_anim,
+               static_seconds_per_frame=meta_static)
 
 r1, r0 = results[1], results[0]
 summary = {
@@ -192,6 +203,9 @@ summary = {
     "remesh_share_of_static_frame": {"1 thread": r1["remesh_per_frame"] / base["seconds_per_frame"],
                                      "all": r0["remesh_per_frame"] / base["seconds_per_frame"]},
     "metaballs_per_frame_s": meta["seconds_per_frame"],
+    "metaballs_share_of_static_frame": meta["seconds_per_frame"] / base["seconds_per_frame"],
+    "metaballs_cycles_frame_s": {"animated": metar["animated_seconds_per_frame"],
+                                 "static": metar["static_seconds_per_frame"]},
     "remesh_vs_metaballs": {"1 thread": r1["remesh_per_frame"] / meta["seconds_per_frame"],
                             "all": r0["remesh_per_frame"] / meta["seconds_per_frame"]},
     "bake_24_frames_s": bake_s["seconds"],
