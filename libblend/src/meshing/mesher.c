@@ -205,6 +205,7 @@ typedef struct run {
     size_t nblocks;
     uint32_t nb[3];
     int phase;
+    size_t hi; /* the current phase runs blocks [next's start, hi) */
     atomic_size_t next, done;
     atomic_int stop;
     const volatile int *cancel;
@@ -434,7 +435,7 @@ static void *worker(void *arg) {
     run *R = arg;
     while (!stopped(R)) {
         const size_t i = atomic_fetch_add(&R->next, 1);
-        if (i >= R->nblocks) break;
+        if (i >= R->hi) break;
         do_block(R, i);
     }
     return NULL;
@@ -447,22 +448,26 @@ typedef struct progress {
     int cancelled;
 } progress;
 
-/* One phase on nt threads; the calling thread works too and is the only
- * one that reports progress (between its own blocks). */
-static lb_status phase(run *R, int ph, size_t nt, progress *P) {
+/* One phase over blocks [lo, hi) on nt threads; the calling thread works too
+ * and is the only one that reports progress (between its own blocks).
+ * P->weight is the phase's share of the run over all blocks. */
+static lb_status phase(run *R, int ph, size_t lo, size_t hi, size_t nt, progress *P) {
+    if (lo >= hi) return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
     R->phase = ph;
-    atomic_store(&R->next, 0);
+    R->hi = hi;
+    atomic_store(&R->next, lo);
     atomic_store(&R->done, 0);
+    if (nt > hi - lo) nt = hi - lo;
     pthread_t tid[256];
     size_t started = 0;
     for (size_t t = 1; t < nt && t < 256; ++t) {
         if (pthread_create(&tid[started], NULL, worker, R) != 0) break;
         ++started;
     }
+    const double all = (double)(R->nblocks ? R->nblocks : 1);
     while (!stopped(R)) {
         if (P->fn) {
-            const double f = P->base + P->weight * (double)atomic_load(&R->done) /
-                                           (double)(R->nblocks ? R->nblocks : 1);
+            const double f = P->base + P->weight * (double)atomic_load(&R->done) / all;
             if (P->fn(f, P->user)) {
                 P->cancelled = 1;
                 atomic_store(&R->stop, 1);
@@ -470,13 +475,43 @@ static lb_status phase(run *R, int ph, size_t nt, progress *P) {
             }
         }
         const size_t i = atomic_fetch_add(&R->next, 1);
-        if (i >= R->nblocks) break;
+        if (i >= hi) break;
         do_block(R, i);
     }
     for (size_t t = 0; t < started; ++t) pthread_join(tid[t], NULL);
-    P->base += P->weight;
+    P->base += P->weight * (double)(hi - lo) / all;
     if (R->cancel && *R->cancel) P->cancelled = 1;
     return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
+}
+
+/* The phases, one layer of blocks (one block z) at a time: the node values
+ * of a layer and of the next one (whose near faces the layer's far faces
+ * take), then the layer's sharing and extraction, which frees its node
+ * data. So node data is held for two layers at once, never for the whole
+ * surface (the peak memory of a fine mesh is its output). The values are
+ * the same as computing every layer's nodes first: a block only reads nodes
+ * of the next blocks that those blocks never overwrite (block_share). */
+static lb_status layers(run *R, size_t nt, progress *P) {
+    lb_status s = LB_OK;
+    size_t cur = 0;
+    size_t next = 0; /* the first block of the layer after cur's */
+    while (next < R->nblocks && R->blocks[next].b[2] == R->blocks[0].b[2]) ++next;
+    const double wn = 0.45, ws = 0.05, wm = 0.40;
+    P->weight = wn;
+    s = phase(R, PH_NODES, 0, next, nt, P);
+    while (!s && !P->cancelled && cur < R->nblocks) {
+        size_t after = next;
+        while (after < R->nblocks && R->blocks[after].b[2] == R->blocks[next].b[2]) ++after;
+        P->weight = wn;
+        if (!s && !P->cancelled) s = phase(R, PH_NODES, next, after, nt, P);
+        P->weight = ws;
+        if (!s && !P->cancelled) s = phase(R, PH_SHARE, cur, next, nt, P);
+        P->weight = wm;
+        if (!s && !P->cancelled) s = phase(R, PH_MESH, cur, next, nt, P);
+        cur = next;
+        next = after;
+    }
+    return s;
 }
 
 /* ---- merge ---- */
@@ -648,12 +683,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     P.base = 0.05;
     lb_mesh *M = calloc(1, sizeof *M);
     if (!M) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    P.weight = 0.45;
-    if (!s && !P.cancelled) s = phase(&R, PH_NODES, nt, &P);
-    P.weight = 0.05;
-    if (!s && !P.cancelled) s = phase(&R, PH_SHARE, nt, &P);
-    P.weight = 0.40;
-    if (!s && !P.cancelled) s = phase(&R, PH_MESH, nt, &P);
+    if (!s && !P.cancelled) s = layers(&R, nt, &P);
     if (s && R.err_block != SIZE_MAX && err) *err = R.err;
     if (!s && !P.cancelled) s = merge(&R, M, err);
     if (!s && P.cancelled) s = lb__fail(err, LB_ERR_CANCELLED, "%s: cancelled by the caller", FN);
