@@ -1,7 +1,7 @@
 """Anchor (b): Blender's own metaball polygonizer, timed in-process around
 the depsgraph evaluation. Run by:
 
-    blender -b --factory-startup --python blender_metaballs.py -- S1|S2 RESOLUTION
+    blender -b --factory-startup --python blender_metaballs.py -- S1|S2 RESOLUTION [STIFFNESS]
 
 Balls are placed like S1 / S2; each ball's radius is set so that, alone, its
 surface has the sphere's radius (Blender's field is stiffness (1 - d^2/R^2)^3
@@ -17,6 +17,7 @@ import bpy
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 name, res = argv[0], int(argv[1])
+stiff = float(argv[2]) if len(argv) > 2 else 2.0  # Blender's default stiffness is 2
 if name == "S1":
     balls = [((0, 0, 0), 1.0), ((1.2, 0, 0), 1.0), ((0, 1.2, 0), 1.0)]
 else:
@@ -31,7 +32,6 @@ cell = 5.0 / res
 mb.resolution = cell
 mb.render_resolution = cell
 mb.update_method = "UPDATE_ALWAYS"  # full resolution, every change
-stiff = 2.0
 # alone: stiff (1 - d^2/R^2)^3 = threshold  ->  d = R sqrt(1 - (threshold/stiff)^(1/3))
 shrink = (1.0 - (mb.threshold / stiff) ** (1.0 / 3.0)) ** 0.5
 for (c, r) in balls:

@@ -337,6 +337,24 @@ activate(out)
 check(bpy.ops.libblend.bake_clear() == {"FINISHED"} and not os.path.exists(folder) and
       not out.libblend.use_bake, "clear bake")
 
+# ---------------------------------------------------------------- scrubbing, live
+# a frame change outside a render marks the field dirty; the live path meshes
+# that frame's state at preview resolution
+out.libblend.live = True
+live.update_now(out)
+n_before = len(out.data.vertices)
+sc.frame_set(3)
+check(live.state_of(out).dirty, "a frame change marks the live field dirty")
+while live.tick() is not None:
+    time.sleep(0.002)
+text2, _ = tree.to_json(out, bpy.context.evaluated_depsgraph_get())
+with live.library().parse_scene(text2) as scn, scn.compile() as ev:
+    ref2 = ev.mesh(tuple(s.bounds_min), tuple(s.bounds_max), resolution=s.preview_resolution)
+check(len(out.data.vertices) == len(ref2.positions) != n_before and
+      abs(json.loads(text2)["root"]["args"][0]["args"][0]["r"] - expected(3)["r"]) < 2e-6,
+      "scrubbing from frame 2 to 3 shows frame 3 at preview resolution")
+out.libblend.live = False
+
 # ---------------------------------------------------------------- a driver, live
 sc.frame_set(4)
 live.update_now(out)
