@@ -1,7 +1,7 @@
 /* Binary conic BT_2: closed form against the root-solved conic and a
  * long-double reference, p = 0 against the hyper-ellipsoidal operator with
  * p_i = 2, the non-blending region, m-independence of the zero set, duality
- * and gradients (shared/spec/operators.md sections 4 and 10). */
+ * and gradients (docs/operators.md sections 4 and 10). */
 #include "testlib.h"
 #include "../libblend/src/common/internal.h"
 

@@ -1,5 +1,5 @@
 /* BT_k (displacement family): values against a long-double bisection of the
- * defining equation, the invariants of shared/spec/operators.md sections 4
+ * defining equation, the invariants of docs/operators.md sections 4
  * and 10, and gradients against central differences. */
 #include "testlib.h"
 #include "../libblend/src/common/internal.h"

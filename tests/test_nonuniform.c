@@ -1,7 +1,7 @@
 /* Non-uniform scaling for soft objects: B_Sk (union), B_Ak (intersection),
  * difference, and the binary conic variants, against long-double bisection
  * of the defining equations in h, with the invariants of
- * shared/spec/operators.md sections 7 and 10. */
+ * docs/operators.md sections 7 and 10. */
 #include "testlib.h"
 
 #define N_CASES 100000

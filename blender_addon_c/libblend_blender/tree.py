@@ -92,7 +92,7 @@ VALUE_BLIND = ("min", "max", "complement")
 def m_has_effect(blend):
     """Whether the subsequent-blend parameter m of `blend`'s arguments can
     change the surface: m scales the blend's values outside its blending
-    region and its zero set never moves (docs/operators.md), so it acts only
+    region and its zero set never moves (docs/operators.md, section 4), so it acts only
     through a later blend that uses those values, an ancestor that is not a
     sharp min / max / complement."""
     o = blend.parent

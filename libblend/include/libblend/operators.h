@@ -17,7 +17,7 @@
  *    sum_i grad[i] * grad f_i(X).
  *  - Root-solved operators use one safeguarded solver (Newton inside a bracket,
  *    bisection fallback): the result never leaves the bracket stated in
- *    shared/spec/operators.md, and gradients come from the implicit function
+ *    docs/operators.md, and gradients come from the implicit function
  *    theorem, so they are exact to rounding.
  *  - For every finite input (|x_i| <= LB_MAX_ABS_ARG) and valid parameters the
  *    value and the gradient are finite. Non-finite or larger inputs give
@@ -92,7 +92,7 @@ LB_API lb_status lb_conic(lb_setop op, const double x[2], const double r[2], dou
  * min(y) <= 0. lb_scale_bs: Max-like B_S(y) (0 < r_i <= 1); equals max(y)
  * when max(y) <= 0; all r_i = 1 is Ricci's (sum y_i^p)^(1/p).
  * lb_scale: zero-convention set operations B_U, B_I, B_D built from them
- * (shared/spec/operators.md section 5). Parameters: 1 < p_i <= LB_MAX_EXPONENT;
+ * (docs/operators.md section 5). Parameters: 1 < p_i <= LB_MAX_EXPONENT;
  * lb_scale_ba: r_i > 0; lb_scale_bs: 0 < r_i <= 1; lb_scale: 0 < r_i <= 1 for
  * intersection and difference (they use B_S), any r_i > 0 for the union
  * (where a union argument is <= -1, outside the ray-linear range f >= -1, its
@@ -126,7 +126,7 @@ LB_API lb_status lb_bounded(lb_setop op, size_t k, const double *x, const double
  * Binary blends whose ranges (and, for the displacement family, m) depend on
  * the angle theta between the argument gradients g1, g2:
  *   R_i = r_i (1 - cos theta + omega)                 (LB_BULGE_RANGE)
- *   M_i as in shared/spec/operators.md section 4      (LB_BULGE_SLOPE; not for
+ *   M_i as in docs/operators.md section 4      (LB_BULGE_SLOPE; not for
  *                                                      the scale family)
  * Gradients: dx[2] = d value / d x_i, dg1[3], dg2[3] = d value / d g1, g2
  * (each may be NULL); M_i is kept within [LB_MIN_SLOPE, LB_MAX_SLOPE] (it

@@ -2,7 +2,7 @@
  *
  * The ranges become R_i = r_i (1 - cos theta + omega), theta the angle
  * between the argument gradients; for the displacement and conic families the
- * m_i may also become M_i(cos theta, G = |g1|/|g2|) (shared/spec/operators.md
+ * m_i may also become M_i(cos theta, G = |g1|/|g2|) (docs/operators.md
  * section 4). The base operator is evaluated with (R, M) and its derivatives
  * with respect to r and m are chained through cos theta and G, so the
  * derivatives with respect to g1 and g2 are exact.

@@ -1,4 +1,4 @@
-/* Classic operators: the baselines users know (shared/spec/operators.md 8). */
+/* Classic operators: the baselines users know (docs/operators.md 8). */
 #include "../common/internal.h"
 
 static double classic_eval(lb_classic_kind kind, size_t k, const double *x, double n, double *g) {

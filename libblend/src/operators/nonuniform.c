@@ -4,7 +4,7 @@
  * z_i = x_i / s_i(h) = a_i exp(-m_i lambda) with a_i = x_i 2^(1 - m_i):
  *   intersection B_Ak: T = sum_i [(1 + r_i - z_i)/r_i]+^p_i - 1
  *   union        B_Sk: T = 1 - sum_i [(r_i - 1 + z_i)/r_i]+^p_i
- * Both increase with lambda; brackets from shared/spec/operators.md section 7
+ * Both increase with lambda; brackets from docs/operators.md section 7
  * (for r_i = 1 the union's upper end is where that term is <= 1/k).
  * Conic variants use H of lb__conic_H with u_i = z_i - 1 (intersection,
  * T = H) or u_i = 1 - z_i (union, T = -H), between the non-blending value
