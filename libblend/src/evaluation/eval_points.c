@@ -134,7 +134,8 @@ static void run_prim(const lb__instr *in, size_t n, const double *x, const doubl
  * re-validating parameters the compiler already checked. x, r, p, m hold the
  * k active arguments (all of them unless a plan culled some). */
 static double fast_op(const lb__instr *in, size_t k, const uint16_t *act, const double *x,
-                      const double *r, const double *p, const double *m, double *dx) {
+                      const double *r, const double *p, const double *m, const double *ir,
+                      const double *im, double *dx) {
     const lb__node *n = &in->op;
     double xt[LB_MAX_ARITY], sg[LB_MAX_ARITY];
     switch (in->fast) {
@@ -163,7 +164,9 @@ static double fast_op(const lb__instr *in, size_t k, const uint16_t *act, const 
         if (k == 1) { /* BT_1 = u / m: one active argument (the others culled) */
             h = u[0] / m[0];
             dx[0] = 1.0 / m[0];
-        } else if (disp)
+        } else if (disp && ir)
+            h = lb__bt_two_union_recip(k, u, r, m, ir, im, dx);
+        else if (disp)
             h = lb__bt_union(k, u, r, p, m, in->mode, dx, NULL, NULL);
         else
             h = lb__conic_union(u, r, n->shape, m, dx, NULL, NULL);
@@ -295,11 +298,15 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
         dgall = malloc(6 * LB__CHUNK * sizeof *dgall);
         if (!dgall) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", nd->path);
     }
+    /* every p = 2 displacement: the reciprocals of r and m once for the chunk */
+    double irb[LB_MAX_ARITY], imb[LB_MAX_ARITY];
+    const int recip = in->fast == LB__FAST_DISPLACEMENT && in->mode == LB__P_TWO && k > 1;
+    if (recip) lb__bt_recip(k, r, m, irb, imb);
     for (size_t j = 0; j < n; ++j) {
         for (size_t i = 0; i < k; ++i) x[i] = vs[i][j];
         double v;
         if (in->fast && point_ok(x, k)) {
-            v = fast_op(in, k, act, x, r, p, m, dx);
+            v = fast_op(in, k, act, x, r, p, m, recip ? irb : NULL, imb, dx);
         } else {
             if (bounded)
                 for (size_t i = 0; i < k; ++i) c[i] = lb__reg(regs, in->src[k + i], 0)[j];
@@ -693,34 +700,57 @@ lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const double *x, c
 /* Points known to lie in one box (a mesher's block): one interval pass for
  * the box decides the culling for every chunk; no reordering, no threads.
  * The caller guarantees every point is inside [bmin, bmax]. */
+lb_status lb__boxeval_init(const lb_evaluator *ev, const double bmin[3], const double bmax[3],
+                           lb__boxeval *E, lb_error *err) {
+    memset(E, 0, sizeof *E);
+    E->regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *E->regs);
+    lb__iv *R = malloc(ev->nregs * sizeof *R);
+    E->plan.need = malloc(ev->n);
+    E->plan.nact = malloc(ev->n * sizeof *E->plan.nact);
+    E->plan.act = malloc((ev->total_k ? ev->total_k : 1) * sizeof *E->plan.act);
+    if (!E->regs || !R || !E->plan.need || !E->plan.nact || !E->plan.act) {
+        free(R);
+        lb__boxeval_free(E);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_evaluator_eval: out of memory");
+    }
+    double bc[3], br[3];
+    lb__box_centre(bmin, bmax, bc, br);
+    lb__bounds_pass(ev, bc, br, R, &E->plan);
+    free(R);
+    return LB_OK;
+}
+
+lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n, const double *x,
+                          const double *y, const double *z, double *v, double *gx, double *gy,
+                          double *gz, lb_error *err) {
+    lb_status s = LB_OK;
+    for (size_t o = 0; o < n && !s; o += LB__CHUNK) {
+        const size_t m = n - o < LB__CHUNK ? n - o : LB__CHUNK;
+        s = lb__tape_run_plan(ev, &E->plan, m, x + o, y + o, z + o, E->regs, err);
+        if (s) break;
+        memcpy(v + o, lb__reg(E->regs, ev->out, 0), m * sizeof *v);
+        memcpy(gx + o, lb__reg(E->regs, ev->out, 1), m * sizeof *gx);
+        memcpy(gy + o, lb__reg(E->regs, ev->out, 2), m * sizeof *gy);
+        memcpy(gz + o, lb__reg(E->regs, ev->out, 3), m * sizeof *gz);
+    }
+    return s;
+}
+
+void lb__boxeval_free(lb__boxeval *E) {
+    free(E->regs);
+    free(E->plan.need);
+    free(E->plan.nact);
+    free(E->plan.act);
+    memset(E, 0, sizeof *E);
+}
+
 lb_status lb__eval_in_box(const lb_evaluator *ev, const double bmin[3], const double bmax[3],
                           size_t n, const double *x, const double *y, const double *z, double *v,
                           double *gx, double *gy, double *gz, lb_error *err) {
-    double *regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
-    lb__iv *R = malloc(ev->nregs * sizeof *R);
-    lb__plan plan = {malloc(ev->n), malloc(ev->n * sizeof *plan.nact),
-                     malloc((ev->total_k ? ev->total_k : 1) * sizeof *plan.act)};
-    lb_status s = LB_OK;
-    if (!regs || !R || !plan.need || !plan.nact || !plan.act) {
-        s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_evaluator_eval: out of memory");
-    } else {
-        double bc[3], br[3];
-        lb__box_centre(bmin, bmax, bc, br);
-        lb__bounds_pass(ev, bc, br, R, &plan);
-        for (size_t o = 0; o < n && !s; o += LB__CHUNK) {
-            const size_t m = n - o < LB__CHUNK ? n - o : LB__CHUNK;
-            s = lb__tape_run_plan(ev, &plan, m, x + o, y + o, z + o, regs, err);
-            if (s) break;
-            memcpy(v + o, lb__reg(regs, ev->out, 0), m * sizeof *v);
-            memcpy(gx + o, lb__reg(regs, ev->out, 1), m * sizeof *gx);
-            memcpy(gy + o, lb__reg(regs, ev->out, 2), m * sizeof *gy);
-            memcpy(gz + o, lb__reg(regs, ev->out, 3), m * sizeof *gz);
-        }
-    }
-    free(regs);
-    free(R);
-    free(plan.need);
-    free(plan.nact);
-    free(plan.act);
+    lb__boxeval E;
+    lb_status s = lb__boxeval_init(ev, bmin, bmax, &E, err);
+    if (s) return s;
+    s = lb__boxeval_run(ev, &E, n, x, y, z, v, gx, gy, gz, err);
+    lb__boxeval_free(&E);
     return s;
 }

@@ -168,6 +168,20 @@ LB_INTERNAL lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *
                                         const double *x, const double *y, const double *z,
                                         double *regs, lb_error *err);
 
+/* Evaluation of many batches of points inside one box under one plan: the
+ * interval pass over the box once (init), then any number of runs (the
+ * mesher's node values and refinement rounds of one block). */
+typedef struct lb__boxeval {
+    lb__plan plan;
+    double *regs;
+} lb__boxeval;
+LB_INTERNAL lb_status lb__boxeval_init(const lb_evaluator *ev, const double bmin[3],
+                                       const double bmax[3], lb__boxeval *E, lb_error *err);
+LB_INTERNAL lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n,
+                                      const double *x, const double *y, const double *z, double *v,
+                                      double *gx, double *gy, double *gz, lb_error *err);
+LB_INTERNAL void lb__boxeval_free(lb__boxeval *E);
+
 /* Values and gradients of n points that all lie in [bmin, bmax], with the
  * culling of one interval pass over that box (single-threaded; the
  * mesher's blocks). */

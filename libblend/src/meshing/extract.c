@@ -21,10 +21,17 @@ typedef struct face {
     uint32_t n;
 } face;
 
+/* One thread's extraction state, reused block after block (lb__bctx_new):
+ * the arrays keep their capacity, and the edge map is reset by a stamp
+ * instead of a clear. */
+#define EMAP_SIZE ((size_t)(LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1) * 8)
+
 struct lb__bctx {
     const lb__grid *g;
     lb__block *B;
-    int32_t *emap; /* local edge id -> crossing edge index */
+    int32_t *emap;    /* local edge id -> crossing edge index, valid where stamp matches */
+    uint32_t *estamp; /* the block stamp each emap entry was written for */
+    uint32_t stamp;
     size_t ne, cap;
     double *ea, *eb, *pa, *pb; /* inside end, outside end, their phi */
     double *ga, *gb;           /* and their gradients */
@@ -56,7 +63,7 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
     const uint32_t li = i + (op & 1), lj = j + ((op >> 1) & 1), lk = k + ((op >> 2) & 1);
     const int mask = op ^ oq;
     const size_t lid = ((size_t)(lk * D1 + lj) * D0 + li) * 8 + (size_t)mask;
-    if (C->emap[lid] >= 0) return C->emap[lid];
+    if (C->estamp[lid] == C->stamp) return C->emap[lid];
     size_t cap = C->cap;
     if (C->ne + 1 > cap) {
         size_t nc = cap ? 2 * cap : 256;
@@ -97,6 +104,7 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
     memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
     C->key[e] = lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask;
     C->emap[lid] = (int32_t)e;
+    C->estamp[lid] = C->stamp;
     return (int64_t)e;
 }
 
@@ -195,20 +203,44 @@ static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g
     return T;
 }
 
-lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B, lb_error *err) {
-    bctx C;
-    memset(&C, 0, sizeof C);
-    C.g = g;
-    C.B = B;
-    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
-    const size_t nid = (size_t)D0 * D1 * D2 * 8;
-    C.emap = malloc(nid * sizeof *C.emap);
-    lb_status s = LB_OK;
-    if (!C.emap) {
-        s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
-        goto done;
+lb__bctx *lb__bctx_new(void) {
+    lb__bctx *C = calloc(1, sizeof *C);
+    if (!C) return NULL;
+    C->emap = malloc(EMAP_SIZE * sizeof *C->emap);
+    C->estamp = calloc(EMAP_SIZE, sizeof *C->estamp);
+    if (!C->emap || !C->estamp) {
+        lb__bctx_free(C);
+        return NULL;
     }
-    memset(C.emap, 0xff, nid * sizeof *C.emap);
+    return C;
+}
+
+void lb__bctx_free(lb__bctx *C) {
+    if (!C) return;
+    free(C->emap);
+    free(C->estamp);
+    free(C->ea);
+    free(C->eb);
+    free(C->pa);
+    free(C->pb);
+    free(C->ga);
+    free(C->gb);
+    free(C->key);
+    free(C->faces);
+    free(C);
+}
+
+lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B, lb__bctx *C,
+                         lb_error *err) {
+    C->g = g;
+    C->B = B;
+    C->ne = C->nf = 0;
+    if (++C->stamp == 0) { /* wrapped: clear the stamps once */
+        memset(C->estamp, 0, EMAP_SIZE * sizeof *C->estamp);
+        C->stamp = 1;
+    }
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    lb_status s = LB_OK;
     for (uint32_t k = 0; k < B->nc[2]; ++k)
         for (uint32_t j = 0; j < B->nc[1]; ++j)
             for (uint32_t i = 0; i < B->nc[0]; ++i) {
@@ -223,40 +255,31 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
                     nin += c[o] < 0.0;
                 }
                 if (nin == 0 || nin == 8) continue;
-                if (!(g->tetrahedra ? lb__tetra_cell : lb__cube_cell)(&C, i, j, k, c)) {
+                if (!(g->tetrahedra ? lb__tetra_cell : lb__cube_cell)(C, i, j, k, c)) {
                     s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
                     goto done;
                 }
             }
-    B->nv = C.ne;
-    if (C.ne) {
-        B->vkey = C.key;
-        C.key = NULL;
-        B->vpos = malloc(3 * C.ne * sizeof *B->vpos);
-        B->vnrm = malloc(3 * C.ne * sizeof *B->vnrm);
+    B->nv = C->ne;
+    if (C->ne) {
+        B->vkey = malloc(C->ne * sizeof *B->vkey);
+        B->vpos = malloc(3 * C->ne * sizeof *B->vpos);
+        B->vnrm = malloc(3 * C->ne * sizeof *B->vnrm);
         size_t nt = 0;
-        for (size_t f = 0; f < C.nf; ++f) nt += C.faces[f].n - 2;
+        for (size_t f = 0; f < C->nf; ++f) nt += C->faces[f].n - 2;
         B->tri = malloc(3 * (nt ? nt : 1) * sizeof *B->tri);
-        if (!B->vpos || !B->vnrm || !B->tri) {
+        if (!B->vkey || !B->vpos || !B->vnrm || !B->tri) {
             s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
             goto done;
         }
-        s = lb__refine_edges(ev, g, B, C.ne, C.ea, C.eb, C.pa, C.pb, C.ga, C.gb, B->vpos, B->vnrm,
-                             err);
+        memcpy(B->vkey, C->key, C->ne * sizeof *B->vkey);
+        s = lb__refine_edges(ev, g, B, C->ne, C->ea, C->eb, C->pa, C->pb, C->ga, C->gb, B->vpos,
+                             B->vnrm, err);
         if (s) goto done;
         uint32_t *T = B->tri;
-        for (size_t f = 0; f < C.nf; ++f) T = triangulate(&C.faces[f], B->vpos, g, T);
+        for (size_t f = 0; f < C->nf; ++f) T = triangulate(&C->faces[f], B->vpos, g, T);
         B->nt = nt;
     }
 done:
-    free(C.emap);
-    free(C.ea);
-    free(C.eb);
-    free(C.pa);
-    free(C.pb);
-    free(C.ga);
-    free(C.gb);
-    free(C.key);
-    free(C.faces);
     return s;
 }

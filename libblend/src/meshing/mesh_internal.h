@@ -86,8 +86,14 @@ LB_INTERNAL double lb__mesh_phi(const lb__grid *g, const double X[3], double f, 
  * finds the crossing edges cell by cell (cubes.c, or tetra.c with
  * g->tetrahedra), refines a vertex on each (lb__refine_edges), triangulates
  * the cell polygons and writes the block's vertices and triangles. */
+typedef struct lb__bctx lb__bctx;
 LB_INTERNAL lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B,
-                                     lb_error *err);
+                                     lb__bctx *C, lb_error *err);
+
+/* A thread's extraction state for lb__mesh_block, reused across blocks
+ * (NULL when out of memory); freed by lb__bctx_free (NULL is fine). */
+LB_INTERNAL lb__bctx *lb__bctx_new(void);
+LB_INTERNAL void lb__bctx_free(lb__bctx *C);
 
 /* Safeguarded, batched root solve of phi_c along n grid edges: a[i] inside
  * (phi < 0), b[i] outside, pa/pb their values and ga/gb their gradients
@@ -100,7 +106,6 @@ LB_INTERNAL lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g
                                        lb_error *err);
 
 /* ---- the cell methods' side of extract.c */
-typedef struct lb__bctx lb__bctx;
 
 /* The vertex on the crossing edge between corners op and oq (op a subset of
  * oq) of cell (i, j, k) of the block, c its 8 corner values: its index in the

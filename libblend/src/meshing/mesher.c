@@ -212,6 +212,8 @@ typedef struct run {
     pthread_mutex_t lock;
     size_t err_block;
     lb_error err;
+    lb__bctx **ctx; /* one extraction state per thread (index 0: the calling thread) */
+    size_t nctx;
 } run;
 
 static lb__block *find_block(run *R, const uint32_t b[3]) {
@@ -279,53 +281,47 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
             }
 }
 
-/* The block's plan (its interval pass), then mark(). */
-static lb_status mark_block(run *R, lb__block *B, lb_error *err) {
-    const lb_evaluator *ev = R->ev;
-    lb__iv *IV = malloc(ev->nregs * sizeof *IV);
-    lb__plan plan = {malloc(ev->n), malloc(ev->n * sizeof *plan.nact),
-                     malloc((ev->total_k ? ev->total_k : 1) * sizeof *plan.act)};
-    lb_status s = LB_OK;
-    if (!IV || !plan.need || !plan.nact || !plan.act) {
-        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    } else {
-        double bmin[3], bmax[3], bc[3], br[3];
-        lb__block_box(R->g, B, bmin, bmax);
-        lb__box_centre(bmin, bmax, bc, br);
-        lb__bounds_pass(ev, bc, br, IV, &plan);
-        const uint32_t zero[3] = {0, 0, 0};
-        mark(R, B, &plan, IV, zero, B->nc);
-    }
-    free(IV);
-    free(plan.need);
-    free(plan.nact);
-    free(plan.act);
-    return s;
-}
-
+/* The node values of a block: its plan (one interval pass over the block's
+ * box), mark() with sub-box passes under that plan, then the marked nodes
+ * evaluated under the same plan (the point evaluator's culling for that
+ * box, computed once). */
 static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     const lb__grid *g = R->g;
+    const lb_evaluator *ev = R->ev;
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
     const size_t n = (size_t)D0 * D1 * D2;
     B->nmask = calloc(n, 1);
     B->cmask = calloc((size_t)B->nc[0] * B->nc[1] * B->nc[2], 1);
     B->vals = malloc(n * sizeof *B->vals);
     B->grads = malloc(3 * n * sizeof *B->grads);
-    if (!B->nmask || !B->cmask || !B->vals || !B->grads)
-        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    lb_status s = mark_block(R, B, err);
-    if (s) return s;
+    lb__iv *IV = malloc(ev->nregs * sizeof *IV);
+    lb__plan plan = {malloc(ev->n), malloc(ev->n * sizeof *plan.nact),
+                     malloc((ev->total_k ? ev->total_k : 1) * sizeof *plan.act)};
+    double *mem = NULL, *regs = NULL;
+    size_t *idx = NULL;
+    lb_status s = LB_OK;
+    if (!B->nmask || !B->cmask || !B->vals || !B->grads || !IV || !plan.need || !plan.nact ||
+        !plan.act) {
+        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        goto done;
+    }
+    double bmin[3], bmax[3], bc[3], br[3];
+    lb__block_box(g, B, bmin, bmax);
+    lb__box_centre(bmin, bmax, bc, br);
+    lb__bounds_pass(ev, bc, br, IV, &plan);
+    const uint32_t zero[3] = {0, 0, 0};
+    mark(R, B, &plan, IV, zero, B->nc);
     size_t m = 0;
     for (size_t q = 0; q < n; ++q) m += B->nmask[q];
-    if (m == 0) return LB_OK;
-    double *mem = malloc(7 * m * sizeof *mem);
-    size_t *idx = malloc(m * sizeof *idx);
-    if (!mem || !idx) {
-        free(mem);
-        free(idx);
-        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    if (m == 0) goto done;
+    mem = malloc(7 * m * sizeof *mem);
+    idx = malloc(m * sizeof *idx);
+    regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
+    if (!mem || !idx || !regs) {
+        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        goto done;
     }
-    double *x = mem, *y = x + m, *z = y + m, *v = z + m, *gx = v + m, *gy = gx + m, *gz = gy + m;
+    double *x = mem, *y = x + m, *z = y + m;
     size_t q = 0, w = 0;
     for (uint32_t k = 0; k < D2; ++k)
         for (uint32_t j = 0; j < D1; ++j)
@@ -339,15 +335,24 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
                 z[w] = X[2];
                 idx[w++] = q;
             }
-    double bmin[3], bmax[3];
-    lb__block_box(g, B, bmin, bmax);
-    s = lb__eval_in_box(R->ev, bmin, bmax, m, x, y, z, v, gx, gy, gz, err);
-    for (size_t i = 0; i < m && !s; ++i) {
-        const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
-        B->vals[idx[i]] = lb__mesh_phi(g, X, v[i], gf, B->grads + 3 * idx[i]);
+    for (size_t o = 0; o < m && !s; o += LB__CHUNK) {
+        const size_t c = m - o < LB__CHUNK ? m - o : LB__CHUNK;
+        s = lb__tape_run_plan(ev, &plan, c, x + o, y + o, z + o, regs, err);
+        const double *v = lb__reg(regs, ev->out, 0), *gx = lb__reg(regs, ev->out, 1),
+                     *gy = lb__reg(regs, ev->out, 2), *gz = lb__reg(regs, ev->out, 3);
+        for (size_t i = 0; i < c && !s; ++i) {
+            const double X[3] = {x[o + i], y[o + i], z[o + i]}, gf[3] = {gx[i], gy[i], gz[i]};
+            B->vals[idx[o + i]] = lb__mesh_phi(g, X, v[i], gf, B->grads + 3 * idx[o + i]);
+        }
     }
+done:
+    free(IV);
+    free(plan.need);
+    free(plan.nact);
+    free(plan.act);
     free(mem);
     free(idx);
+    free(regs);
     return s;
 }
 
@@ -391,8 +396,9 @@ static void block_share(run *R, lb__block *B) {
             }
 }
 
-/* One block of the current phase; failures keep the first block's error. */
-static void do_block(run *R, size_t i) {
+/* One block of the current phase on thread t; failures keep the first
+ * block's error. */
+static void do_block(run *R, size_t i, size_t t) {
     lb_error e = {LB_OK, ""};
     lb_status s = LB_OK;
     lb__block *B = &R->blocks[i];
@@ -401,7 +407,7 @@ static void do_block(run *R, size_t i) {
     else if (R->phase == PH_SHARE)
         block_share(R, B);
     else {
-        s = lb__mesh_block(R->ev, R->g, B, &e);
+        s = lb__mesh_block(R->ev, R->g, B, R->ctx[t], &e);
         /* the node data is not needed any more (the share phase is over) */
         free(B->vals);
         free(B->grads);
@@ -431,12 +437,18 @@ static int stopped(run *R) {
     return 0;
 }
 
+typedef struct wctx {
+    run *R;
+    size_t t;
+} wctx;
+
 static void *worker(void *arg) {
-    run *R = arg;
+    const wctx *W = arg;
+    run *R = W->R;
     while (!stopped(R)) {
         const size_t i = atomic_fetch_add(&R->next, 1);
         if (i >= R->hi) break;
-        do_block(R, i);
+        do_block(R, i, W->t);
     }
     return NULL;
 }
@@ -458,10 +470,14 @@ static lb_status phase(run *R, int ph, size_t lo, size_t hi, size_t nt, progress
     atomic_store(&R->next, lo);
     atomic_store(&R->done, 0);
     if (nt > hi - lo) nt = hi - lo;
+    if (nt > R->nctx) nt = R->nctx;
     pthread_t tid[256];
+    wctx W[256];
     size_t started = 0;
     for (size_t t = 1; t < nt && t < 256; ++t) {
-        if (pthread_create(&tid[started], NULL, worker, R) != 0) break;
+        W[started].R = R;
+        W[started].t = t;
+        if (pthread_create(&tid[started], NULL, worker, &W[started]) != 0) break;
         ++started;
     }
     const double all = (double)(R->nblocks ? R->nblocks : 1);
@@ -476,7 +492,7 @@ static lb_status phase(run *R, int ph, size_t lo, size_t hi, size_t nt, progress
         }
         const size_t i = atomic_fetch_add(&R->next, 1);
         if (i >= hi) break;
-        do_block(R, i);
+        do_block(R, i, 0);
     }
     for (size_t t = 0; t < started; ++t) pthread_join(tid[t], NULL);
     P->base += P->weight * (double)(hi - lo) / all;
@@ -682,7 +698,12 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     if (P.fn && P.fn(0.05, P.user)) P.cancelled = 1;
     P.base = 0.05;
     lb_mesh *M = calloc(1, sizeof *M);
-    if (!M) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    if (nt > 256) nt = 256;
+    R.ctx = calloc(nt, sizeof *R.ctx);
+    if (R.ctx)
+        for (R.nctx = 0; R.nctx < nt; ++R.nctx)
+            if (!(R.ctx[R.nctx] = lb__bctx_new())) break;
+    if (!M || !R.ctx || R.nctx < nt) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     if (!s && !P.cancelled) s = layers(&R, nt, &P);
     if (s && R.err_block != SIZE_MAX && err) *err = R.err;
     if (!s && !P.cancelled) s = merge(&R, M, err);
@@ -702,6 +723,8 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         free(B->tri);
     }
     free(R.blocks);
+    for (size_t t = 0; t < R.nctx; ++t) lb__bctx_free(R.ctx[t]);
+    free(R.ctx);
     pthread_mutex_destroy(&R.lock);
     if (s) {
         lb_mesh_free(M);

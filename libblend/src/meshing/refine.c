@@ -108,7 +108,12 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
     }
     double bmin[3], bmax[3];
     lb__block_box(g, B, bmin, bmax);
-    lb_status s = LB_OK;
+    lb__boxeval E;
+    lb_status s = lb__boxeval_init(ev, bmin, bmax, &E, err);
+    if (s) {
+        free(mem);
+        return s;
+    }
     for (int it = 0; it < MAX_ITER && na > 0 && !s; ++it) {
         for (size_t j = 0; j < na; ++j) {
             const size_t i = act[j];
@@ -117,7 +122,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
             y[j] = A[1] + t[i] * (Bp[1] - A[1]);
             z[j] = A[2] + t[i] * (Bp[2] - A[2]);
         }
-        s = lb__eval_in_box(ev, bmin, bmax, na, x, y, z, v, gx, gy, gz, err);
+        s = lb__boxeval_run(ev, &E, na, x, y, z, v, gx, gy, gz, err);
         if (s) break;
         size_t keep = 0;
         const int last = it == MAX_ITER - 1;
@@ -193,6 +198,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
         }
         na = keep;
     }
+    lb__boxeval_free(&E);
     free(mem);
     return s;
 }

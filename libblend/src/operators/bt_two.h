@@ -31,6 +31,36 @@ static inline void lb__bt_setup(size_t k, const double *x, const double *r, cons
     *argmin = j;
 }
 
+/* The reciprocals of lb__bt_setup alone: they depend only on r and m, so a
+ * batch over many points computes them once (the same bits as per point). */
+static inline void lb__bt_recip(size_t k, const double *r, const double *m, double *ir,
+                                double *im) {
+    for (size_t i = 0; i < k; ++i) {
+        const double inv = 1.0 / (r[i] * m[i]);
+        ir[i] = m[i] * inv;
+        im[i] = r[i] * inv;
+    }
+}
+
+/* lb__bt_setup with the reciprocals given (lb__bt_recip). */
+static inline void lb__bt_setup_recip(size_t k, const double *x, const double *r, const double *im,
+                                      double *b, double *lo, double *hi, size_t *argmin) {
+    double a = INFINITY, c = INFINITY;
+    size_t j = 0;
+    for (size_t i = 0; i < k; ++i) {
+        b[i] = (x[i] - r[i]) * im[i];
+        const double hi_i = x[i] * im[i];
+        if (b[i] < a) a = b[i];
+        if (hi_i < c) {
+            c = hi_i;
+            j = i;
+        }
+    }
+    *lo = a;
+    *hi = c;
+    *argmin = j;
+}
+
 /* Non-blending region: no argument but the argmin j is within its range at
  * h = x_j/m_j (every other breakpoint b_i >= hi). Then BT = x_j/m_j exactly. */
 static inline int lb__bt_alone(size_t k, const double *x, const double *m, const double *b,
@@ -140,6 +170,21 @@ static inline double lb__bt_two_union(size_t k, const double *x, const double *r
     if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
     const double h = lb__bt_two(k, b, m, ir, lo, hi);
     lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, dx, dr, dm);
+    return h;
+}
+
+/* lb__bt_two_union with the reciprocals of r and m given (lb__bt_recip):
+ * the same value and derivatives by the arguments, bit for bit. */
+static inline double lb__bt_two_union_recip(size_t k, const double *x, const double *r,
+                                            const double *m, const double *ir, const double *im,
+                                            double *dx) {
+    double b[LB_MAX_ARITY];
+    double lo, hi;
+    size_t j;
+    lb__bt_setup_recip(k, x, r, im, b, &lo, &hi, &j);
+    if (lb__bt_alone(k, x, m, b, hi, j, dx, NULL, NULL)) return x[j] / m[j];
+    const double h = lb__bt_two(k, b, m, ir, lo, hi);
+    lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, dx, NULL, NULL);
     return h;
 }
 
