@@ -214,6 +214,13 @@ typedef struct run {
     lb_error err;
     lb__bctx **ctx; /* one extraction state per thread (index 0: the calling thread) */
     size_t nctx;
+    /* the worker pool, started once per run: each phase wakes it (gen) and
+     * waits until every worker is done with it (active) */
+    pthread_mutex_t pm;
+    pthread_cond_t go, fin;
+    unsigned gen;
+    size_t active, nworkers;
+    int quit;
 } run;
 
 static lb__block *find_block(run *R, const uint32_t b[3]) {
@@ -445,12 +452,49 @@ typedef struct wctx {
 static void *worker(void *arg) {
     const wctx *W = arg;
     run *R = W->R;
-    while (!stopped(R)) {
-        const size_t i = atomic_fetch_add(&R->next, 1);
-        if (i >= R->hi) break;
-        do_block(R, i, W->t);
+    unsigned seen = 0;
+    pthread_mutex_lock(&R->pm);
+    for (;;) {
+        while (R->gen == seen && !R->quit) pthread_cond_wait(&R->go, &R->pm);
+        if (R->quit) break;
+        seen = R->gen;
+        pthread_mutex_unlock(&R->pm);
+        while (!stopped(R)) {
+            const size_t i = atomic_fetch_add(&R->next, 1);
+            if (i >= R->hi) break;
+            do_block(R, i, W->t);
+        }
+        pthread_mutex_lock(&R->pm);
+        if (--R->active == 0) pthread_cond_signal(&R->fin);
     }
+    pthread_mutex_unlock(&R->pm);
     return NULL;
+}
+
+/* Start up to nt - 1 workers (fewer if the system refuses threads: the
+ * calling thread still does every phase). */
+static void pool_start(run *R, wctx *W, pthread_t *tid, size_t nt) {
+    pthread_mutex_init(&R->pm, NULL);
+    pthread_cond_init(&R->go, NULL);
+    pthread_cond_init(&R->fin, NULL);
+    R->nworkers = 0;
+    for (size_t t = 1; t < nt && t < 256; ++t) {
+        W[R->nworkers].R = R;
+        W[R->nworkers].t = t;
+        if (pthread_create(&tid[R->nworkers], NULL, worker, &W[R->nworkers]) != 0) break;
+        ++R->nworkers;
+    }
+}
+
+static void pool_stop(run *R, pthread_t *tid) {
+    pthread_mutex_lock(&R->pm);
+    R->quit = 1;
+    pthread_cond_broadcast(&R->go);
+    pthread_mutex_unlock(&R->pm);
+    for (size_t t = 0; t < R->nworkers; ++t) pthread_join(tid[t], NULL);
+    pthread_cond_destroy(&R->go);
+    pthread_cond_destroy(&R->fin);
+    pthread_mutex_destroy(&R->pm);
 }
 
 typedef struct progress {
@@ -463,23 +507,17 @@ typedef struct progress {
 /* One phase over blocks [lo, hi) on nt threads; the calling thread works too
  * and is the only one that reports progress (between its own blocks).
  * P->weight is the phase's share of the run over all blocks. */
-static lb_status phase(run *R, int ph, size_t lo, size_t hi, size_t nt, progress *P) {
+static lb_status phase(run *R, int ph, size_t lo, size_t hi, progress *P) {
     if (lo >= hi) return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
     R->phase = ph;
     R->hi = hi;
     atomic_store(&R->next, lo);
     atomic_store(&R->done, 0);
-    if (nt > hi - lo) nt = hi - lo;
-    if (nt > R->nctx) nt = R->nctx;
-    pthread_t tid[256];
-    wctx W[256];
-    size_t started = 0;
-    for (size_t t = 1; t < nt && t < 256; ++t) {
-        W[started].R = R;
-        W[started].t = t;
-        if (pthread_create(&tid[started], NULL, worker, &W[started]) != 0) break;
-        ++started;
-    }
+    pthread_mutex_lock(&R->pm);
+    R->active = R->nworkers;
+    ++R->gen;
+    pthread_cond_broadcast(&R->go);
+    pthread_mutex_unlock(&R->pm);
     const double all = (double)(R->nblocks ? R->nblocks : 1);
     while (!stopped(R)) {
         if (P->fn) {
@@ -494,7 +532,9 @@ static lb_status phase(run *R, int ph, size_t lo, size_t hi, size_t nt, progress
         if (i >= hi) break;
         do_block(R, i, 0);
     }
-    for (size_t t = 0; t < started; ++t) pthread_join(tid[t], NULL);
+    pthread_mutex_lock(&R->pm);
+    while (R->active) pthread_cond_wait(&R->fin, &R->pm);
+    pthread_mutex_unlock(&R->pm);
     P->base += P->weight * (double)(hi - lo) / all;
     if (R->cancel && *R->cancel) P->cancelled = 1;
     return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
@@ -508,25 +548,30 @@ static lb_status phase(run *R, int ph, size_t lo, size_t hi, size_t nt, progress
  * the same as computing every layer's nodes first: a block only reads nodes
  * of the next blocks that those blocks never overwrite (block_share). */
 static lb_status layers(run *R, size_t nt, progress *P) {
+    pthread_t tid[256];
+    wctx W[256];
+    if (nt > R->nctx) nt = R->nctx;
+    pool_start(R, W, tid, nt);
     lb_status s = LB_OK;
     size_t cur = 0;
     size_t next = 0; /* the first block of the layer after cur's */
     while (next < R->nblocks && R->blocks[next].b[2] == R->blocks[0].b[2]) ++next;
     const double wn = 0.45, ws = 0.05, wm = 0.40;
     P->weight = wn;
-    s = phase(R, PH_NODES, 0, next, nt, P);
+    s = phase(R, PH_NODES, 0, next, P);
     while (!s && !P->cancelled && cur < R->nblocks) {
         size_t after = next;
         while (after < R->nblocks && R->blocks[after].b[2] == R->blocks[next].b[2]) ++after;
         P->weight = wn;
-        if (!s && !P->cancelled) s = phase(R, PH_NODES, next, after, nt, P);
+        if (!s && !P->cancelled) s = phase(R, PH_NODES, next, after, P);
         P->weight = ws;
-        if (!s && !P->cancelled) s = phase(R, PH_SHARE, cur, next, nt, P);
+        if (!s && !P->cancelled) s = phase(R, PH_SHARE, cur, next, P);
         P->weight = wm;
-        if (!s && !P->cancelled) s = phase(R, PH_MESH, cur, next, nt, P);
+        if (!s && !P->cancelled) s = phase(R, PH_MESH, cur, next, P);
         cur = next;
         next = after;
     }
+    pool_stop(R, tid);
     return s;
 }
 
