@@ -18,7 +18,9 @@ def _active(context):
 
 
 def _selected(context):
-    return [o for o in context.view_layer.objects if o.select_get()]
+    # o is None for a base whose object was just removed, until the view layer
+    # resyncs (seen in Blender 4.3 after Apply removed a large tree)
+    return [o for o in context.view_layer.objects if o is not None and o.select_get()]
 
 
 def _make_active(context, obj):
@@ -480,6 +482,7 @@ class LIBBLEND_OT_apply(bpy.types.Operator):
             if old.users == 0:
                 bpy.data.meshes.remove(old)
             obj.name = name
+            context.view_layer.update()  # resync the view layer's bases after the removals
         _make_active(context, obj)
         self.report({"INFO"}, "'%s': %d triangles at %d cells" % (obj.name, len(job.mesh.triangles),
                                                                   res))

@@ -653,6 +653,13 @@ Vb, _Nb, Fb = meshcheck.read(ply)
 ib = meshcheck.check(Vb, Fb)
 check(ipl["vertices"] == ib["vertices"] and abs(ipl["volume"] - ib["volume"]) < 1e-5 * ib["volume"],
       "the applied mesh is the field at 48 cells: %d / %d vertices" % (ipl["vertices"], ib["vertices"]))
+# a large tree (64 spheres): Apply removes 65 objects at once, and selecting afterwards works
+check(bpy.ops.libblend.import_scene(filepath=os.path.join(SRC, "scenes", "bench-s2-64-spheres.json"),
+                                    with_render=False) == {"FINISHED"}, "import S2")
+big = active()
+big.libblend.preview_resolution = 24
+check(bpy.ops.libblend.apply(resolution=24) == {"FINISHED"} and active().type == "MESH" and
+      active().libblend.kind == "NONE" and len(active().data.polygons) > 1000, "apply a large tree")
 activate(out)
 check(bpy.ops.libblend.apply(resolution=24, keep_field=True) == {"FINISHED"} and
       bpy.data.objects.get("libblend field") == out and active() != out and
