@@ -14,6 +14,9 @@ add-on (and its tests) call these functions instead of testing versions.
                      blender_manifest.toml replaces        by __package__;
                      bl_info                               is_extension says)
   4.2                EEVEE is BLENDER_EEVEE_NEXT          eevee_engine
+  4.3 (seen)         view_layer.objects yields None for    view_layer_objects
+                     objects just removed, until the view
+                     layer resyncs
 """
 import bpy
 
@@ -23,6 +26,12 @@ VERSION = bpy.app.version
 def is_extension():
     """True when the add-on runs as a 4.2+ extension (bl_ext.<repo>.<id>)."""
     return __package__.startswith("bl_ext.")
+
+
+def view_layer_objects(view_layer):
+    """The view layer's objects, without the None entries Blender 4.3 leaves
+    for objects removed since its last resync (3.4 resyncs at once)."""
+    return [o for o in view_layer.objects if o is not None]
 
 
 def set_triangles(me, nt):

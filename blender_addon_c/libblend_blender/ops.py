@@ -10,7 +10,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, IntProper
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 from mathutils import Matrix
 
-from . import bake, binding, live, props, render_section, tree
+from . import bake, binding, compat, live, props, render_section, tree
 
 
 def _active(context):
@@ -18,9 +18,7 @@ def _active(context):
 
 
 def _selected(context):
-    # o is None for a base whose object was just removed, until the view layer
-    # resyncs (seen in Blender 4.3 after Apply removed a large tree)
-    return [o for o in context.view_layer.objects if o is not None and o.select_get()]
+    return [o for o in compat.view_layer_objects(context.view_layer) if o.select_get()]
 
 
 def _make_active(context, obj):
