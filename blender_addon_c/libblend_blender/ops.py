@@ -267,6 +267,14 @@ class LIBBLEND_OT_move_argument(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _refused(op, e, paths):
+    """Report a tree or library error (naming the object its JSON path points
+    to) and cancel."""
+    op.report({"ERROR"}, tree.explain(str(e), paths) if isinstance(e, binding.LibblendError)
+              else str(e))
+    return {"CANCELLED"}
+
+
 def _output(context, op):
     a = _active(context)
     out = tree.output_of(a) if a else None
@@ -362,12 +370,8 @@ class LIBBLEND_OT_export_scene(bpy.types.Operator, ExportHelper):
             text, paths = tree.to_json(out)
             live.library().parse_scene(text, os.path.basename(self.filepath)).close()
             _atomic_write(self.filepath, text + "\n")
-        except tree.TreeError as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        except binding.LibblendError as e:
-            self.report({"ERROR"}, tree.explain(str(e), paths))
-            return {"CANCELLED"}
+        except (tree.TreeError, binding.LibblendError) as e:
+            return _refused(self, e, paths)
         except OSError as e:
             self.report({"ERROR"}, "cannot write %s: %s" % (self.filepath, e.strerror))
             return {"CANCELLED"}
@@ -456,12 +460,8 @@ class LIBBLEND_OT_apply(bpy.types.Operator):
             job.run()
             if job.error:
                 raise binding.LibblendError(job.error)
-        except tree.TreeError as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        except binding.LibblendError as e:
-            self.report({"ERROR"}, tree.explain(str(e), paths))
-            return {"CANCELLED"}
+        except (tree.TreeError, binding.LibblendError) as e:
+            return _refused(self, e, paths)
         name = out.name
         me = bpy.data.meshes.new(name)
         live.set_mesh_data(me, job.mesh, out.libblend.normals)
@@ -523,12 +523,8 @@ class LIBBLEND_OT_export_pov(bpy.types.Operator, ExportHelper):
             if inc and os.path.abspath(inc) != dst:  # render with: povray +I<file> (no +L needed)
                 shutil.copyfile(inc, dst + ".tmp")
                 os.replace(dst + ".tmp", dst)
-        except tree.TreeError as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
-        except binding.LibblendError as e:
-            self.report({"ERROR"}, tree.explain(str(e), paths))
-            return {"CANCELLED"}
+        except (tree.TreeError, binding.LibblendError) as e:
+            return _refused(self, e, paths)
         except OSError as e:
             self.report({"ERROR"}, "cannot write next to %s: %s" % (self.filepath, e))
             return {"CANCELLED"}

@@ -16,6 +16,31 @@ import addon_utils
 import bpy
 
 
+checks = 0  # how many check() calls passed
+
+
+def check(cond, what):
+    """Count a check; raise AssertionError(what) when cond is false."""
+    global checks
+    checks += 1
+    if not cond:
+        raise AssertionError(what)
+    return cond
+
+
+def active():
+    return bpy.context.view_layer.objects.active
+
+
+def activate(obj):
+    """Make obj the only selected object and the active one."""
+    for o in bpy.context.view_layer.objects:
+        if o is not None:
+            o.select_set(False)
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+
+
 def enable(spec):
     """Enable the add-on named by spec; returns (package, module name)."""
     if spec.startswith("ext:"):

@@ -45,25 +45,7 @@ ok, msg = live.library_status()
 assert ok, msg
 print("library:", msg)
 lib = live.library()
-checks = 0
-
-
-def check(cond, what):
-    global checks
-    checks += 1
-    if not cond:
-        raise AssertionError(what)
-
-
-def activate(obj):
-    for o in bpy.context.view_layer.objects:
-        o.select_set(False)
-    obj.select_set(True)
-    bpy.context.view_layer.objects.active = obj
-
-
-def active():
-    return bpy.context.view_layer.objects.active
+check, active, activate = addon_env.check, addon_env.active, addon_env.activate
 
 
 def blender_mesh(obj):
@@ -736,4 +718,4 @@ check(len(anim.data.vertices) == meshcheck.check(*blender_mesh(anim))["vertices"
       "after the render the field is back at its preview mesh")
 
 addon_utils.disable(ADDON_NAME)
-print("test_addon: %d checks passed" % checks)
+print("test_addon: %d checks passed" % addon_env.checks)

@@ -49,26 +49,7 @@ os.environ.pop("LIBBLEND_LIBRARY", None)
 lbb, ADDON_NAME = addon_env.enable(ADDON)
 live, tree, bake = lbb.live, lbb.tree, lbb.bake
 print("Blender %s, add-on %s" % (bpy.app.version_string, ADDON_NAME))
-checks = 0
-
-
-def check(cond, what):
-    global checks
-    checks += 1
-    if not cond:
-        raise AssertionError(what)
-    return cond
-
-
-def active():
-    return bpy.context.view_layer.objects.active
-
-
-def activate(obj):
-    for o in bpy.context.view_layer.objects:
-        o.select_set(False)
-    obj.select_set(True)
-    bpy.context.view_layer.objects.active = obj
+check, active, activate = addon_env.check, addon_env.active, addon_env.activate
 
 
 def linear(obj, path):
@@ -417,4 +398,4 @@ check(bpy.ops.libblend.apply(resolution=24) == {"FINISHED"} and active().type ==
       active().libblend.kind == "NONE", "Apply a 66-object field after objects were removed")
 
 __import__("addon_utils").disable(ADDON_NAME)
-print("test_animation: %d checks passed" % checks)
+print("test_animation: %d checks passed" % addon_env.checks)

@@ -8,29 +8,6 @@
 
 #include "../common/internal.h"
 
-/* Reciprocals, the bracket [min (x-r)/m, min x/m] and its argmin. */
-static inline void lb__bt_setup(size_t k, const double *x, const double *r, const double *m,
-                                double *ir, double *im, double *b, double *lo, double *hi,
-                                size_t *argmin) {
-    double a = INFINITY, c = INFINITY;
-    size_t j = 0;
-    for (size_t i = 0; i < k; ++i) {
-        const double inv = 1.0 / (r[i] * m[i]); /* one division for both reciprocals */
-        ir[i] = m[i] * inv;
-        im[i] = r[i] * inv;
-        b[i] = (x[i] - r[i]) * im[i];
-        const double hi_i = x[i] * im[i];
-        if (b[i] < a) a = b[i];
-        if (hi_i < c) {
-            c = hi_i;
-            j = i;
-        }
-    }
-    *lo = a;
-    *hi = c;
-    *argmin = j;
-}
-
 /* The reciprocals of lb__bt_setup alone: they depend only on r and m, so a
  * batch over many points computes them once (the same bits as per point). */
 static inline void lb__bt_recip(size_t k, const double *r, const double *m, double *ir,
@@ -59,6 +36,14 @@ static inline void lb__bt_setup_recip(size_t k, const double *x, const double *r
     *lo = a;
     *hi = c;
     *argmin = j;
+}
+
+/* Reciprocals, the bracket [min (x-r)/m, min x/m] and its argmin. */
+static inline void lb__bt_setup(size_t k, const double *x, const double *r, const double *m,
+                                double *ir, double *im, double *b, double *lo, double *hi,
+                                size_t *argmin) {
+    lb__bt_recip(k, r, m, ir, im);
+    lb__bt_setup_recip(k, x, r, im, b, lo, hi, argmin);
 }
 
 /* Non-blending region: no argument but the argmin j is within its range at
