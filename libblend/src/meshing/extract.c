@@ -127,19 +127,24 @@ int lb__cell_polygon(lb__bctx *C, const uint32_t *e, const uint8_t *ce, uint32_t
 /* The cosine of a triangle's smallest angle (1 for a degenerate one): the
  * largest of its three corner cosines. */
 static double worst_cos(const double *A, const double *B, const double *C) {
-    const double *P[3] = {A, B, C};
-    double w = -1.0;
-    for (int q = 0; q < 3; ++q) {
-        const double *o = P[q], *u = P[(q + 1) % 3], *v = P[(q + 2) % 3];
-        const double a[3] = {u[0] - o[0], u[1] - o[1], u[2] - o[2]};
-        const double b[3] = {v[0] - o[0], v[1] - o[1], v[2] - o[2]};
-        const double la = a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
-        const double lb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
-        const double den = sqrt(la * lb);
-        const double c = den > 0.0 ? (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / den : 1.0;
-        if (c > w) w = c;
+    /* the smallest angle is the one opposite the shortest side */
+    const double e0[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]}; /* AB, opposite C */
+    const double e1[3] = {C[0] - B[0], C[1] - B[1], C[2] - B[2]}; /* BC, opposite A */
+    const double e2[3] = {A[0] - C[0], A[1] - C[1], A[2] - C[2]}; /* CA, opposite B */
+    const double l0 = e0[0] * e0[0] + e0[1] * e0[1] + e0[2] * e0[2];
+    const double l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
+    const double l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
+    const double *u, *v;
+    double lu, lv;
+    if (l0 <= l1 && l0 <= l2) { /* at C, between CA and CB = -BC */
+        u = e2, v = e1, lu = l2, lv = l1;
+    } else if (l1 <= l2) { /* at A, between AB and AC = -CA */
+        u = e0, v = e2, lu = l0, lv = l2;
+    } else { /* at B, between BC and BA = -AB */
+        u = e1, v = e0, lu = l1, lv = l0;
     }
-    return w;
+    const double den = sqrt(lu * lv);
+    return den > 0.0 ? -(u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / den : 1.0;
 }
 
 /* Cut polygon f (vertices placed in pos) into f->n - 2 triangles along the

@@ -378,8 +378,11 @@ static void block_share(run *R, lb__block *B) {
         next[c] = ok ? find_block(R, ob) : NULL;
     }
     for (uint32_t k = 0; k < D2; ++k)
-        for (uint32_t j = 0; j < D1; ++j)
-            for (uint32_t i = 0; i < D0; ++i) {
+        for (uint32_t j = 0; j < D1; ++j) {
+            /* only far-face nodes take another block's values: off the far
+             * faces in y and z, only the far x node of the row */
+            const uint32_t i0 = (k == LB__MB || j == LB__MB) ? 0 : LB__MB;
+            for (uint32_t i = i0; i < D0; ++i) {
                 const uint32_t l[3] = {i, j, k};
                 int c = 0;
                 uint32_t ol[3];
@@ -401,6 +404,7 @@ static void block_share(run *R, lb__block *B) {
                 B->vals[mine] = O->vals[theirs];
                 memcpy(B->grads + 3 * mine, O->grads + 3 * theirs, 3 * sizeof(double));
             }
+        }
 }
 
 /* One block of the current phase on thread t; failures keep the first
