@@ -472,7 +472,7 @@ class LIBBLEND_OT_apply(bpy.types.Operator):
             c.objects.link(obj)
         obj.matrix_world = out.matrix_world.copy()
         if not self.keep_field:
-            for o in sorted(out.children_recursive, key=lambda o: -len(o.name)):
+            for o in out.children_recursive:
                 if tree.is_node(o):
                     bpy.data.objects.remove(o)
             old = out.data
@@ -480,7 +480,6 @@ class LIBBLEND_OT_apply(bpy.types.Operator):
             if old.users == 0:
                 bpy.data.meshes.remove(old)
             obj.name = name
-            context.view_layer.update()  # resync the view layer's bases after the removals
         _make_active(context, obj)
         self.report({"INFO"}, "'%s': %d triangles at %d cells" % (obj.name, len(job.mesh.triangles),
                                                                   res))

@@ -33,7 +33,9 @@ import subprocess
 import sys
 import time
 
+import addon_utils
 import bpy
+import mathutils
 import numpy as np
 from bpy_extras.object_utils import world_to_camera_view
 
@@ -222,7 +224,7 @@ def screen_box(frames, sel):
         V = z["V"].astype(np.float64)
         pts.append(V[sel(V)])
     P = np.concatenate(pts)
-    uv = np.array([world_to_camera_view(sc, cam, out.matrix_world @ __import__("mathutils").Vector(p))[:2]
+    uv = np.array([world_to_camera_view(sc, cam, out.matrix_world @ mathutils.Vector(p))[:2]
                    for p in P[::max(1, len(P) // 3000)]])
     x0, y0 = np.floor(uv.min(0) * [W, H]) - 2
     x1, y1 = np.ceil(uv.max(0) * [W, H]) + 2
@@ -397,5 +399,5 @@ big.select_set(True)
 check(bpy.ops.libblend.apply(resolution=24) == {"FINISHED"} and active().type == "MESH" and
       active().libblend.kind == "NONE", "Apply a 66-object field after objects were removed")
 
-__import__("addon_utils").disable(ADDON_NAME)
+addon_utils.disable(ADDON_NAME)
 print("test_animation: %d checks passed" % addon_env.checks)

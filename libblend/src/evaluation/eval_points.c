@@ -704,19 +704,17 @@ lb_status lb__boxeval_init(const lb_evaluator *ev, const double bmin[3], const d
                            lb__boxeval *E, lb_error *err) {
     memset(E, 0, sizeof *E);
     E->regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *E->regs);
-    lb__iv *R = malloc(ev->nregs * sizeof *R);
+    E->iv = malloc(ev->nregs * sizeof *E->iv);
     E->plan.need = malloc(ev->n);
     E->plan.nact = malloc(ev->n * sizeof *E->plan.nact);
     E->plan.act = malloc((ev->total_k ? ev->total_k : 1) * sizeof *E->plan.act);
-    if (!E->regs || !R || !E->plan.need || !E->plan.nact || !E->plan.act) {
-        free(R);
+    if (!E->regs || !E->iv || !E->plan.need || !E->plan.nact || !E->plan.act) {
         lb__boxeval_free(E);
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_evaluator_eval: out of memory");
     }
     double bc[3], br[3];
     lb__box_centre(bmin, bmax, bc, br);
-    lb__bounds_pass(ev, bc, br, R, &E->plan);
-    free(R);
+    lb__bounds_pass(ev, bc, br, E->iv, &E->plan);
     return LB_OK;
 }
 
@@ -738,6 +736,7 @@ lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n, cons
 
 void lb__boxeval_free(lb__boxeval *E) {
     free(E->regs);
+    free(E->iv);
     free(E->plan.need);
     free(E->plan.nact);
     free(E->plan.act);

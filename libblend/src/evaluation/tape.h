@@ -174,6 +174,7 @@ LB_INTERNAL lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *
 typedef struct lb__boxeval {
     lb__plan plan;
     double *regs;
+    lb__iv *iv; /* the box's interval registers (scratch for sub-box passes afterwards) */
 } lb__boxeval;
 LB_INTERNAL lb_status lb__boxeval_init(const lb_evaluator *ev, const double bmin[3],
                                        const double bmax[3], lb__boxeval *E, lb_error *err);

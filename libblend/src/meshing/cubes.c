@@ -20,8 +20,9 @@
  * edge in each of the two cells and in no other polygon: two triangles per
  * face segment, one on each side, with opposite orientations. A polygon is
  * cut into triangles only along diagonals through the cell's interior, never
- * along a segment of a face (lb__mctable_init checks that every loop of
- * every case has such a triangulation: all do, with at most 7 vertices), so
+ * along a segment of a face (lb__mctable_check, run by the tests, proves
+ * that every loop of every case has such a triangulation: all do, with at
+ * most 7 vertices), so
  * an interior edge belongs to two triangles of one polygon. Around a vertex
  * (a crossing grid edge, shared by four cells) each of the four cells' loops
  * passes through it once, joining the segments on the two faces of that cell

@@ -82,7 +82,6 @@ static lb_status make_grid(const lb_evaluator *ev, const lb_mesh_options *o, lb_
     }
     g->closed = !(o->flags & LB_MESH_OPEN_BOUNDARY);
     g->tetrahedra = (o->flags & LB_MESH_TETRAHEDRA) != 0;
-    lb__mctable_init(&g->mc);
     g->soft = lb_evaluator_convention(ev) == LB_CONVENTION_SOFT;
     for (int d = 0; d < 3; ++d) {
         const double nf = ceil(ext[d] / h - 1e-9);
@@ -301,34 +300,27 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     B->cmask = calloc((size_t)B->nc[0] * B->nc[1] * B->nc[2], 1);
     B->vals = malloc(n * sizeof *B->vals);
     B->grads = malloc(3 * n * sizeof *B->grads);
-    lb__iv *IV = malloc(ev->nregs * sizeof *IV);
-    lb__plan plan = {malloc(ev->n), malloc(ev->n * sizeof *plan.nact),
-                     malloc((ev->total_k ? ev->total_k : 1) * sizeof *plan.act)};
-    double *mem = NULL, *regs = NULL;
-    size_t *idx = NULL;
-    lb_status s = LB_OK;
-    if (!B->nmask || !B->cmask || !B->vals || !B->grads || !IV || !plan.need || !plan.nact ||
-        !plan.act) {
-        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-        goto done;
-    }
-    double bmin[3], bmax[3], bc[3], br[3];
+    if (!B->nmask || !B->cmask || !B->vals || !B->grads)
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    double bmin[3], bmax[3];
     lb__block_box(g, B, bmin, bmax);
-    lb__box_centre(bmin, bmax, bc, br);
-    lb__bounds_pass(ev, bc, br, IV, &plan);
+    lb__boxeval E;
+    lb_status s = lb__boxeval_init(ev, bmin, bmax, &E, err);
+    if (s) return s;
     const uint32_t zero[3] = {0, 0, 0};
-    mark(R, B, &plan, IV, zero, B->nc);
+    mark(R, B, &E.plan, E.iv, zero, B->nc);
     size_t m = 0;
     for (size_t q = 0; q < n; ++q) m += B->nmask[q];
+    double *mem = NULL;
+    size_t *idx = NULL;
     if (m == 0) goto done;
     mem = malloc(7 * m * sizeof *mem);
     idx = malloc(m * sizeof *idx);
-    regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
-    if (!mem || !idx || !regs) {
+    if (!mem || !idx) {
         s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
         goto done;
     }
-    double *x = mem, *y = x + m, *z = y + m;
+    double *x = mem, *y = x + m, *z = y + m, *v = z + m, *gx = v + m, *gy = gx + m, *gz = gy + m;
     size_t q = 0, w = 0;
     for (uint32_t k = 0; k < D2; ++k)
         for (uint32_t j = 0; j < D1; ++j)
@@ -342,24 +334,15 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
                 z[w] = X[2];
                 idx[w++] = q;
             }
-    for (size_t o = 0; o < m && !s; o += LB__CHUNK) {
-        const size_t c = m - o < LB__CHUNK ? m - o : LB__CHUNK;
-        s = lb__tape_run_plan(ev, &plan, c, x + o, y + o, z + o, regs, err);
-        const double *v = lb__reg(regs, ev->out, 0), *gx = lb__reg(regs, ev->out, 1),
-                     *gy = lb__reg(regs, ev->out, 2), *gz = lb__reg(regs, ev->out, 3);
-        for (size_t i = 0; i < c && !s; ++i) {
-            const double X[3] = {x[o + i], y[o + i], z[o + i]}, gf[3] = {gx[i], gy[i], gz[i]};
-            B->vals[idx[o + i]] = lb__mesh_phi(g, X, v[i], gf, B->grads + 3 * idx[o + i]);
-        }
+    s = lb__boxeval_run(ev, &E, m, x, y, z, v, gx, gy, gz, err);
+    for (size_t i = 0; i < m && !s; ++i) {
+        const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
+        B->vals[idx[i]] = lb__mesh_phi(g, X, v[i], gf, B->grads + 3 * idx[i]);
     }
 done:
-    free(IV);
-    free(plan.need);
-    free(plan.nact);
-    free(plan.act);
+    lb__boxeval_free(&E);
     free(mem);
     free(idx);
-    free(regs);
     return s;
 }
 
@@ -703,6 +686,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     lb__grid g;
     lb_status s = make_grid(ev, opt, &g, err);
     if (s) return s;
+    lb__mctable_init(&g.mc); /* extraction only: not in make_grid, which fits() calls */
     const size_t max_memory = opt->max_memory ? opt->max_memory : LB_MESH_DEFAULT_MAX_MEMORY;
     const size_t max_blocks = max_memory / BLOCK_BYTES;
     run R;
