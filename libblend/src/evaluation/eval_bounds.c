@@ -330,6 +330,23 @@ static uint16_t cull(const lb__node *n, const iv *x, uint16_t *act) {
     return na;
 }
 
+/* What the root needs, backwards from the plan's argument lists. */
+static void plan_needs(const lb_evaluator *ev, lb__plan *plan) {
+    memset(plan->need, 0, ev->n);
+    plan->need[ev->n - 1] = 1;
+    for (size_t i = ev->n; i-- > 0;) {
+        const lb__instr *in = &ev->ins[i];
+        if (!plan->need[i] || in->code != LB__I_OP) continue;
+        const uint16_t *act = plan->act + in->aoff;
+        for (uint16_t a = 0; a < plan->nact[i]; ++a) {
+            plan->need[in->srci[act[a]]] = 1;
+            if (in->op.family == LB__F_BOUNDED) plan->need[in->srcb[act[a]]] = 1;
+        }
+        if (in->op.bulge) /* the Hessian terms re-run both arguments' prefixes */
+            for (size_t a = 0; a < in->op.k; ++a) plan->need[in->srci[a]] = 1;
+    }
+}
+
 void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br[3], iv *R,
                      lb__plan *plan) {
     iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
@@ -361,21 +378,7 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
         o.hi = clampd(o.hi);
         R[in->dst] = o;
     }
-    if (!plan) return;
-    /* what the root needs, backwards */
-    memset(plan->need, 0, ev->n);
-    plan->need[ev->n - 1] = 1;
-    for (size_t i = ev->n; i-- > 0;) {
-        const lb__instr *in = &ev->ins[i];
-        if (!plan->need[i] || in->code != LB__I_OP) continue;
-        const uint16_t *act = plan->act + in->aoff;
-        for (uint16_t a = 0; a < plan->nact[i]; ++a) {
-            plan->need[in->srci[act[a]]] = 1;
-            if (in->op.family == LB__F_BOUNDED) plan->need[in->srcb[act[a]]] = 1;
-        }
-        if (in->op.bulge) /* the Hessian terms re-run both arguments' prefixes */
-            for (size_t a = 0; a < in->op.k; ++a) plan->need[in->srci[a]] = 1;
-    }
+    if (plan) plan_needs(ev, plan);
 }
 
 /* An operator over all its arguments' intervals (no culling). */
@@ -396,9 +399,11 @@ static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const d
  * lb__bounds_pass): instructions the parent does not need are skipped, and
  * blends consider only the arguments the parent kept, which are the only
  * ones that can matter inside. Fills R for the needed instructions; the
- * root's interval is R[ev->out]. */
+ * root's interval is R[ev->out]. With child (may be NULL), also the plan of
+ * the smaller box: each blend keeps what the sub-box culling kept (a subset
+ * of the parent's), every other operator the parent's list. */
 void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const double bc[3],
-                         const double br[3], iv *R) {
+                         const double br[3], iv *R, lb__plan *child) {
     iv x[LB_MAX_ARITY];
     for (size_t i = 0; i < ev->n; ++i) {
         if (!parent->need[i]) continue;
@@ -436,14 +441,29 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                     if (!(reach >= n->r[a] * (1.0 + 1e-9) + 1e-12 * fabs(u.lo))) act[na++] = a;
                 }
                 fast_bounds(in, x, act, na, &o);
+                if (child) {
+                    memcpy(child->act + in->aoff, act, na * sizeof *act);
+                    child->nact[i] = na;
+                }
+            }
+            if (child && in->fast == LB__FAST_MINMAX) {
+                memcpy(child->act + in->aoff, parent->act + in->aoff,
+                       parent->nact[i] * sizeof *parent->act);
+                child->nact[i] = parent->nact[i];
             }
         } else {
             all_args_bounds(ev, in, bc, br, R, &o);
+            if (child) {
+                memcpy(child->act + in->aoff, parent->act + in->aoff,
+                       parent->nact[i] * sizeof *parent->act);
+                child->nact[i] = parent->nact[i];
+            }
         }
         o.lo = clampd(o.lo);
         o.hi = clampd(o.hi);
         R[in->dst] = o;
     }
+    if (child) plan_needs(ev, child);
 }
 
 void lb__bounds_pass_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist,

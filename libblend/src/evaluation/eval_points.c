@@ -734,6 +734,36 @@ lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n, cons
     return s;
 }
 
+void lb__boxeval_narrow(const lb_evaluator *ev, lb__boxeval *E, const lb__plan *outer,
+                        const double bmin[3], const double bmax[3]) {
+    double bc[3], br[3];
+    lb__box_centre(bmin, bmax, bc, br);
+    lb__bounds_pass_sub(ev, outer, bc, br, E->iv, &E->plan);
+}
+
+lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P, lb_error *err) {
+    const size_t nk = ev->total_k ? ev->total_k : 1;
+    P->need = malloc(ev->n);
+    P->nact = malloc(ev->n * sizeof *P->nact);
+    P->act = malloc(nk * sizeof *P->act);
+    if (!P->need || !P->nact || !P->act) {
+        lb__plan_free(P);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+    }
+    memcpy(P->need, from->need, ev->n);
+    memcpy(P->nact, from->nact, ev->n * sizeof *P->nact);
+    memcpy(P->act, from->act, nk * sizeof *P->act);
+    return LB_OK;
+}
+
+void lb__plan_free(lb__plan *P) {
+    free(P->need);
+    free(P->nact);
+    free(P->act);
+    P->need = NULL;
+    P->nact = P->act = NULL;
+}
+
 void lb__boxeval_free(lb__boxeval *E) {
     free(E->regs);
     free(E->iv);

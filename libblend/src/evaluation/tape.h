@@ -85,9 +85,11 @@ LB_INTERNAL void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], con
                                  lb__iv *R, lb__plan *plan);
 
 /* The pass over a box inside the box a parent plan was made for: only the
- * instructions and blend arguments the parent kept (eval_bounds.c). */
+ * instructions and blend arguments the parent kept (eval_bounds.c); child
+ * (NULL for none) receives the smaller box's plan. */
 LB_INTERNAL void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent,
-                                     const double bc[3], const double br[3], lb__iv *R);
+                                     const double bc[3], const double br[3], lb__iv *R,
+                                     lb__plan *child);
 
 /* Run instructions list[0..nlist) (tape order, no culling) on n <= LB__CHUNK
  * points into regs: one argument's cone, at compile time (local.c). */
@@ -182,6 +184,16 @@ LB_INTERNAL lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, si
                                       const double *x, const double *y, const double *z, double *v,
                                       double *gx, double *gy, double *gz, lb_error *err);
 LB_INTERNAL void lb__boxeval_free(lb__boxeval *E);
+/* A box inside E's box: E's plan becomes that box's (one sub-box pass under
+ * the current plan; the culling only tightens), for the runs that follow.
+ * Every later point must lie in [bmin, bmax]. */
+LB_INTERNAL void lb__boxeval_narrow(const lb_evaluator *ev, lb__boxeval *E, const lb__plan *outer,
+                                    const double bmin[3], const double bmax[3]);
+/* A copy of E's plan into P (allocated like E's; NULL members when memory is
+ * short), so that E can be narrowed again from the same outer plan. */
+LB_INTERNAL lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P,
+                                    lb_error *err);
+LB_INTERNAL void lb__plan_free(lb__plan *P);
 
 /* Values and gradients of n points that all lie in [bmin, bmax], with the
  * culling of one interval pass over that box (single-threaded; the

@@ -74,6 +74,9 @@ static inline void lb__node_pos(const lb__grid *g, uint64_t x, uint64_t y, uint6
     X[2] = g->origin[2] + (double)z * g->h[2];
 }
 
+/* The box of the block's local nodes [l0, l1] (padded by 1e-9 of a cell). */
+LB_INTERNAL void lb__node_box(const lb__grid *g, const lb__block *B, const uint32_t l0[3],
+                              const uint32_t l1[3], double bmin[3], double bmax[3]);
 /* The world box of a block's nodes, widened by a hair for rounding. */
 LB_INTERNAL void lb__block_box(const lb__grid *g, const lb__block *B, double bmin[3],
                                double bmax[3]);

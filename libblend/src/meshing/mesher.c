@@ -7,11 +7,15 @@
  * 2. Blocks of 8^3 cells: an octree over block ranges keeps the blocks whose
  *    interval bound of phi_c (lb_evaluator_bounds) contains 0.
  * 3. In parallel, each kept block finds, by intervals again, its sub-boxes
- *    of 2^3 cells that may cross (mark) and evaluates only their nodes.
+ *    of 2^3 cells that may cross (mark) and evaluates only their nodes,
+ *    octant by octant, each octant under the plan of its own interval pass
+ *    (fewer arguments survive culling over a smaller box).
  * 4. Nodes on a block's far faces are also nodes of the next block: they
  *    take that block's value and gradient, so both sides see the same signs
  *    (the evaluator's per-batch culling may differ in the last bit).
- * 5. In parallel, marching tetrahedra per block (tetra.c, refine.c).
+ * 5. In parallel, per block: the crossing edges' vertices (refine.c, octant
+ *    by octant as in 3) and the cells' polygons (extract.c with cubes.c, or
+ *    tetra.c with LB_MESH_TETRAHEDRA).
  * 6. One thread merges the blocks in block order, sharing the vertex of an
  *    edge two blocks both cut (the first block's copy), so the output is the
  *    same for every thread count.
@@ -236,31 +240,35 @@ static lb__block *find_block(run *R, const uint32_t b[3]) {
 }
 
 /* phi_c's interval over nodes [n0, n1] with phi from an interval pass
- * restricted by the block's plan (lb__bounds_pass_sub). */
+ * restricted by the enclosing box's plan (lb__bounds_pass_sub); child (may
+ * be NULL) receives this box's own plan. */
 static void sub_phi(const lb_evaluator *ev, const lb__grid *g, const lb__plan *plan, lb__iv *R,
-                    const uint64_t n0[3], const uint64_t n1[3], double *lo, double *hi) {
+                    const uint64_t n0[3], const uint64_t n1[3], lb__plan *child, double *lo,
+                    double *hi) {
     double bl[3], bh[3], bc[3], br[3];
     lb__node_pos(g, n0[0], n0[1], n0[2], bl);
     lb__node_pos(g, n1[0], n1[1], n1[2], bh);
     lb__box_centre(bl, bh, bc, br);
-    lb__bounds_pass_sub(ev, plan, bc, br, R);
+    lb__bounds_pass_sub(ev, plan, bc, br, R, child);
     phi_interval(g, bl, bh, R[ev->out].lo, R[ev->out].hi, lo, hi);
 }
 
+/* Splits from a block down to 2^3 cells: one per halving of a side of 8. */
+#define MARK_DEPTH 6
+
 /* Inside a kept block, the sub-boxes of at most 2^3 cells whose interval
  * may contain 0: their cells and corner nodes are marked; nothing else of
- * the block is evaluated (no cell outside them can cross the surface). */
+ * the block is evaluated (no cell outside them can cross the surface). A box
+ * that is split hands its own plan (pool[depth]) to its halves, so deeper
+ * passes look only at the arguments that survived above them. */
 static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const uint32_t s0[3],
-                 const uint32_t s1[3]) {
+                 const uint32_t s1[3], lb__plan *pool, int depth) {
     const lb__grid *g = R->g;
     uint64_t n0[3], n1[3];
     for (int d = 0; d < 3; ++d) {
         n0[d] = (uint64_t)B->b[d] * LB__MB + s0[d];
         n1[d] = (uint64_t)B->b[d] * LB__MB + s1[d];
     }
-    double lo, hi;
-    sub_phi(R->ev, g, plan, IV, n0, n1, &lo, &hi);
-    if (lo >= 0.0 || hi < 0.0) return;
     int axis = -1;
     uint32_t span = 2;
     for (int d = 0; d < 3; ++d)
@@ -268,13 +276,18 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
             span = s1[d] - s0[d];
             axis = d;
         }
+    lb__plan *own = axis >= 0 && depth < MARK_DEPTH ? &pool[depth] : NULL;
+    double lo, hi;
+    sub_phi(R->ev, g, plan, IV, n0, n1, own, &lo, &hi);
+    if (lo >= 0.0 || hi < 0.0) return;
     if (axis >= 0) {
         const uint32_t mid = s0[axis] + span / 2;
         uint32_t a1[3] = {s1[0], s1[1], s1[2]}, b0[3] = {s0[0], s0[1], s0[2]};
         a1[axis] = mid;
         b0[axis] = mid;
-        mark(R, B, plan, IV, s0, a1);
-        mark(R, B, plan, IV, b0, s1);
+        const lb__plan *next = own ? own : plan;
+        mark(R, B, next, IV, s0, a1, pool, depth + 1);
+        mark(R, B, next, IV, b0, s1, pool, depth + 1);
         return;
     }
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
@@ -308,7 +321,15 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     lb_status s = lb__boxeval_init(ev, bmin, bmax, &E, err);
     if (s) return s;
     const uint32_t zero[3] = {0, 0, 0};
-    mark(R, B, &E.plan, E.iv, zero, B->nc);
+    lb__plan pool[MARK_DEPTH];
+    int npool = 0;
+    for (; npool < MARK_DEPTH && !s; ++npool) s = lb__plan_copy(ev, &E.plan, &pool[npool], err);
+    if (!s) mark(R, B, &E.plan, E.iv, zero, B->nc, pool, 0);
+    for (int i = 0; i < npool; ++i) lb__plan_free(&pool[i]);
+    if (s) {
+        lb__boxeval_free(&E);
+        return s;
+    }
     size_t m = 0;
     for (size_t q = 0; q < n; ++q) m += B->nmask[q];
     double *mem = NULL;
@@ -321,20 +342,54 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
         goto done;
     }
     double *x = mem, *y = x + m, *z = y + m, *v = z + m, *gx = v + m, *gy = gx + m, *gz = gy + m;
-    size_t q = 0, w = 0;
-    for (uint32_t k = 0; k < D2; ++k)
-        for (uint32_t j = 0; j < D1; ++j)
-            for (uint32_t i = 0; i < D0; ++i, ++q) {
-                if (!B->nmask[q]) continue;
-                double X[3];
-                lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + i, (uint64_t)B->b[1] * LB__MB + j,
-                             (uint64_t)B->b[2] * LB__MB + k, X);
-                x[w] = X[0];
-                y[w] = X[1];
-                z[w] = X[2];
-                idx[w++] = q;
-            }
-    s = lb__boxeval_run(ev, &E, m, x, y, z, v, gx, gy, gz, err);
+    /* the nodes by octant (nodes up to the middle one in the low half), each
+     * octant evaluated under its own, tighter plan: a block's interval pass
+     * keeps every argument that may matter somewhere in the block, an
+     * octant's about half as many on a lattice of spheres */
+    const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
+    size_t start[9] = {0};
+    for (int pass = 0; pass < 2; ++pass) {
+        size_t q = 0, fill[8];
+        if (pass)
+            for (int o = 0; o < 8; ++o) fill[o] = start[o];
+        for (uint32_t k = 0; k < D2; ++k)
+            for (uint32_t j = 0; j < D1; ++j)
+                for (uint32_t i = 0; i < D0; ++i, ++q) {
+                    if (!B->nmask[q]) continue;
+                    const int o = (i > half[0]) | (j > half[1]) << 1 | (k > half[2]) << 2;
+                    if (!pass) {
+                        start[o + 1]++;
+                        continue;
+                    }
+                    double X[3];
+                    lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + i, (uint64_t)B->b[1] * LB__MB + j,
+                                 (uint64_t)B->b[2] * LB__MB + k, X);
+                    const size_t w = fill[o]++;
+                    x[w] = X[0];
+                    y[w] = X[1];
+                    z[w] = X[2];
+                    idx[w] = q;
+                }
+        if (!pass)
+            for (int o = 0; o < 8; ++o) start[o + 1] += start[o];
+    }
+    lb__plan outer;
+    s = lb__plan_copy(ev, &E.plan, &outer, err);
+    for (int o = 0; o < 8 && !s; ++o) {
+        const size_t c = start[o + 1] - start[o];
+        if (!c) continue;
+        uint32_t l0[3], l1[3];
+        for (int d = 0; d < 3; ++d) {
+            l0[d] = (o >> d) & 1 ? half[d] : 0;
+            l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
+        }
+        double omin[3], omax[3];
+        lb__node_box(g, B, l0, l1, omin, omax);
+        lb__boxeval_narrow(ev, &E, &outer, omin, omax);
+        const size_t a = start[o];
+        s = lb__boxeval_run(ev, &E, c, x + a, y + a, z + a, v + a, gx + a, gy + a, gz + a, err);
+    }
+    lb__plan_free(&outer);
     for (size_t i = 0; i < m && !s; ++i) {
         const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
         B->vals[idx[i]] = lb__mesh_phi(g, X, v[i], gf, B->grads + 3 * idx[i]);

@@ -12,7 +12,9 @@
  * or takes one last Newton step unevaluated when bounds on the curvature
  * (from the normals) and on the change of the slope along the edge (from
  * the end slopes) make its error below 1e-9 h (see the loop). The normal is the
- * gradient at the last evaluated point. */
+ * gradient at the last evaluated point. The edges are refined octant by
+ * octant of the block (by their midpoints), each under the culling plan of
+ * an interval pass over that octant. */
 #include "mesh_internal.h"
 
 #include <math.h>
@@ -66,17 +68,29 @@ static double hermite_root(double f0, double f1, double d0, double d1) {
     return t;
 }
 
-void lb__block_box(const lb__grid *g, const lb__block *B, double bmin[3], double bmax[3]) {
+void lb__node_box(const lb__grid *g, const lb__block *B, const uint32_t l0[3], const uint32_t l1[3],
+                  double bmin[3], double bmax[3]) {
     const uint64_t n0[3] = {(uint64_t)B->b[0] * LB__MB, (uint64_t)B->b[1] * LB__MB,
                             (uint64_t)B->b[2] * LB__MB};
-    lb__node_pos(g, n0[0], n0[1], n0[2], bmin);
-    lb__node_pos(g, n0[0] + B->nc[0], n0[1] + B->nc[1], n0[2] + B->nc[2], bmax);
+    lb__node_pos(g, n0[0] + l0[0], n0[1] + l0[1], n0[2] + l0[2], bmin);
+    lb__node_pos(g, n0[0] + l1[0], n0[1] + l1[1], n0[2] + l1[2], bmax);
     for (int d = 0; d < 3; ++d) {
         const double pad = 1e-9 * g->h[d];
         bmin[d] -= pad;
         bmax[d] += pad;
     }
 }
+
+void lb__block_box(const lb__grid *g, const lb__block *B, double bmin[3], double bmax[3]) {
+    const uint32_t zero[3] = {0, 0, 0};
+    lb__node_box(g, B, zero, B->nc, bmin, bmax);
+}
+
+static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxeval *E, size_t *act,
+                             size_t na, const double *a, const double *b, const double *ga,
+                             const double *gb, double tol, double *t, double *lo, double *hi,
+                             double *x, double *y, double *z, double *v, double *gx, double *gy,
+                             double *gz, double *pos, double *nrm, lb_error *err);
 
 lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, size_t n,
                            const double *a, const double *b, const double *pa, const double *pb,
@@ -92,9 +106,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
     double *t = mem, *lo = t + n, *hi = lo + n, *x = hi + n, *y = x + n, *z = y + n, *v = z + n,
            *gx = v + n, *gy = gx + n, *gz = gy + n;
     size_t *act = (size_t *)(mem + 10 * n);
-    size_t na = n;
     for (size_t i = 0; i < n; ++i) {
-        act[i] = i;
         lo[i] = 0.0;
         hi[i] = 1.0;
         const double e[3] = {b[3 * i] - a[3 * i], b[3 * i + 1] - a[3 * i + 1],
@@ -114,6 +126,57 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
         free(mem);
         return s;
     }
+    lb__plan outer;
+    s = lb__plan_copy(ev, &E.plan, &outer, err);
+    /* the edges by octant of the block (as the node values, mesher.c), each
+     * octant refined under its own plan: the edge's midpoint decides */
+    const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
+    double mid[3];
+    lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + half[0], (uint64_t)B->b[1] * LB__MB + half[1],
+                 (uint64_t)B->b[2] * LB__MB + half[2], mid);
+    size_t start[9] = {0};
+    for (int pass = 0; pass < 2 && !s; ++pass) {
+        size_t fill[8];
+        for (int o = 0; o < 8; ++o) fill[o] = start[o];
+        for (size_t i = 0; i < n; ++i) {
+            int o = 0;
+            for (int d = 0; d < 3; ++d) o |= (0.5 * (a[3 * i + d] + b[3 * i + d]) >= mid[d]) << d;
+            if (pass)
+                act[fill[o]++] = i;
+            else
+                start[o + 1]++;
+        }
+        if (!pass)
+            for (int o = 0; o < 8; ++o) start[o + 1] += start[o];
+    }
+    for (int o = 0; o < 8 && !s; ++o) {
+        const size_t na = start[o + 1] - start[o];
+        if (!na) continue;
+        uint32_t l0[3], l1[3];
+        for (int d = 0; d < 3; ++d) {
+            l0[d] = (o >> d) & 1 ? half[d] : 0;
+            l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
+        }
+        double omin[3], omax[3];
+        lb__node_box(g, B, l0, l1, omin, omax);
+        lb__boxeval_narrow(ev, &E, &outer, omin, omax);
+        s = refine_some(ev, g, &E, act + start[o], na, a, b, ga, gb, tol, t, lo, hi, x, y, z, v, gx,
+                        gy, gz, pos, nrm, err);
+    }
+    lb__plan_free(&outer);
+    lb__boxeval_free(&E);
+    free(mem);
+    return s;
+}
+
+/* The safeguarded iteration for edges act[0..na) (act is reordered as
+ * edges converge; the other arrays are indexed by edge). */
+static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxeval *E, size_t *act,
+                             size_t na, const double *a, const double *b, const double *ga,
+                             const double *gb, double tol, double *t, double *lo, double *hi,
+                             double *x, double *y, double *z, double *v, double *gx, double *gy,
+                             double *gz, double *pos, double *nrm, lb_error *err) {
+    lb_status s = LB_OK;
     for (int it = 0; it < MAX_ITER && na > 0 && !s; ++it) {
         for (size_t j = 0; j < na; ++j) {
             const size_t i = act[j];
@@ -122,7 +185,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
             y[j] = A[1] + t[i] * (Bp[1] - A[1]);
             z[j] = A[2] + t[i] * (Bp[2] - A[2]);
         }
-        s = lb__boxeval_run(ev, &E, na, x, y, z, v, gx, gy, gz, err);
+        s = lb__boxeval_run(ev, E, na, x, y, z, v, gx, gy, gz, err);
         if (s) break;
         size_t keep = 0;
         const int last = it == MAX_ITER - 1;
@@ -198,7 +261,5 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
         }
         na = keep;
     }
-    lb__boxeval_free(&E);
-    free(mem);
     return s;
 }
