@@ -255,6 +255,18 @@ static lb_status c_mesh(unsigned mask, int size, lb_error *err, int *hs) {
     lb_mesh_free(m);
     return s;
 }
+static lb_status c_mesh_edges(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    const size_t nc = 3 * C.mesh->ntriangles;
+    uint32_t *edges = malloc(2 * nc * sizeof *edges), *corner = malloc(nc * sizeof *corner);
+    assert_true(edges && corner);
+    size_t ne = 0;
+    lb_status s = lb_mesh_edges(P(0, C.mesh), P(1, edges), P(2, corner), P(3, &ne), P(4, err));
+    free(edges);
+    free(corner);
+    return s;
+}
 static lb_status c_mesh_write(unsigned mask, int size, lb_error *err, int *hs) {
     *hs = 1;
     char path[128];
@@ -332,6 +344,7 @@ static const fn_case CASES[] = {
     {"lb_evaluator_bounds", 6, 0x1f, c_bounds},
     {"lb_mesh_create", 4, 0x07, c_mesh},
     {"lb_mesh_write / _stream", 4, 0x07, c_mesh_write},
+    {"lb_mesh_edges", 5, 0x0f, c_mesh_edges},
     {"lb_scene_write_pov", 6, 0x0b, c_pov},
     {"lb_output_*", 5, 0x03, c_output},
 };

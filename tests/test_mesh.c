@@ -805,6 +805,95 @@ static void test_min_feature(void **state) {
     assert_int_equal(kept, 400);
 }
 
+/* lb_mesh_edges against a sort of the corners' vertex pairs done here: the
+ * same set of edges, each corner's edge joining that corner's two vertices,
+ * first-appearance numbering, and on a closed manifold mesh every edge used
+ * by exactly two corners (3/2 edges per triangle). Bad input is refused. */
+static int cmp_pair(const void *a, const void *b) {
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static void test_edges(void **state) {
+    (void)state;
+    size_t checked = 0;
+    for (size_t sidx = 0; sidx < nscenes; ++sidx) {
+        built B;
+        build_file(scene_paths[sidx], 40, 0, 2, &B);
+        const lb_mesh *m = B.m;
+        const size_t nt = m->ntriangles, nc = 3 * nt;
+        if (!nt) {
+            unbuild(&B);
+            continue;
+        }
+        uint32_t *edges = malloc(2 * nc * sizeof *edges), *ce = malloc(nc * sizeof *ce);
+        uint64_t *key = malloc(nc * sizeof *key);
+        unsigned *uses = calloc(nc, sizeof *uses);
+        assert_true(edges && ce && key && uses);
+        size_t ne = 0;
+        lb_error e = {LB_OK, ""};
+        assert_int_equal(lb_mesh_edges(m, edges, ce, &ne, &e), LB_OK);
+        assert_int_equal(2 * ne, nc); /* closed and manifold: two corners per edge */
+        size_t next = 0; /* first appearance: corner order introduces edges 0, 1, 2, ... */
+        for (size_t q = 0; q < nc; ++q) {
+            const uint32_t a = m->triangles[q], b = m->triangles[q - q % 3 + (q % 3 + 1) % 3];
+            const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
+            assert_true(ce[q] < ne);
+            assert_true(ce[q] <= next);
+            if (ce[q] == next) ++next;
+            assert_int_equal(edges[2 * ce[q]], lo);
+            assert_int_equal(edges[2 * ce[q] + 1], hi);
+            uses[ce[q]]++;
+            key[q] = (uint64_t)lo << 32 | hi;
+        }
+        for (size_t i = 0; i < ne; ++i) assert_int_equal(uses[i], 2);
+        ++checked;
+        qsort(key, nc, sizeof *key, cmp_pair);
+        size_t distinct = 0;
+        for (size_t q = 0; q < nc; ++q) distinct += q == 0 || key[q] != key[q - 1];
+        assert_int_equal(distinct, ne);
+        free(edges);
+        free(ce);
+        free(key);
+        free(uses);
+        unbuild(&B);
+    }
+    assert_true(checked >= 17);
+    /* an open mesh has boundary edges with one corner each */
+    built O;
+    build_file(scene_paths[0], 40, LB_MESH_OPEN_BOUNDARY, 1, &O);
+    {
+        const size_t nc = 3 * O.m->ntriangles;
+        uint32_t *edges = malloc(2 * nc * sizeof *edges), *ce = malloc(nc * sizeof *ce);
+        size_t ne = 0;
+        assert_int_equal(lb_mesh_edges(O.m, edges, ce, &ne, NULL), LB_OK);
+        assert_true(ne >= nc / 2 && ne <= nc);
+        free(edges);
+        free(ce);
+    }
+    unbuild(&O);
+    /* a hand-made mesh: a vertex index out of range is named */
+    uint32_t tri[6] = {0, 1, 2, 2, 1, 7};
+    lb_mesh bad;
+    memset(&bad, 0, sizeof bad);
+    bad.nvertices = 4;
+    bad.ntriangles = 2;
+    bad.triangles = tri;
+    uint32_t edges[12], ce[6];
+    size_t ne = 99;
+    lb_error e = {LB_OK, ""};
+    assert_int_equal(lb_mesh_edges(&bad, edges, ce, &ne, &e), LB_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(e.message, "triangle 1 names vertex 7"));
+    assert_int_equal(ne, 0);
+    bad.nvertices = 8;
+    assert_int_equal(lb_mesh_edges(&bad, edges, ce, &ne, &e), LB_OK);
+    assert_int_equal(ne, 5); /* 01 12 02 17 27 */
+    const uint32_t want[10] = {0, 1, 1, 2, 0, 2, 1, 7, 2, 7};
+    for (int i = 0; i < 10; ++i) assert_int_equal(edges[i], want[i]);
+    const uint32_t wce[6] = {0, 1, 2, 1, 3, 4};
+    for (int i = 0; i < 6; ++i) assert_int_equal(ce[i], wce[i]);
+}
+
 static void test_bad_options(void **state) {
     (void)state;
     static const char text[] =
@@ -902,6 +991,7 @@ int main(void) {
         cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_memory_cap_and_empty),
         cmocka_unit_test(test_min_feature),
+        cmocka_unit_test(test_edges),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -95,6 +95,20 @@ LB_API lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *o
 
 LB_API void lb_mesh_free(lb_mesh *mesh);
 
+/* The mesh's undirected edges and the edge of every triangle corner, for
+ * hosts that store edges (Blender's meshes do). Corner c of triangle t
+ * (index 3t + c) runs from triangles[3t + c] to triangles[3t + (c + 1) % 3];
+ * corner_edge[3t + c] is the index of that edge. Edges are numbered in order
+ * of first appearance over the corners and written as (smaller vertex,
+ * larger vertex) pairs, so the result depends only on the triangles.
+ * Buffers are the caller's: edges has room for 3 * ntriangles pairs
+ * (6 * ntriangles values; a closed mesh uses exactly half of that),
+ * corner_edge for 3 * ntriangles values. *nedges receives the edge count.
+ * Linear time; allocates O(nvertices + ntriangles) scratch. Fails with
+ * LB_ERR_INVALID_ARGUMENT on NULL buffers or a vertex index out of range. */
+LB_API lb_status lb_mesh_edges(const lb_mesh *mesh, uint32_t *edges, uint32_t *corner_edge,
+                               size_t *nedges, lb_error *err);
+
 typedef enum lb_mesh_format {
     LB_MESH_FORMAT_AUTO = 0, /* from the file name's extension */
     LB_MESH_FORMAT_PLY = 1,  /* binary little-endian PLY, float positions and normals */
