@@ -88,6 +88,7 @@ class _Stats(ctypes.Structure):
 _P = ctypes.c_void_p
 _D = ctypes.POINTER(ctypes.c_double)
 _ERR = ctypes.POINTER(_Error)
+_U32 = ctypes.POINTER(ctypes.c_uint32)
 
 # name: (restype, argtypes)
 _SIGNATURES = {
@@ -111,6 +112,8 @@ _SIGNATURES = {
     "lb_mesh_create": (ctypes.c_int, [_P, ctypes.POINTER(_MeshOptions),
                                       ctypes.POINTER(ctypes.POINTER(_Mesh)), _ERR]),
     "lb_mesh_free": (None, [ctypes.POINTER(_Mesh)]),
+    "lb_mesh_edges": (ctypes.c_int, [ctypes.POINTER(_Mesh), _U32, _U32,
+                                     ctypes.POINTER(ctypes.c_size_t), _ERR]),
     "lb_mesh_write": (ctypes.c_int, [ctypes.POINTER(_Mesh), ctypes.c_char_p, ctypes.c_int, _ERR]),
     "lb_scene_write_pov": (ctypes.c_int, [_P, _P, ctypes.POINTER(_PovOptions), ctypes.c_char_p,
                                           _D, _ERR]),
@@ -338,9 +341,10 @@ class Evaluator(_Handle):
         return lo.value, hi.value
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
-             max_memory=0, cancel=None):
+             max_memory=0, cancel=None, edges=False):
         """Mesh the field over the box [bmin, bmax] (docs/meshing.md). Returns a
-        Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called."""
+        Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called.
+        edges=True also fills Mesh.edges and Mesh.corner_edges (lb_mesh_edges)."""
         _need_numpy()
         o = _MeshOptions()
         self.lib._c.lb_mesh_options_init(ctypes.byref(o))
@@ -367,7 +371,16 @@ class Evaluator(_Handle):
                 pos, nrm = np.zeros((0, 3)), np.zeros((0, 3))
             tri = np.ctypeslib.as_array(m.triangles, shape=(nt, 3)).copy() if nt else \
                 np.zeros((0, 3), dtype=np.uint32)
-            return Mesh(pos, nrm, tri, tuple(m.origin), tuple(m.cell), tuple(m.cells))
+            mesh = Mesh(pos, nrm, tri, tuple(m.origin), tuple(m.cell), tuple(m.cells))
+            if edges:
+                ed = np.empty((3 * nt, 2), dtype=np.uint32)
+                ce = np.empty(3 * nt, dtype=np.uint32)
+                ne = ctypes.c_size_t()
+                st = self.lib._c.lb_mesh_edges(out, ed.ctypes.data_as(_U32), ce.ctypes.data_as(_U32),
+                                               ctypes.byref(ne), ctypes.byref(err))
+                self.lib._check(st, err, "mesh edges")
+                mesh.edges, mesh.corner_edges = ed[:ne.value].copy(), ce
+            return mesh
         finally:
             self.lib._c.lb_mesh_free(out)
 
@@ -380,6 +393,9 @@ class Mesh:
     def __init__(self, positions, normals, triangles, origin, cell, cells):
         self.positions, self.normals, self.triangles = positions, normals, triangles
         self.origin, self.cell, self.cells = origin, cell, cells
+        # with mesh(edges=True): the unique edges (e, 2) uint32, smaller vertex
+        # first, and each triangle corner's edge (3 t,) uint32 (lb_mesh_edges)
+        self.edges = self.corner_edges = None
 
     def volume(self):
         """Enclosed volume (divergence theorem); exact for a closed mesh."""

@@ -4,6 +4,8 @@ add-on (and its tests) call these functions instead of testing versions.
 
   version            what changed                        handled by
   4.0                Mesh polygons' loop_total read-only  set_triangles
+  4.0                corner edges stored as an attribute  set_edges
+                     (no block copy from foreach_set)
   4.0                Principled BSDF renamed inputs       principled_inputs
                      (Specular -> Specular IOR Level)
   4.1                auto smooth removed (custom normals  set_custom_normals,
@@ -37,9 +39,24 @@ def view_layer_objects(view_layer):
 def set_triangles(me, nt):
     """Mark me's polygons as nt triangles whose loops are consecutive."""
     import numpy as np
-    me.polygons.foreach_set("loop_start", np.arange(0, 3 * nt, 3, dtype=np.int32))
+    # uint32, the properties' own type: foreach_set then copies one block
+    me.polygons.foreach_set("loop_start", np.arange(0, 3 * nt, 3, dtype=np.uint32))
     if VERSION < (4, 0, 0):  # later versions derive loop_total from loop_start
-        me.polygons.foreach_set("loop_total", np.full(nt, 3, dtype=np.int32))
+        me.polygons.foreach_set("loop_total", np.full(nt, 3, dtype=np.uint32))
+
+
+def set_edges(me, edges, corner_edges):
+    """The edges of a mesh just given its triangles: libblend's (lb_mesh_edges,
+    (e, 2) and (3 t,) uint32) where Blender stores them as one block, else
+    Blender derives them. Measured on 85,568 triangles: 3.4 derives them in
+    9-11 ms and takes libblend's in 1.2 ms; 4.3 derives them in 7 ms but
+    takes the corners' edges element by element (8 ms), so it derives."""
+    if edges is None or corner_edges is None or VERSION >= (4, 0, 0):
+        me.update(calc_edges=True)
+        return
+    me.edges.add(len(edges))
+    me.edges.foreach_set("vertices", edges.ravel())
+    me.loops.foreach_set("edge_index", corner_edges)
 
 
 def set_custom_normals(me, normals):

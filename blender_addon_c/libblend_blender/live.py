@@ -72,7 +72,7 @@ class _Job:
             with self.lib.parse_scene(self.text, self.name) as scene, scene.compile() as ev:
                 self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
                                     open_boundary=self.open_boundary, threads=self.threads,
-                                    cancel=self.cancel)
+                                    cancel=self.cancel, edges=True)
         except binding.Cancelled:
             self.error = None
         except binding.LibblendError as e:
@@ -147,10 +147,13 @@ def set_mesh_data(me, mesh, normals="AUTO"):
         me.vertices.add(nv)
         me.vertices.foreach_set("co", mesh.positions.astype(np.float32).ravel())
         me.loops.add(3 * nt)
-        me.loops.foreach_set("vertex_index", mesh.triangles.astype(np.int32).ravel())
+        # uint32: the properties' own type, which foreach_set copies as one
+        # block (int32 goes element by element: 9 ms against 0.5 ms for 85k
+        # triangles on 3.4, bench/run_blender_anim_bench.sh)
+        me.loops.foreach_set("vertex_index", mesh.triangles.astype(np.uint32).ravel())
         me.polygons.add(nt)
         compat.set_triangles(me, nt)
-        me.update(calc_edges=True)
+        compat.set_edges(me, getattr(mesh, "edges", None), getattr(mesh, "corner_edges", None))
         me.polygons.foreach_set("use_smooth", np.ones(nt, dtype=bool))
         if wants_analytic(normals, nt):
             set_normals(me, mesh.normals)
