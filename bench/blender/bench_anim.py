@@ -19,7 +19,9 @@ All in one run, on this machine:
     (5 / 128) with each ball's radius keyframed so that every frame changes:
     seconds per frame of the depsgraph update a frame change makes;
  4. baking the 24 frames (render resolution, files written);
- 5. the metaballs' own 24-frame Cycles render, animated and not.
+ 5. the metaballs' own 24-frame Cycles render, animated and not, and of
+    their surface converted to a plain mesh (no polygonizing): the frame
+    their own update adds to.
 Prints one "BENCH {json}" line per measurement and a summary.
 """
 import json
@@ -148,14 +150,23 @@ bake_s = report(what="bake 24 frames", seconds=secs, per_frame=secs / FRAMES,
                               os.walk(os.path.join(WORK, "libblend_cache")) for f in fs) / 1e6)
 out.libblend.use_bake = False
 
-# the baseline: the same render of a static mesh (Apply at render resolution)
-bpy.context.view_layer.objects.active = out
-out.select_set(True)
-bpy.ops.libblend.apply(resolution=RES)
-static = bpy.context.view_layer.objects.active
-sc.frame_set(1)
-base = report(what="render 24 frames, static mesh (no remeshing)", seconds_per_frame=render_animation(sc),
-              triangles=len(static.data.polygons))
+# the baselines: the same render of a static mesh (Apply at render resolution),
+# with Blender's smooth normals, then with the analytic ones (the default)
+bases = {}
+for normals in ("FACES", "AUTO"):
+    out.libblend.normals = normals
+    bpy.context.view_layer.objects.active = out
+    out.select_set(True)
+    bpy.ops.libblend.apply(resolution=RES, keep_field=True)
+    static = bpy.context.view_layer.objects.active
+    out.hide_render = True  # the field itself is not rendered (nor remeshed)
+    sc.frame_set(1)
+    bases[normals] = report(what="render 24 frames, static mesh (no remeshing)", normals=normals,
+                            seconds_per_frame=render_animation(sc),
+                            triangles=len(static.data.polygons))
+    bpy.data.objects.remove(static)
+    out.hide_render = False
+base, base_b = bases["AUTO"], bases["FACES"]
 
 # Blender's metaballs: the same balls, each radius keyed so that every frame changes
 clear()
@@ -196,8 +207,16 @@ meta_anim = render_animation(sc)
 mb.animation_data_clear()
 sc.frame_set(1)
 meta_static = render_animation(sc)
+# the metaballs' surface as a plain mesh: their Cycles frame without any
+# polygonizing, the baseline their own update adds to
+dg = bpy.context.evaluated_depsgraph_get()
+mesh_copy = bpy.data.objects.new("balls mesh", bpy.data.meshes.new_from_object(mobj.evaluated_get(dg)))
+sc.collection.objects.link(mesh_copy)
+mobj.hide_render = True
+sc.frame_set(1)
+meta_mesh = render_animation(sc)
 metar = report(what="metaballs, render 24 frames", animated_seconds_per_frame=meta_anim,
-               static_seconds_per_frame=meta_static)
+               static_seconds_per_frame=meta_static, as_plain_mesh_seconds_per_frame=meta_mesh)
 
 r1, r0, rb = results[1, "AUTO"], results[0, "AUTO"], results[0, "FACES"]
 summary = {
@@ -206,13 +225,17 @@ summary = {
                                  "all, Blender normals": rb["seconds_per_frame"]},
     "remesh_per_frame_s": {"1 thread": r1["remesh_per_frame"], "all": r0["remesh_per_frame"],
                            "all, Blender normals": rb["remesh_per_frame"]},
-    "remesh_share_of_static_frame": {k: r["remesh_per_frame"] / base["seconds_per_frame"]
-                                     for k, r in (("1 thread", r1), ("all", r0),
-                                                  ("all, Blender normals", rb))},
+    "cycles_frame_static_blender_normals_s": base_b["seconds_per_frame"],
+    "remesh_share_of_static_frame": {"1 thread": r1["remesh_per_frame"] / base["seconds_per_frame"],
+                                     "all": r0["remesh_per_frame"] / base["seconds_per_frame"],
+                                     "all, Blender normals (its own static frame)":
+                                     rb["remesh_per_frame"] / base_b["seconds_per_frame"]},
     "metaballs_per_frame_s": meta["seconds_per_frame"],
     "metaballs_share_of_static_frame": meta["seconds_per_frame"] / base["seconds_per_frame"],
     "metaballs_cycles_frame_s": {"animated": metar["animated_seconds_per_frame"],
-                                 "static": metar["static_seconds_per_frame"]},
+                                 "static": metar["static_seconds_per_frame"],
+                                 "as a plain mesh": meta_mesh},
+    "metaballs_share_of_their_plain_mesh_frame": meta["seconds_per_frame"] / meta_mesh,
     "remesh_vs_metaballs": {k: r["remesh_per_frame"] / meta["seconds_per_frame"]
                             for k, r in (("1 thread", r1), ("all", r0),
                                          ("all, Blender normals", rb))},
