@@ -741,6 +741,12 @@ void lb__boxeval_narrow(const lb_evaluator *ev, lb__boxeval *E, const lb__plan *
     lb__bounds_pass_sub(ev, outer, bc, br, E->iv, &E->plan);
 }
 
+size_t lb__plan_prims(const lb_evaluator *ev, const lb__plan *P) {
+    size_t c = 0;
+    for (size_t i = 0; i < ev->n; ++i) c += P->need[i] && ev->ins[i].code != LB__I_OP;
+    return c;
+}
+
 lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P, lb_error *err) {
     const size_t nk = ev->total_k ? ev->total_k : 1;
     P->need = malloc(ev->n);

@@ -194,6 +194,8 @@ LB_INTERNAL void lb__boxeval_narrow(const lb_evaluator *ev, lb__boxeval *E, cons
 LB_INTERNAL lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P,
                                     lb_error *err);
 LB_INTERNAL void lb__plan_free(lb__plan *P);
+/* How many primitives the plan runs per point. */
+LB_INTERNAL size_t lb__plan_prims(const lb_evaluator *ev, const lb__plan *P);
 
 /* Values and gradients of n points that all lie in [bmin, bmax], with the
  * culling of one interval pass over that box (single-threaded; the

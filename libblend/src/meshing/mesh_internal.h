@@ -74,6 +74,12 @@ static inline void lb__node_pos(const lb__grid *g, uint64_t x, uint64_t y, uint6
     X[2] = g->origin[2] + (double)z * g->h[2];
 }
 
+/* A block whose plan runs fewer primitives per point is evaluated under
+ * that one plan, not octant by octant (mesher.c, refine.c): measured in
+ * instructions, the octant passes and grouping cost more than they save on
+ * three spheres and pay off from four (bench scenes S1, S2, 2026-12-01). */
+#define LB__NARROW_MIN_PRIMS 4
+
 /* The box of the block's local nodes [l0, l1] (padded by 1e-9 of a cell). */
 LB_INTERNAL void lb__node_box(const lb__grid *g, const lb__block *B, const uint32_t l0[3],
                               const uint32_t l1[3], double bmin[3], double bmax[3]);

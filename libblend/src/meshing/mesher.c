@@ -260,7 +260,8 @@ static void sub_phi(const lb_evaluator *ev, const lb__grid *g, const lb__plan *p
  * may contain 0: their cells and corner nodes are marked; nothing else of
  * the block is evaluated (no cell outside them can cross the surface). A box
  * that is split hands its own plan (pool[depth]) to its halves, so deeper
- * passes look only at the arguments that survived above them. */
+ * passes look only at the arguments that survived above them (pool NULL:
+ * every box under the block's plan). */
 static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const uint32_t s0[3],
                  const uint32_t s1[3], lb__plan *pool, int depth) {
     const lb__grid *g = R->g;
@@ -276,7 +277,7 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
             span = s1[d] - s0[d];
             axis = d;
         }
-    lb__plan *own = axis >= 0 && depth < MARK_DEPTH ? &pool[depth] : NULL;
+    lb__plan *own = pool && axis >= 0 && depth < MARK_DEPTH ? &pool[depth] : NULL;
     double lo, hi;
     sub_phi(R->ev, g, plan, IV, n0, n1, own, &lo, &hi);
     if (lo >= 0.0 || hi < 0.0) return;
@@ -321,10 +322,13 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     lb_status s = lb__boxeval_init(ev, bmin, bmax, &E, err);
     if (s) return s;
     const uint32_t zero[3] = {0, 0, 0};
+    /* few primitives: no narrower plans (LB__NARROW_MIN_PRIMS), here or below */
+    const int narrow = lb__plan_prims(ev, &E.plan) >= LB__NARROW_MIN_PRIMS;
     lb__plan pool[MARK_DEPTH];
     int npool = 0;
-    for (; npool < MARK_DEPTH && !s; ++npool) s = lb__plan_copy(ev, &E.plan, &pool[npool], err);
-    if (!s) mark(R, B, &E.plan, E.iv, zero, B->nc, pool, 0);
+    for (; narrow && npool < MARK_DEPTH && !s; ++npool)
+        s = lb__plan_copy(ev, &E.plan, &pool[npool], err);
+    if (!s) mark(R, B, &E.plan, E.iv, zero, B->nc, narrow ? pool : NULL, 0);
     for (int i = 0; i < npool; ++i) lb__plan_free(&pool[i]);
     if (s) {
         lb__boxeval_free(&E);
@@ -345,47 +349,49 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     /* the nodes by octant (nodes up to the middle one in the low half), each
      * octant evaluated under its own, tighter plan: a block's interval pass
      * keeps every argument that may matter somewhere in the block, an
-     * octant's about half as many on a lattice of spheres */
+     * octant's about half as many on a lattice of spheres. A plan that runs
+     * few primitives gains too little to pay for eight more passes: then
+     * the block is one group under its own plan. */
+    const int ngroups = narrow ? 8 : 1;
     const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
-    size_t start[9] = {0};
-    for (int pass = 0; pass < 2; ++pass) {
-        size_t q = 0, fill[8];
-        if (pass)
-            for (int o = 0; o < 8; ++o) fill[o] = start[o];
-        for (uint32_t k = 0; k < D2; ++k)
-            for (uint32_t j = 0; j < D1; ++j)
-                for (uint32_t i = 0; i < D0; ++i, ++q) {
+    size_t start[9] = {0}, w = 0;
+    for (int o = 0; o < ngroups; ++o) {
+        uint32_t r0[3], r1[3]; /* the group's node range, inclusive */
+        for (int d = 0; d < 3; ++d) {
+            r0[d] = narrow && (o >> d) & 1 ? half[d] + 1 : 0;
+            r1[d] = narrow && !((o >> d) & 1) ? half[d] : B->nc[d];
+        }
+        start[o] = w;
+        for (uint32_t k = r0[2]; k <= r1[2]; ++k)
+            for (uint32_t j = r0[1]; j <= r1[1]; ++j)
+                for (uint32_t i = r0[0]; i <= r1[0]; ++i) {
+                    const size_t q = ((size_t)k * D1 + j) * D0 + i;
                     if (!B->nmask[q]) continue;
-                    const int o = (i > half[0]) | (j > half[1]) << 1 | (k > half[2]) << 2;
-                    if (!pass) {
-                        start[o + 1]++;
-                        continue;
-                    }
                     double X[3];
                     lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + i, (uint64_t)B->b[1] * LB__MB + j,
                                  (uint64_t)B->b[2] * LB__MB + k, X);
-                    const size_t w = fill[o]++;
                     x[w] = X[0];
                     y[w] = X[1];
                     z[w] = X[2];
-                    idx[w] = q;
+                    idx[w++] = q;
                 }
-        if (!pass)
-            for (int o = 0; o < 8; ++o) start[o + 1] += start[o];
     }
-    lb__plan outer;
-    s = lb__plan_copy(ev, &E.plan, &outer, err);
-    for (int o = 0; o < 8 && !s; ++o) {
+    start[ngroups] = w;
+    lb__plan outer = {NULL, NULL, NULL};
+    if (narrow) s = lb__plan_copy(ev, &E.plan, &outer, err);
+    for (int o = 0; o < ngroups && !s; ++o) {
         const size_t c = start[o + 1] - start[o];
         if (!c) continue;
-        uint32_t l0[3], l1[3];
-        for (int d = 0; d < 3; ++d) {
-            l0[d] = (o >> d) & 1 ? half[d] : 0;
-            l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
+        if (narrow) {
+            uint32_t l0[3], l1[3];
+            for (int d = 0; d < 3; ++d) {
+                l0[d] = (o >> d) & 1 ? half[d] : 0;
+                l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
+            }
+            double omin[3], omax[3];
+            lb__node_box(g, B, l0, l1, omin, omax);
+            lb__boxeval_narrow(ev, &E, &outer, omin, omax);
         }
-        double omin[3], omax[3];
-        lb__node_box(g, B, l0, l1, omin, omax);
-        lb__boxeval_narrow(ev, &E, &outer, omin, omax);
         const size_t a = start[o];
         s = lb__boxeval_run(ev, &E, c, x + a, y + a, z + a, v + a, gx + a, gy + a, gz + a, err);
     }

@@ -126,40 +126,51 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
         free(mem);
         return s;
     }
-    lb__plan outer;
-    s = lb__plan_copy(ev, &E.plan, &outer, err);
     /* the edges by octant of the block (as the node values, mesher.c), each
-     * octant refined under its own plan: the edge's midpoint decides */
-    const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
-    double mid[3];
-    lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + half[0], (uint64_t)B->b[1] * LB__MB + half[1],
-                 (uint64_t)B->b[2] * LB__MB + half[2], mid);
+     * octant refined under its own plan: the edge's midpoint decides. A plan
+     * with few primitives keeps all the edges in one group. */
+    const int narrow = lb__plan_prims(ev, &E.plan) >= LB__NARROW_MIN_PRIMS;
+    const int ngroups = narrow ? 8 : 1;
+    lb__plan outer = {NULL, NULL, NULL};
     size_t start[9] = {0};
-    for (int pass = 0; pass < 2 && !s; ++pass) {
-        size_t fill[8];
-        for (int o = 0; o < 8; ++o) fill[o] = start[o];
-        for (size_t i = 0; i < n; ++i) {
-            int o = 0;
-            for (int d = 0; d < 3; ++d) o |= (0.5 * (a[3 * i + d] + b[3 * i + d]) >= mid[d]) << d;
-            if (pass)
-                act[fill[o]++] = i;
-            else
-                start[o + 1]++;
+    const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
+    if (narrow) {
+        s = lb__plan_copy(ev, &E.plan, &outer, err);
+        double mid[3];
+        lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + half[0], (uint64_t)B->b[1] * LB__MB + half[1],
+                     (uint64_t)B->b[2] * LB__MB + half[2], mid);
+        for (int pass = 0; pass < 2 && !s; ++pass) {
+            size_t fill[8];
+            for (int o = 0; o < 8; ++o) fill[o] = start[o];
+            for (size_t i = 0; i < n; ++i) {
+                int o = 0;
+                for (int d = 0; d < 3; ++d)
+                    o |= (0.5 * (a[3 * i + d] + b[3 * i + d]) >= mid[d]) << d;
+                if (pass)
+                    act[fill[o]++] = i;
+                else
+                    start[o + 1]++;
+            }
+            if (!pass)
+                for (int o = 0; o < 8; ++o) start[o + 1] += start[o];
         }
-        if (!pass)
-            for (int o = 0; o < 8; ++o) start[o + 1] += start[o];
+    } else {
+        for (size_t i = 0; i < n; ++i) act[i] = i;
+        start[1] = n;
     }
-    for (int o = 0; o < 8 && !s; ++o) {
+    for (int o = 0; o < ngroups && !s; ++o) {
         const size_t na = start[o + 1] - start[o];
         if (!na) continue;
-        uint32_t l0[3], l1[3];
-        for (int d = 0; d < 3; ++d) {
-            l0[d] = (o >> d) & 1 ? half[d] : 0;
-            l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
+        if (narrow) {
+            uint32_t l0[3], l1[3];
+            for (int d = 0; d < 3; ++d) {
+                l0[d] = (o >> d) & 1 ? half[d] : 0;
+                l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
+            }
+            double omin[3], omax[3];
+            lb__node_box(g, B, l0, l1, omin, omax);
+            lb__boxeval_narrow(ev, &E, &outer, omin, omax);
         }
-        double omin[3], omax[3];
-        lb__node_box(g, B, l0, l1, omin, omax);
-        lb__boxeval_narrow(ev, &E, &outer, omin, omax);
         s = refine_some(ev, g, &E, act + start[o], na, a, b, ga, gb, tol, t, lo, hi, x, y, z, v, gx,
                         gy, gz, pos, nrm, err);
     }
