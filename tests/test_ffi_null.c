@@ -202,8 +202,8 @@ static lb_status c_scene_queries(unsigned mask, int size, lb_error *err, int *hs
                                                    : sizeof buf);
     if (mask & 1u) assert_int_equal(n, 0);
     if (!(mask & 1u)) assert_int_equal(n, lb_scene_describe(C.scene, NULL, 10));
-    double loc[3], look[3], ang;
-    lb_pov_camera(P(0, C.scene), 1.0, P(1, loc), P(2, look), P(3, &ang));
+    double loc[3], look[3], upv[3], ang;
+    lb_pov_camera(P(0, C.scene), 1.0, P(1, loc), P(2, look), P(4, upv), P(3, &ang));
     *hs = 1;
     double v, g[3];
     return lb_scene_eval_reference(P(0, C.scene), P(1, C3), P(2, &v), P(3, g), P(5, err));

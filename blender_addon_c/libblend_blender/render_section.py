@@ -15,15 +15,20 @@ material nobody changed since import is written exactly as it was read
 (Blender stores float32 and a camera's orientation, not its look_at point);
 a changed one is written from the object. Deleted objects drop out.
 
-Conventions: the camera's up direction is +y (POV-Ray's `up y`, what
-`blendtool pov` writes), so Blender frames the field as POV-Ray does; POV-Ray
-is left-handed, so its image is the mirror image of Blender's.
+Conventions: scenes are right-handed with z up, as Blender is. The camera
+looks at `look_at` with its up direction along the section's `up` (default
++z); `blendtool pov` writes the same camera for POV-Ray with `sky` up and a
+negated `right`, so both render the same right-handed view
+(tests/blender/test_addon.py compares their silhouettes). Without lights in
+the section both exporters light the field the same three-point way (key
+with soft shadows, fill, rim, placed around the camera), over a floor under
+the surface (`floor`, default on) and a neutral background (`background`).
 """
 import json
 import math
 
 import bpy
-from mathutils import Vector
+from mathutils import Matrix, Vector
 
 from . import compat, tree
 
@@ -47,6 +52,36 @@ def _aim(obj, target, up="Y"):
     obj.rotation_quaternion = d.to_track_quat("-Z", up)
 
 
+def _aim_up(obj, target, up):
+    """Point obj's -z at target with its +y as close to up as possible (a
+    camera: +x is then the image's right, forward x up)."""
+    d = Vector(target) - obj.location
+    if d.length == 0:
+        return
+    d.normalize()
+    x = d.cross(Vector(up))
+    if x.length < 1e-9:  # up along the line of sight (the scene parser refuses this)
+        x = d.orthogonal()
+    x.normalize()
+    y = x.cross(d)
+    obj.rotation_mode = "QUATERNION"
+    obj.rotation_quaternion = Matrix((x, y, -d)).transposed().to_quaternion()
+
+
+def camera_basis(location, look_at, up):
+    """(forward, right, up) unit vectors of a camera, right-handed."""
+    f = (Vector(look_at) - Vector(location)).normalized()
+    r = f.cross(Vector(up)).normalized()
+    return f, r, r.cross(f)
+
+
+# the default three-point lights, in units of the camera's distance to its
+# target along (right, up, forward), with their strengths (the same numbers
+# as libblend's POV-Ray writer, pov.c)
+THREE_POINT = (((-0.7, 0.9, -0.5), 0.85, True), ((1.0, 0.2, -0.6), 0.35, False),
+               ((0.4, 1.0, 1.1), 0.5, False))
+
+
 def _same_vec(a, b, tol=1e-6):
     return len(a) == len(b) and all(abs(x - y) <= tol * max(1.0, abs(y)) for x, y in zip(a, b))
 
@@ -64,7 +99,7 @@ def create(output, section, collection, scene):
         obj = bpy.data.objects.new(output.name + " camera", data)
         collection.objects.link(obj)
         obj.location = cam["location"]
-        _aim(obj, cam.get("look_at", [0, 0, 0]))
+        _aim_up(obj, cam.get("look_at", [0, 0, 0]), cam.get("up", [0, 0, 1]))
         data.clip_end = max(data.clip_end, 4 * (Vector(cam["location"]) - _centre(output)).length)
         s.render_camera = obj
         scene.camera = obj
@@ -80,6 +115,16 @@ def create(output, section, collection, scene):
         obj.location = li["location"]
         _aim(obj, _centre(output), "Z")
         s.render_lights.add().obj = obj
+    if cam and not section.get("lights"):
+        _three_point(output, cam, collection)
+    if section.get("floor", True) is not False:
+        _floor(output, section, collection)
+    bg = section.get("background", [0.9, 0.9, 0.9])
+    world = scene.world or bpy.data.worlds.new("World")
+    scene.world = world
+    world.color = bg
+    if world.use_nodes and world.node_tree and world.node_tree.nodes.get("Background"):
+        world.node_tree.nodes["Background"].inputs["Color"].default_value = list(bg) + [1.0]
     mat = section.get("material")
     if mat:
         m = bpy.data.materials.new(output.name + " material")
@@ -93,6 +138,72 @@ def create(output, section, collection, scene):
         m.diffuse_color = list(c) + [1.0]  # the viewport's solid colour
         output.data.materials.clear()
         output.data.materials.append(m)
+
+
+def _three_point(output, cam, collection):
+    """The default lights around the camera (THREE_POINT), as suns aimed at
+    the camera's target; the key's 5 degree disc gives soft shadows. They
+    are not the section's lights: export leaves "lights" out, as read."""
+    at = cam.get("look_at", [0, 0, 0])
+    f, r, u = camera_basis(cam["location"], at, cam.get("up", [0, 0, 1]))
+    dist = (Vector(at) - Vector(cam["location"])).length
+    for i, ((a, b, c), strength, shadows) in enumerate(THREE_POINT):
+        data = bpy.data.lights.new("%s %s light" % (output.name, ("key", "fill", "rim")[i]), "SUN")
+        data.energy = SUN_STRENGTH * strength
+        data.angle = math.radians(5.0) if shadows else 0.0
+        data.use_shadow = shadows
+        obj = bpy.data.objects.new(data.name, data)
+        collection.objects.link(obj)
+        obj.location = Vector(at) + dist * (a * r + b * u + c * f)
+        _aim(obj, at, "Z")
+
+
+def floor_height(output, up):
+    """The floor's height along up: the lowest vertex of a 48-cell mesh of
+    the field less half a cell (as libblend's POV-Ray writer), or the
+    region's lowest corner when there is no surface."""
+    from . import live
+    s = output.libblend
+    corners = [Vector((x, y, z)) for x in (s.bounds_min[0], s.bounds_max[0])
+               for y in (s.bounds_min[1], s.bounds_max[1]) for z in (s.bounds_min[2], s.bounds_max[2])]
+    h = min((output.matrix_world @ c).dot(Vector(up)) for c in corners)
+    try:
+        job = live.prepare(output, 48)
+        job.run()
+    except Exception:  # no library or a tree error: the region's corner, as documented
+        return h
+    if job.error or job.mesh is None or not len(job.mesh.positions):
+        return h
+    import numpy as np
+    P = np.asarray(job.mesh.positions) @ np.asarray(output.matrix_world.to_3x3()).T + \
+        np.asarray(output.matrix_world.translation)
+    cell = max(job.mesh.cell)
+    return max(h, float((P @ np.asarray(up)).min()) - 0.5 * cell)
+
+
+def _floor(output, section, collection):
+    """A large plane under the field (floor_height) with the section's
+    floor colour."""
+    up = Vector(section.get("camera", {}).get("up", [0, 0, 1])).normalized()
+    h = floor_height(output, up)
+    s = output.libblend
+    size = 20.0 * max((Vector(s.bounds_max) - Vector(s.bounds_min)).length, 1e-3)
+    me = bpy.data.meshes.new(output.name + " floor")
+    me.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
+    obj = bpy.data.objects.new(output.name + " floor", me)
+    collection.objects.link(obj)
+    obj.scale = (size, size, 1)
+    obj.rotation_mode = "QUATERNION"
+    obj.rotation_quaternion = Vector((0, 0, 1)).rotation_difference(up)
+    obj.location = up * h
+    fl = section.get("floor")
+    col = fl.get("color", [0.75] * 3) if isinstance(fl, dict) else [0.75] * 3
+    m = bpy.data.materials.new(output.name + " floor")
+    m.use_nodes = True
+    m.node_tree.nodes["Principled BSDF"].inputs[compat.principled_inputs()["color"]] \
+        .default_value = list(col) + [1.0]
+    m.diffuse_color = list(col) + [1.0]
+    me.materials.append(m)
 
 
 def _alive(obj):
@@ -117,11 +228,17 @@ def to_section(output):
     old = stored.get("camera")
     if cam is not None:
         loc = tree.vec(cam.matrix_world.translation)
-        fwd = (cam.matrix_world.to_quaternion() @ Vector((0, 0, -1))).normalized()
+        q = cam.matrix_world.to_quaternion()
+        fwd = (q @ Vector((0, 0, -1))).normalized()
+        cup = (q @ Vector((0, 1, 0))).normalized()
         angle = math.degrees(cam.data.angle_x)
         if old and _same_vec(loc, old["location"]) and abs(angle - old.get("angle", 40)) < 1e-4:
             target = Vector(old.get("look_at", [0, 0, 0])) - Vector(old["location"])
-            if target.length == 0 or fwd.dot(target.normalized()) > 1 - 1e-9:
+            # the same up: the stored one, made perpendicular to the line of sight
+            want = (camera_basis(old["location"], old.get("look_at", [0, 0, 0]),
+                                 old.get("up", [0, 0, 1]))[2] if target.length else cup)
+            if target.length == 0 or (fwd.dot(target.normalized()) > 1 - 1e-9 and
+                                      cup.dot(want) > 1 - 1e-6):  # mathutils is float32
                 cam = None
                 out["camera"] = old
         if cam is not None:
@@ -129,7 +246,7 @@ def to_section(output):
                 if old else (_centre(output) - cam.matrix_world.translation).length
             out["camera"] = {"location": loc,
                              "look_at": tree.vec(cam.matrix_world.translation + fwd * max(dist, 1e-3)),
-                             "angle": tree.f32(angle)}
+                             "up": tree.vec(cup), "angle": tree.f32(angle)}
     elif old and not made:
         out["camera"] = old
     # lights

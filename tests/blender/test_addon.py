@@ -578,7 +578,10 @@ to_at = mathutils.Vector(sec["camera"]["look_at"]) - mathutils.Vector(sec["camer
 check(fwd.dot(to_at.normalized()) > 1 - 1e-6, "the camera looks at look_at")
 check(abs(math.degrees(cam.data.angle_x) - sec["camera"]["angle"]) < 1e-4, "horizontal angle")
 up = cam.matrix_world.to_quaternion() @ mathutils.Vector((0, 1, 0))
-check(up.y > 0 and abs(up.dot(fwd)) < 1e-6, "up is +y, as POV-Ray's camera")
+check(up.z > 0 and abs(up.dot(fwd)) < 1e-6, "up is +z (the scene's up, also POV-Ray's sky)")
+right = cam.matrix_world.to_quaternion() @ mathutils.Vector((1, 0, 0))
+check(right.dot(fwd.cross(mathutils.Vector((0, 0, 1))).normalized()) > 1 - 1e-6,
+      "right is forward x up: a right-handed view")
 lights = [r.obj for r in dimp.libblend.render_lights]
 check(len(lights) == 2 and all(o.type == "LIGHT" for o in lights), "two lights")
 check(np.allclose(lights[1].location, sec["lights"][1]["location"]) and
@@ -731,6 +734,83 @@ for a, b in ((0, 1), (1, 2), (0, 2)):
     check(diff.sum() > 20, "rendered frames %d and %d differ: %d pixels" % (a + 1, b + 1, diff.sum()))
 check(len(anim.data.vertices) == meshcheck.check(*blender_mesh(anim))["vertices"],
       "after the render the field is back at its preview mesh")
+
+# ---------------------------------------------------------------- one view in both renderers
+# An asymmetric blend (a small sphere on +x, one on +z, one on -y) seen from
+# two named sides: POV-Ray's silhouette (blendtool render --silhouette) and
+# Blender's (Workbench, the alpha of a transparent film) must cover the same
+# pixels; the mirror image must not (a handedness slip fails here).
+def sil_scene(camera):
+    spheres = [([0, 0, 0], 0.6), ([1.0, 0, 0], 0.35), ([0, 0, 0.9], 0.3), ([0, -0.8, -0.2], 0.25)]
+    return {"format": "libblend-scene", "version": 1, "convention": "zero",
+            "bounds": {"min": [-1.2, -1.3, -1.0], "max": [1.6, 1.0, 1.5]},
+            "root": {"type": "displacement", "op": "union", "r": 0.2, "p": 2,
+                     "args": [{"type": "sphere", "center": c, "radius": r} for c, r in spheres]},
+            "render": {"camera": camera, "floor": False}}
+
+
+SW, SH = 160, 120
+views = {"front (from -y, up +z)": {"location": [0.3, -6, 0.4], "look_at": [0.2, 0, 0.2], "angle": 40},
+         "top (from +z, up +y)": {"location": [0.2, -0.1, 6], "look_at": [0.2, -0.1, 0],
+                                  "up": [0, 1, 0], "angle": 40}}
+for vi, (side, camera) in enumerate(views.items()):
+    js = os.path.join(WORK, "view-%d.json" % vi)
+    json.dump(sil_scene(camera), open(js, "w"))
+    pov_png = os.path.join(WORK, "view-%d-pov.png" % vi)
+    r = subprocess.run([BLENDTOOL, "render", js, "-o", pov_png, "--width", str(SW), "--height",
+                        str(SH), "--silhouette"], capture_output=True, text=True)
+    check(r.returncode == 0, "POV-Ray renders the %s view: %s" % (side, r.stderr[-300:]))
+    pov = addon_env.image_pixels(pov_png)[:, :, 0] > 0.5
+    for o in list(bpy.data.objects):
+        bpy.data.objects.remove(o)
+    check(bpy.ops.libblend.import_scene(filepath=js) == {"FINISHED"}, "import the %s view" % side)
+    vobj = active()
+    vobj.libblend.live = False
+    vobj.libblend.render_resolution = 96
+    sc = bpy.context.scene
+    sc.render.engine = "BLENDER_WORKBENCH"
+    sc.render.film_transparent = True
+    sc.render.resolution_x, sc.render.resolution_y, sc.render.resolution_percentage = SW, SH, 100
+    sc.render.image_settings.file_format = "PNG"
+    sc.render.image_settings.color_mode = "RGBA"
+    sc.render.filepath = os.path.join(WORK, "view-%d-blender.png" % vi)
+    bpy.ops.render.render(write_still=True)
+    bl = addon_env.image_pixels(sc.render.filepath)[:, :, 3] > 0.5
+    inter, union = (bl & pov).sum(), (bl | pov).sum()
+    mirror = pov[:, ::-1]
+    iou, iou_m = inter / union, (bl & mirror).sum() / (bl | mirror).sum()
+    print("%s: %d / %d pixels (Blender / POV-Ray), IoU %.4f, mirrored %.4f"
+          % (side, bl.sum(), pov.sum(), iou, iou_m))
+    check(bl.sum() > 0.05 * SW * SH, "the %s view shows the blend" % side)
+    check(iou > 0.97, "the %s view: Blender and POV-Ray show the same silhouette" % side)
+    check(iou_m < iou - 0.05, "the %s view: and not its mirror image" % side)
+
+# the defaults: three-point lights around the camera and the floor, where POV-Ray has them
+dsc = sil_scene(views["front (from -y, up +z)"])
+dsc["render"] = {"camera": dsc["render"]["camera"], "background": [0.2, 0.3, 0.4]}
+djs = os.path.join(WORK, "view-defaults.json")
+json.dump(dsc, open(djs, "w"))
+for o in list(bpy.data.objects):
+    bpy.data.objects.remove(o)
+check(bpy.ops.libblend.import_scene(filepath=djs) == {"FINISHED"}, "import a section without lights")
+suns = sorted((o for o in bpy.data.objects if o.type == "LIGHT"), key=lambda o: o.name)
+check([o.name.split()[-2] for o in suns] == ["fill", "key", "rim"], "key, fill and rim lights made")
+key = [o for o in suns if " key " in o.name][0]
+check(key.data.use_shadow and key.data.angle > 0 and not any(o.data.use_shadow for o in suns
+                                                                 if o is not key),
+      "only the key casts (soft) shadows")
+floors = [o for o in bpy.data.objects if o.name.endswith(" floor")]
+r = subprocess.run([BLENDTOOL, "pov", djs, "-o", os.path.join(WORK, "view-defaults.pov")],
+                   capture_output=True, text=True)
+povtext = open(os.path.join(WORK, "view-defaults.pov")).read()
+pov_h = float(povtext.split("plane { <0, 0, 1>, ")[1].split()[0])
+check(len(floors) == 1 and abs(floors[0].location.z - pov_h) < 1e-5,
+      "the floor where POV-Ray's is: %s / %.6f" % ([f.location.z for f in floors], pov_h))
+check(tuple(bpy.context.scene.world.color) == (0.2, 0.3, 0.4) or
+      np.allclose(bpy.context.scene.world.color, (0.2, 0.3, 0.4)), "the background")
+check(bpy.ops.libblend.export_scene(filepath=djs + ".out.json") == {"FINISHED"} and
+      json.load(open(djs + ".out.json"))["render"] == dsc["render"],
+      "the defaults export as the section read (no lights written)")
 
 addon_utils.disable(ADDON_NAME)
 print("test_addon: %d checks passed" % addon_env.checks)

@@ -37,14 +37,14 @@ static void unit(double *a) {
 
 static int silhouette(const lb_scene *sc, const lb_mesh *m, unsigned char *img) {
     const double aspect = (double)W / H;
-    double loc[3], at[3], angle;
-    lb_pov_camera(sc, aspect, loc, at, &angle);
+    double loc[3], at[3], sky[3], angle;
+    lb_pov_camera(sc, aspect, loc, at, sky, &angle);
+    /* the right-handed view the exporter asks POV-Ray for: right = forward x up */
     double D[3] = {at[0] - loc[0], at[1] - loc[1], at[2] - loc[2]}, R[3], U[3];
-    const double sky[3] = {0, 1, 0};
     unit(D);
-    cross(sky, D, R);
+    cross(D, sky, R);
     unit(R);
-    cross(D, R, U);
+    cross(R, D, U);
     unit(U);
     const double dlen = 0.5 * aspect / tan(0.5 * angle * M_PI / 180.0);
     double *px = malloc(2 * m->nvertices * sizeof *px);

@@ -45,11 +45,14 @@ typedef struct lb_pov_options {
 } lb_pov_options;
 
 /* The camera the exporter uses: the scene's render section, or one framing
- * the bounds. POV-Ray's conventions: left-handed, sky +y, angle the
- * horizontal field of view in degrees, image aspect `aspect` (0: 4/3).
- * Writes nothing when any pointer is NULL. */
+ * the bounds from the front (-y), above (+z) and to the right (+x). The
+ * scene is right-handed with up `up` (unit; +z unless the section says
+ * otherwise); the exporter writes POV-Ray's camera with `sky up` and a
+ * negated `right`, so POV-Ray's image is the right-handed view, the same as
+ * Blender's. angle is the horizontal field of view in degrees, for image
+ * aspect `aspect` (0: 4/3). Writes nothing when any pointer is NULL. */
 LB_API void lb_pov_camera(const lb_scene *scene, double aspect, double location[3],
-                          double look_at[3], double *angle);
+                          double look_at[3], double up[3], double *angle);
 
 /* Write the scene to path (through an lb_output: libblend/output.h). ev must
  * be compiled from scene. The file includes "libblend.inc": render with

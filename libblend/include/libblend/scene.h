@@ -61,15 +61,21 @@ typedef struct lb_render_light {
     double color[3];
 } lb_render_light;
 
+/* Scenes are right-handed with z up (as Blender): a camera's up direction
+ * defaults to +z, the floor lies under the scene along it. */
 typedef struct lb_render {
     int has_camera;     /* 0: exporters frame the bounds themselves */
     double location[3]; /* camera position */
     double look_at[3];  /* camera target */
+    double up[3];       /* the camera's up direction (default 0, 0, 1; unit length) */
     double angle;       /* horizontal field of view in degrees, (0, 180) */
-    size_t light_count; /* 0: exporters use their default lights */
+    size_t light_count; /* 0: exporters use their default three-point lights */
     lb_render_light lights[LB_SCENE_MAX_LIGHTS];
     double color[3];                   /* material colour, each in [0, 1] */
     double ambient, diffuse, specular; /* material finish, each in [0, 1] */
+    int floor;                         /* 1 (default): a floor under the surface, taking shadows */
+    double floor_color[3];             /* default 0.75 grey */
+    double background[3];              /* default a neutral 0.9 grey */
 } lb_render;
 
 typedef struct lb_scene_stats {

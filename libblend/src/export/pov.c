@@ -5,6 +5,7 @@
 #include "../evaluation/tape.h"
 #include "libblend/output.h"
 
+#include <libblend/mesh.h>
 #include <libblend/pov.h>
 
 #include <math.h>
@@ -478,30 +479,141 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
     return LB_OK;
 }
 
-void lb_pov_camera(const lb_scene *scene, double aspect, double loc[3], double at[3],
+void lb_pov_camera(const lb_scene *scene, double aspect, double loc[3], double at[3], double up[3],
                    double *angle) {
     (void)aspect;
-    if (!scene || !loc || !at || !angle) return; /* nothing to write to, or from */
+    if (!scene || !loc || !at || !up || !angle) return; /* nothing to write to, or from */
     const lb_render *R = &scene->render;
     *angle = R->has_camera ? R->angle : 40.0;
+    memcpy(up, R->up, 3 * sizeof *up);
     if (R->has_camera) {
         memcpy(loc, R->location, 3 * sizeof *loc);
         memcpy(at, R->look_at, 3 * sizeof *at);
         return;
     }
-    /* frame the bounding sphere from the front, a little above and to the right */
+    /* frame the bounding sphere from the front (-y), a little above (+z)
+     * and to the right (+x) */
     double diag = 0.0, ctr[3];
     for (int d = 0; d < 3; ++d) {
         diag += (scene->bmax[d] - scene->bmin[d]) * (scene->bmax[d] - scene->bmin[d]);
         ctr[d] = 0.5 * (scene->bmin[d] + scene->bmax[d]);
     }
     diag = sqrt(diag);
-    const double dir[3] = {0.45, 0.5, -1.0}, dl = sqrt(0.45 * 0.45 + 0.25 + 1.0);
+    const double dir[3] = {0.45, -1.0, 0.5}, dl = sqrt(0.45 * 0.45 + 1.0 + 0.25);
     const double dist = 0.5 * diag / sin(0.5 * *angle * M_PI / 180.0) * 1.05;
     for (int d = 0; d < 3; ++d) {
         at[d] = ctr[d];
         loc[d] = ctr[d] + dir[d] / dl * dist;
     }
+}
+
+static void cross3(const double *a, const double *b, double *c) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static void unit3(double *a) {
+    const double l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (l > 0.0)
+        for (int d = 0; d < 3; ++d) a[d] /= l;
+}
+
+/* Every number in b (outside // comments) in its shortest form that reads
+ * back as the same double: the writer prints 17 significant digits, which
+ * always round-trip, and this keeps the fewest that still do (0.3, not
+ * 0.29999999999999999). Identifiers' digits (LBn12) are left alone. */
+static void shorten_numbers(sbuf *b) {
+    if (!b->s) return;
+    size_t r = 0, w = 0;
+    while (r < b->n) {
+        const char ch = b->s[r];
+        if (ch == '/' && r + 1 < b->n && b->s[r + 1] == '/') { /* a comment: copied as is */
+            while (r < b->n && b->s[r] != '\n') b->s[w++] = b->s[r++];
+            continue;
+        }
+        const char prev = w ? b->s[w - 1] : ' ';
+        const int starts = (ch >= '0' && ch <= '9') ||
+                           (ch == '.' && r + 1 < b->n && b->s[r + 1] >= '0' && b->s[r + 1] <= '9');
+        const int word = (prev >= 'a' && prev <= 'z') || (prev >= 'A' && prev <= 'Z') ||
+                         (prev >= '0' && prev <= '9') || prev == '_' || prev == '.';
+        if (!starts || word) {
+            b->s[w++] = b->s[r++];
+            continue;
+        }
+        size_t e = r;
+        while (e < b->n && b->s[e] >= '0' && b->s[e] <= '9') ++e;
+        if (e < b->n && b->s[e] == '.') {
+            ++e;
+            while (e < b->n && b->s[e] >= '0' && b->s[e] <= '9') ++e;
+        }
+        if (e + 1 < b->n && (b->s[e] == 'e' || b->s[e] == 'E')) {
+            size_t f = e + 1;
+            if (f < b->n && (b->s[f] == '+' || b->s[f] == '-')) ++f;
+            if (f < b->n && b->s[f] >= '0' && b->s[f] <= '9') {
+                while (f < b->n && b->s[f] >= '0' && b->s[f] <= '9') ++f;
+                e = f;
+            }
+        }
+        char tok[64], best[64];
+        const size_t len = e - r;
+        if (len >= sizeof tok) { /* not a number the writer made: copied as is */
+            while (r < e) b->s[w++] = b->s[r++];
+            continue;
+        }
+        memcpy(tok, b->s + r, len);
+        tok[len] = 0;
+        const double v = strtod(tok, NULL);
+        size_t blen = len;
+        memcpy(best, tok, len + 1);
+        for (int p = 1; p <= 17; ++p) {
+            char t[64];
+            const int n = snprintf(t, sizeof t, "%.*g", p, v);
+            if (n > 0 && (size_t)n < blen && strtod(t, NULL) == v) {
+                memcpy(best, t, (size_t)n + 1);
+                blen = (size_t)n;
+                break;
+            }
+        }
+        memcpy(b->s + w, best, blen); /* never longer than what it replaces */
+        w += blen;
+        r = e;
+    }
+    b->n = w;
+    b->s[w] = 0;
+}
+
+/* The floor's height along up: the lowest point of a coarse mesh of the
+ * surface (48 cells), or of the bounds when there is no surface. */
+static double floor_height(const lb_scene *scene, const lb_evaluator *ev, const double up[3],
+                           int threads) {
+    double h = INFINITY;
+    for (int c = 0; c < 8; ++c) {
+        double t = 0.0;
+        for (int d = 0; d < 3; ++d) t += up[d] * ((c >> d) & 1 ? scene->bmax[d] : scene->bmin[d]);
+        if (t < h) h = t;
+    }
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    memcpy(o.bmin, scene->bmin, sizeof o.bmin);
+    memcpy(o.bmax, scene->bmax, sizeof o.bmax);
+    o.resolution = 48;
+    o.threads = threads;
+    lb_mesh *m = NULL;
+    if (lb_mesh_create(ev, &o, &m, NULL) == LB_OK && m->nvertices) {
+        double lo = INFINITY;
+        for (size_t i = 0; i < m->nvertices; ++i) {
+            const double *X = m->positions + 3 * i;
+            const double t = up[0] * X[0] + up[1] * X[1] + up[2] * X[2];
+            if (t < lo) lo = t;
+        }
+        /* a coarse mesh's lowest vertex is within a cell of the surface's */
+        const double cell = m->cell[0] > m->cell[1] ? m->cell[0] : m->cell[1];
+        lo -= 0.5 * (cell > m->cell[2] ? cell : m->cell[2]);
+        if (lo > h) h = lo;
+    }
+    lb_mesh_free(m);
+    return h;
 }
 
 /* the largest |grad f| on a grid over the box */
@@ -561,24 +673,58 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
     if (!s && !o.include_only) {
         const lb_render *R = &scene->render;
         const double aspect = o.aspect > 0.0 ? o.aspect : 4.0 / 3.0;
-        double loc[3], at[3], angle;
-        lb_pov_camera(scene, aspect, loc, at, &angle);
+        double loc[3], at[3], up[3], angle;
+        lb_pov_camera(scene, aspect, loc, at, up, &angle);
+        /* the camera's basis: forward, right (right-handed), true up */
+        double F[3] = {at[0] - loc[0], at[1] - loc[1], at[2] - loc[2]}, Rt[3], U[3];
+        const double L = sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+        unit3(F);
+        cross3(F, up, Rt);
+        unit3(Rt);
+        cross3(Rt, F, U);
+        const double *bg = R->background;
+        /* POV-Ray is left-handed: a negated right vector makes the image the
+         * right-handed view; sky is the scene's up (the look_at keeps both) */
         sb(&b,
-           "\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb <%d, %d, %d> }\n"
-           "camera { perspective location <%.17g, %.17g, %.17g> look_at <%.17g, %.17g, %.17g> "
-           "right x * %.17g up y angle %.17g }\n",
-           !o.silhouette, !o.silhouette, !o.silhouette, loc[0], loc[1], loc[2], at[0], at[1], at[2],
-           aspect, angle);
+           "\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb <%.17g, %.17g, %.17g> }\n"
+           "camera { perspective location <%.17g, %.17g, %.17g> sky <%.17g, %.17g, %.17g> up y "
+           "right -x * %.17g angle %.17g look_at <%.17g, %.17g, %.17g> }\n",
+           o.silhouette ? 0.0 : bg[0], o.silhouette ? 0.0 : bg[1], o.silhouette ? 0.0 : bg[2],
+           loc[0], loc[1], loc[2], up[0], up[1], up[2], aspect, angle, at[0], at[1], at[2]);
         if (o.silhouette) {
             /* no lights: the object is its ambient white */
-        } else if (R->light_count)
+        } else if (R->light_count) {
             for (size_t i = 0; i < R->light_count; ++i)
                 sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb <%.17g, %.17g, %.17g> }\n",
                    R->lights[i].location[0], R->lights[i].location[1], R->lights[i].location[2],
                    R->lights[i].color[0], R->lights[i].color[1], R->lights[i].color[2]);
-        else
-            sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb 1 }\n", loc[0] + diag,
-               loc[1] + 2.0 * diag, loc[2]);
+        } else {
+            /* three-point lighting around the camera: a key light above and
+             * to the left with soft shadows, a dim fill from the right and a
+             * rim light from behind, both without shadows */
+            static const double P[3][3] = {{-0.7, 0.9, -0.5}, {1.0, 0.2, -0.6}, {0.4, 1.0, 1.1}};
+            static const double I[3] = {0.85, 0.35, 0.5};
+            for (int k = 0; k < 3; ++k) {
+                double X[3];
+                for (int d = 0; d < 3; ++d)
+                    X[d] = at[d] + L * (P[k][0] * Rt[d] + P[k][1] * U[d] + P[k][2] * F[d]);
+                if (k == 0)
+                    sb(&b,
+                       "light_source { <%.17g, %.17g, %.17g> rgb %.17g area_light <%.17g, 0, 0>, "
+                       "<0, %.17g, 0>, 5, 5 adaptive 1 jitter circular orient }\n",
+                       X[0], X[1], X[2], I[k], 0.2 * L, 0.2 * L);
+                else
+                    sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb %.17g shadowless }\n", X[0],
+                       X[1], X[2], I[k]);
+            }
+        }
+        if (R->floor && !o.silhouette) {
+            const double h = floor_height(scene, ev, up, o.threads);
+            sb(&b,
+               "plane { <%.17g, %.17g, %.17g>, %.17g pigment { rgb <%.17g, %.17g, %.17g> } "
+               "finish { ambient 0.15 diffuse 0.75 } }\n",
+               up[0], up[1], up[2], h, R->floor_color[0], R->floor_color[1], R->floor_color[2]);
+        }
         const int soft = scene->convention == LB_CONVENTION_SOFT;
         sb(&b,
            "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
@@ -601,6 +747,7 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
         free(b.s);
         return s;
     }
+    shorten_numbers(&b);
     *out = b;
     if (out_gradient) *out_gradient = g;
     return LB_OK;

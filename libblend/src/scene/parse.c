@@ -1069,10 +1069,16 @@ static lb_status parse_render(pctx *c, const cJSON *root) {
     R->ambient = 0.1;
     R->diffuse = 0.7;
     R->specular = 0.3;
+    R->up[0] = R->up[1] = 0.0;
+    R->up[2] = 1.0;
+    R->floor = 1;
+    R->floor_color[0] = R->floor_color[1] = R->floor_color[2] = 0.75;
+    R->background[0] = R->background[1] = R->background[2] = 0.9;
     const cJSON *r = cJSON_GetObjectItemCaseSensitive(root, "render");
     if (!r) return LB_OK;
-    static const char *const keys[] = {"camera", "lights", "material", NULL};
-    static const char *const cam_keys[] = {"location", "look_at", "angle", NULL};
+    static const char *const keys[] = {"camera", "lights", "material", "floor", "background", NULL};
+    static const char *const cam_keys[] = {"location", "look_at", "up", "angle", NULL};
+    static const char *const floor_keys[] = {"color", NULL};
     static const char *const light_keys[] = {"location", "color", NULL};
     static const char *const mat_keys[] = {"color", "ambient", "diffuse", "specular", NULL};
     const double CM = LB_SCENE_MAX_COORD;
@@ -1094,13 +1100,27 @@ static lb_status parse_render(pctx *c, const cJSON *root) {
         else if (!(s = check_keys(c, cam, cam_keys, "camera")) &&
                  !(s = get_vec3(c, cam, "location", 1, -CM, CM, "|value| <= 1e9", R->location)) &&
                  !(s = get_vec3(c, cam, "look_at", 0, -CM, CM, "|value| <= 1e9", R->look_at)) &&
+                 !(s = get_vec3(c, cam, "up", 0, -CM, CM, "|value| <= 1e9", R->up)) &&
                  !(s = get_number(c, cam, "angle", 0, 1e-3, 179.0, "0 < angle < 180 (degrees)",
                                   &R->angle))) {
             const double d[3] = {R->look_at[0] - R->location[0], R->look_at[1] - R->location[1],
                                  R->look_at[2] - R->location[2]};
-            if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
+            const double *u = R->up;
+            const double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]),
+                         ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+            const double cx[3] = {d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2],
+                                  d[0] * u[1] - d[1] * u[0]};
+            const double sl = sqrt(cx[0] * cx[0] + cx[1] * cx[1] + cx[2] * cx[2]);
+            if (!(dl > 0.0))
                 s = perr(c, LB_ERR_INVALID_ARGUMENT,
                          "location equals look_at; allowed: a camera looking somewhere");
+            else if (!(ul > 0.0) || !(sl > 1e-6 * dl * ul))
+                s = perr(c, LB_ERR_INVALID_ARGUMENT,
+                         "up [%g, %g, %g] is %s; allowed: a direction not along the line of sight "
+                         "(default [0, 0, 1])",
+                         u[0], u[1], u[2], ul > 0.0 ? "along the line of sight" : "zero");
+            else
+                for (int d2 = 0; d2 < 3; ++d2) R->up[d2] /= ul;
             R->has_camera = !s;
         }
         pop(c, o);
@@ -1147,7 +1167,22 @@ static lb_status parse_render(pctx *c, const cJSON *root) {
                                   &R->diffuse)))
             s = get_number(c, mat, "specular", 0, 0.0, 1.0, "0 <= specular <= 1", &R->specular);
         pop(c, o);
+        if (s) goto done;
     }
+    const cJSON *fl = cJSON_GetObjectItemCaseSensitive(r, "floor");
+    if (fl) {
+        const size_t o = push_key(c, "floor");
+        if (cJSON_IsBool(fl))
+            R->floor = cJSON_IsTrue(fl);
+        else if (!cJSON_IsObject(fl))
+            s = perr(c, LB_ERR_INVALID_ARGUMENT,
+                     "expected true, false or {\"color\": [r, g, b]}, found %s", json_kind(fl));
+        else if (!(s = check_keys(c, fl, floor_keys, "floor")))
+            s = get_vec3(c, fl, "color", 0, 0.0, 1.0, "0 <= value <= 1", R->floor_color);
+        pop(c, o);
+        if (s) goto done;
+    }
+    s = get_vec3(c, r, "background", 0, 0.0, 1.0, "0 <= value <= 1", R->background);
 done:
     pop(c, old);
     return s;
