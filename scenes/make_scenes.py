@@ -12,17 +12,29 @@ import os
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def scene(title, description, convention, root, bounds, defs=None, render=None):
+def camera(location, look_at, angle=35, up=None):
+    c = {"location": location, "look_at": look_at, "angle": angle}
+    if up:
+        c["up"] = up
+    return c
+
+
+# Scenes are right-handed with z up. Each figure gets a camera that shows
+# what the figure is about (the comment at each figure says what); the
+# lights are the exporters' three-point default around that camera, over a
+# floor (docs/scene-format.md, Render section).
+THREE_QUARTER = camera([4.0, -6.0, 4.5], [0, 0, 0])
+
+
+def scene(title, description, convention, root, bounds, defs=None, cam=THREE_QUARTER):
     s = {"format": "libblend-scene", "version": 1, "title": title,
          "description": description, "convention": convention,
          "bounds": {"min": bounds[0], "max": bounds[1]}}
     if defs:
         s["defs"] = defs
     s["root"] = root
-    s["render"] = render or {
-        "camera": {"location": [4.0, -6.0, 4.5], "look_at": [0, 0, 0], "angle": 35},
-        "lights": [{"location": [10, -10, 20], "color": [1, 1, 1]},
-                   {"location": [-10, -5, 8], "color": [0.4, 0.4, 0.4]}],
+    s["render"] = {
+        "camera": cam,
         "material": {"color": [0.85, 0.7, 0.45], "ambient": 0.1, "diffuse": 0.7,
                      "specular": 0.3}}
     return s
@@ -64,7 +76,9 @@ for m2 in (1.2, 0.9, 0.6, 0.3):
     write("hsu2006-fig7-m%s.json" % m2, scene(
         "hsu2006 Fig. 7, m2 = %s" % m2,
         "BT2(S(-BT3(-f1,-f2,-f3)), super-ellipsoid) with m2 = %s for the cube's f2" % m2,
-        "zero", root, B2))
+        # from the +x side: the cube on the left, the super-ellipsoid on the
+        # right, the blend between them in profile
+        "zero", root, B2, cam=camera([7.5, 0.6, 2.2], [0, 0.6, -0.1], 34)))
 
 # hsu2006 Fig. 8: S(-BT2(-b2, b1), 0): the six-plane box b2 (a slot) cut
 # from the six-plane box b1. The slot floor f12 is 0.35 below the top face
@@ -85,7 +99,8 @@ for tag, mlow in (("plain", 1.0), ("lowered-m", 0.3)):
     write("hsu2006-fig8-%s.json" % tag, scene(
         "hsu2006 Fig. 8, %s" % tag,
         "difference of two six-plane intersections, m6 = m12 = %s" % mlow,
-        "zero", root, B2))
+        # down the slot from the front and above: its floor and the top face
+        "zero", root, B2, cam=camera([1.4, -6.5, 3.6], [0, 0, 0.3], 30)))
 
 # hsu2006 Fig. 9: the wheel S(BT2(BT2(f1, f2), f3), 0): crossing spokes f1,
 # f2 joined with bulge elimination, then the toroidal rim f3; m1 = 1 and 0.3
@@ -105,7 +120,10 @@ for m1 in (1, 0.3):
     write("hsu2006-fig9-m%s.json" % m1, scene(
         "hsu2006 Fig. 9, m1 = %s" % m1,
         "wheel BT2(BT2(f1, f2) with bulge elimination, f3), m1 = %s" % m1,
-        "zero", root, ([-1.9, -1.9, -0.6], [1.9, 1.9, 0.6])))
+        # close on the +x spoke's joint with the rim, where m1 acts, with the
+        # hub (which must not change) in view
+        "zero", root, ([-1.9, -1.9, -0.6], [1.9, 1.9, 0.6]),
+        cam=camera([2.8, -3.4, 3.4], [0.8, 0.2, 0], 38)))
 
 # hsu-bounded Fig. 2: the wheel B_D2(B_U2(B_U2(f1, f2), f3), f4) by the
 # scale method: spokes f1, f2, rim f3, axle hole f4.
@@ -120,7 +138,9 @@ root = {"type": "scale", "op": "difference", "r": 0.3, "p": 2,
                          "radius": 0.07}]}
 write("hsu-bounded-fig2-wheel.json", scene(
     "hsu-bounded Fig. 2, wheel", "B_D2(B_U2(B_U2(f1, f2), f3), f4) by the scale method",
-    "zero", root, ([-1.8, -1.8, -0.6], [1.8, 1.8, 0.6])))
+    # from above at a slant: spokes, rim and axle hole
+    "zero", root, ([-1.8, -1.8, -0.6], [1.8, 1.8, 0.6]),
+    cam=camera([0.9, -3.2, 4.6], [0.1, 0, 0], 40)))
 
 # hsu-bounded Fig. 7: a stool, four legs and a plate in one bounded union;
 # the plate's bounding solid keeps its blending region off the corners.
@@ -139,7 +159,9 @@ root = {"type": "bounded", "op": "union", "p": 2, "args": [plate] + legs,
 write("hsu-bounded-fig7-stool.json", scene(
     "hsu-bounded Fig. 7, stool with a bounded plate",
     "bounded union of a plate and four legs; the plate's bounding solid is a taller ellipsoid",
-    "zero", root, ([-1.4, -1.4, -1.5], [1.4, 1.4, 0.8])))
+    # from the side and a little below the plate: the leg joints
+    "zero", root, ([-1.4, -1.4, -1.5], [1.4, 1.4, 0.8]),
+    cam=camera([4.6, -3.4, -0.5], [0, 0, -0.35], 38)))
 
 # hsu-nonuniform Fig. 6: B_S2(B_A3(f1, f2, f3), f4) = 0.5 on soft slabs and a
 # soft super-ellipsoid, m2 = 2.8 fixed, m1 = 0.3, 0.65, 1, 1.5.
@@ -152,7 +174,10 @@ for m1 in (0.3, 0.65, 1, 1.5):
     write("hsu-nonuniform-fig6-m%s.json" % m1, scene(
         "hsu-nonuniform Fig. 6, m1 = %s" % m1,
         "soft B_S2(B_A3(f1, f2, f3), f4) = 0.5, m1 = %s, m2 = 2.8" % m1,
-        "soft", root, ([-2.2, -2.2, -2.2], [2.6, 2.2, 2.2])))
+        # from the front: the cube's +x face and the blob on its top corner
+        # in profile
+        "soft", root, ([-2.2, -2.2, -2.2], [2.6, 2.2, 2.2]),
+        cam=camera([1.2, -7.5, 1.8], [0.5, 0, 0.3], 36)))
 
 # Benchmark scenes (issues 3 and 4). S1: three spheres in one BT_3 union.
 S1 = {"type": "displacement", "op": "union", "r": 0.25, "p": 2,
@@ -160,14 +185,14 @@ S1 = {"type": "displacement", "op": "union", "r": 0.25, "p": 2,
                for c in ([0, 0, 0], [1.2, 0, 0], [0, 1.2, 0])]}
 write("bench-s1-three-spheres.json", scene(
     "S1: three spheres", "three unit spheres in one BT_3 union, r = 0.25, p = 2", "zero", S1,
-    ([-2, -2, -2], [3, 3, 3])))
+    ([-2, -2, -2], [3, 3, 3]), cam=camera([4.5, -5.5, 5.0], [0.4, 0.4, 0], 40)))
 # S2: 64 spheres of radius 0.3 on a 4x4x4 lattice of spacing 0.5.
 S2 = {"type": "displacement", "op": "union", "r": 0.1, "p": 2,
       "args": [{"type": "sphere", "center": [-0.25 + 0.5 * i, -0.25 + 0.5 * j, -0.25 + 0.5 * k],
                 "radius": 0.3} for i in range(4) for j in range(4) for k in range(4)]}
 write("bench-s2-64-spheres.json", scene(
     "S2: 64 spheres", "64 spheres (radius 0.3, 4x4x4 lattice, spacing 0.5) in one BT_64 union",
-    "zero", S2, ([-2, -2, -2], [3, 3, 3])))
+    "zero", S2, ([-2, -2, -2], [3, 3, 3]), cam=camera([4.0, -4.5, 4.0], [0.5, 0.5, 0.45], 36)))
 
 # The README's main job: the hsu2006 Fig. 7 setting with a shared cube def.
 cube = {"type": "displacement", "op": "intersection", "args": [slab(0), slab(1), slab(2)],
@@ -181,7 +206,9 @@ write("default.json", scene(
     "libblend default scene",
     "a rounded cube blended with a super-ellipsoid (m2 = 0.6, hsu2006 Fig. 7) and a rotated, "
     "scaled copy of the same cube (a shared def)",
-    "zero", root, ([-2.2, -4.0, -2.2], [2.2, 2.2, 2.2]), defs={"cube": cube}))
+    # from the +x side: the small cube, the cube and the super-ellipsoid in a row
+    "zero", root, ([-2.2, -4.0, -2.2], [2.2, 2.2, 2.2]), defs={"cube": cube},
+    cam=camera([8.5, -1.6, 3.4], [0, -0.8, -0.2], 40)))
 
 # ---- local blending (Bernhardt, Barthe, Cani, Wyvill 2010): bernhardt-*.json
 
@@ -195,6 +222,10 @@ def soft_capsule(a, b, r):
 
 
 WATER = soft_sphere((0, -5, 0), 5.0)  # its top at y = 0
+# The local-blending scenes stand along +y (the drop falls in -y): their
+# cameras say so with up = +y, and look from +z.
+Y_UP = [0, 1, 0]
+DROP_CAM = camera([0.9, 1.6, 6.5], [0, 0.15, 0], 34, Y_UP)
 DROP_BOUNDS = ([-1.5, -1.0, -1.5], [1.5, 1.6, 1.5])
 # the drop (radius 0.5) from well above the water to half under it: no blend
 # before it touches (y > 0.5), then a blend that grows with the penetration
@@ -204,7 +235,7 @@ for i, y in enumerate([1.0, 0.8, 0.6, 0.52, 0.48, 0.42, 0.36, 0.3, 0.24, 0.18, 0
         "a drop of radius 0.5 over water whose surface is at y = 0, under a local union: it "
         "blends only once it touches, more as it goes deeper (seed Fig. 8)",
         "soft", {"type": "local_union", "args": [soft_sphere((0, y, 0), 0.5), WATER]},
-        DROP_BOUNDS))
+        DROP_BOUNDS, cam=DROP_CAM))
 
 # a hand next to the body: closer than any classic blend range, not touching
 write("bernhardt-hand-near-body.json", scene(
@@ -213,7 +244,7 @@ write("bernhardt-hand-near-body.json", scene(
     "soft", {"type": "local_union", "args": [
         soft_capsule((0, -1.2, 0), (0, 1.2, 0), 0.6),
         soft_capsule((0.84, -1.0, 0), (0.84, 0.6, 0.0), 0.2)]},
-    ([-1.0, -2.0, -1.0], [1.2, 2.0, 1.0])))
+    ([-1.0, -2.0, -1.0], [1.2, 2.0, 1.0]), cam=camera([1.6, 0.6, 6.0], [0.3, -0.1, 0], 40, Y_UP)))
 
 # several convolution-like primitives blended locally (the paper's dancer)
 write("bernhardt-figure.json", scene(
@@ -226,30 +257,32 @@ write("bernhardt-figure.json", scene(
         soft_capsule((0.2, 0.5, 0), (1.1, -0.3, 0), 0.15),
         soft_capsule((-0.15, -0.7, 0), (-0.3, -2.2, 0), 0.18),
         soft_capsule((0.15, -0.7, 0), (0.3, -2.2, 0), 0.18)]},
-    ([-1.5, -2.6, -1.0], [1.5, 1.8, 1.0])))
+    ([-1.5, -2.6, -1.0], [1.5, 1.8, 1.0]), cam=camera([1.5, 0.4, 8.0], [0, -0.4, 0], 40, Y_UP)))
 
 # the same pair three ways: the classic soft sum, Hsu's BT blend, the local blend
 PAIR_BOUNDS = ([-1.6, -1.6, -1.6], [2.8, 1.6, 1.6])
+PAIR_CAM = camera([1.0, -7.5, 2.2], [0.6, 0, 0], 36)  # the pair side by side, from the front
 write("bernhardt-compare-sum.json", scene(
     "comparison: a sphere and a smaller one, soft sum",
     "the classic soft union: the spheres swell toward each other",
     "soft", {"type": "soft_sum", "args": [soft_sphere((0, 0, 0), 1.0),
-                                          soft_sphere((1.5, 0, 0), 0.6)]}, PAIR_BOUNDS))
+                                          soft_sphere((1.5, 0, 0), 0.6)]}, PAIR_BOUNDS,
+    cam=PAIR_CAM))
 write("bernhardt-compare-bt.json", scene(
     "comparison: the same pair, Hsu's BT_2 blend (r = 0.3)",
     "a displacement blend: the fillet follows the contact, but the range acts at a distance",
     "zero", {"type": "displacement", "op": "union", "r": 0.3, "p": 2, "args": [
         {"type": "sphere", "center": [0, 0, 0], "radius": 1.0},
-        {"type": "sphere", "center": [1.5, 0, 0], "radius": 0.6}]}, PAIR_BOUNDS))
+        {"type": "sphere", "center": [1.5, 0, 0], "radius": 0.6}]}, PAIR_BOUNDS, cam=PAIR_CAM))
 write("bernhardt-compare-local.json", scene(
     "comparison: the same pair, local union",
     "blends only around the intersection circle; the exact union elsewhere",
     "soft", {"type": "local_union", "alpha": [0.05, 0.05],
              "args": [soft_sphere((0, 0, 0), 1.0), soft_sphere((1.5, 0, 0), 0.6)]},
-    PAIR_BOUNDS))
+    PAIR_BOUNDS, cam=PAIR_CAM))
 write("bernhardt-drop-zero.json", scene(
     "drop on water in the zero convention",
     "the same local union with distance-like children (zero_scale 1)",
     "zero", {"type": "local_union", "support_factor": 0.3, "args": [
         {"type": "sphere", "center": [0, 0.3, 0], "radius": 0.5},
-        {"type": "sphere", "center": [0, -5, 0], "radius": 5}]}, DROP_BOUNDS))
+        {"type": "sphere", "center": [0, -5, 0], "radius": 5}]}, DROP_BOUNDS, cam=DROP_CAM))

@@ -235,10 +235,11 @@ def to_section(output):
         if old and _same_vec(loc, old["location"]) and abs(angle - old.get("angle", 40)) < 1e-4:
             target = Vector(old.get("look_at", [0, 0, 0])) - Vector(old["location"])
             # the same up: the stored one, made perpendicular to the line of sight
+            # (tolerances of 1e-6: mathutils computes in float32)
             want = (camera_basis(old["location"], old.get("look_at", [0, 0, 0]),
                                  old.get("up", [0, 0, 1]))[2] if target.length else cup)
-            if target.length == 0 or (fwd.dot(target.normalized()) > 1 - 1e-9 and
-                                      cup.dot(want) > 1 - 1e-6):  # mathutils is float32
+            if target.length == 0 or (fwd.dot(target.normalized()) > 1 - 1e-6 and
+                                      cup.dot(want) > 1 - 1e-6):
                 cam = None
                 out["camera"] = old
         if cam is not None:

@@ -5,7 +5,8 @@
  * argument substitutions), rendered as one isosurface whose contained_by box
  * is the scene's bounds and whose max_gradient libblend computes: the
  * largest |grad f| on a dense grid over the box (LB_POV_GRADIENT_SAMPLES per
- * axis) times LB_POV_GRADIENT_SAFETY. Camera, lights and material come from
+ * axis), among the samples the surface may be near (|f - threshold| at most
+ * two grid diagonals times |grad f|), times LB_POV_GRADIENT_SAFETY. Camera, lights and material come from
  * the scene's render section, or frame the bounds by default. Nothing the
  * scene's author typed reaches an identifier: names are generated (LBn0,
  * LBn1, ...) and user text appears only in comments, stripped of anything

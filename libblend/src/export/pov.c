@@ -630,12 +630,23 @@ static lb_status max_gradient(const lb_evaluator *ev, const double lo[3], const 
         z[i] = lo[2] + (hi[2] - lo[2]) * (double)cq / (double)(N - 1);
     }
     lb_status s = lb_evaluator_eval(ev, n, x, y, z, v, gx, gy, gz, threads, err);
-    double m = 0.0;
+    /* Only where the surface may be matters: POV-Ray's root search splits an
+     * interval of a ray only while the function could reach the threshold
+     * in it, so a steep field far from the surface never misleads it. A
+     * sample counts when, to first order, the surface lies within two grid
+     * diagonals of it: |f - threshold| <= 2 d |grad f|. */
+    double d2 = 0.0;
+    for (int d = 0; d < 3; ++d)
+        d2 += (hi[d] - lo[d]) * (hi[d] - lo[d]) / ((double)(N - 1) * (double)(N - 1));
+    const double band = 2.0 * sqrt(d2), level = ev->conv == LB_CONVENTION_SOFT ? 0.5 : 0.0;
+    double m = 0.0, mall = 0.0;
     for (size_t i = 0; i < n && !s; ++i) {
         const double l = sqrt(gx[i] * gx[i] + gy[i] * gy[i] + gz[i] * gz[i]);
-        if (l > m) m = l;
+        if (l > mall) mall = l;
+        if (l > m && fabs(v[i] - level) <= band * l) m = l;
     }
     free(mem);
+    if (!(m > 0.0)) m = mall; /* no surface seen: the whole box's */
     *g = m * LB_POV_GRADIENT_SAFETY;
     if (!(*g > 0.0)) *g = 1.0;
     return s;
