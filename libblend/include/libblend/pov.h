@@ -6,11 +6,10 @@
  * is the scene's bounds and whose max_gradient libblend computes: the
  * largest |grad f| on a dense grid over the box (LB_POV_GRADIENT_SAMPLES per
  * axis), among the samples the surface may be near (|f - threshold| at most
- * two grid diagonals times |grad f|), times LB_POV_GRADIENT_SAFETY. Camera, lights and material come from
- * the scene's render section, or frame the bounds by default. Nothing the
- * scene's author typed reaches an identifier: names are generated (LBn0,
- * LBn1, ...) and user text appears only in comments, stripped of anything
- * but printable ASCII.
+ * two grid diagonals times |grad f|), times LB_POV_GRADIENT_SAFETY. Camera, lights and material
+ * come from the scene's render section, or frame the bounds by default. Nothing the scene's author
+ * typed reaches an identifier: names are generated (LBn0, LBn1, ...) and user text appears only in
+ * comments, stripped of anything but printable ASCII.
  *
  * Local unions: each use (node and world frame) is written with its
  * blending volumes as data, the curve's segments in a tree of functions

@@ -382,16 +382,7 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     for (int o = 0; o < ngroups && !s; ++o) {
         const size_t c = start[o + 1] - start[o];
         if (!c) continue;
-        if (narrow) {
-            uint32_t l0[3], l1[3];
-            for (int d = 0; d < 3; ++d) {
-                l0[d] = (o >> d) & 1 ? half[d] : 0;
-                l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
-            }
-            double omin[3], omax[3];
-            lb__node_box(g, B, l0, l1, omin, omax);
-            lb__boxeval_narrow(ev, &E, &outer, omin, omax);
-        }
+        if (narrow) lb__octant_narrow(ev, g, B, o, &outer, &E);
         const size_t a = start[o];
         s = lb__boxeval_run(ev, &E, c, x + a, y + a, z + a, v + a, gx + a, gy + a, gz + a, err);
     }

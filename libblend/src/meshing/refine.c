@@ -81,6 +81,19 @@ void lb__node_box(const lb__grid *g, const lb__block *B, const uint32_t l0[3], c
     }
 }
 
+void lb__octant_narrow(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, int o,
+                       const lb__plan *outer, lb__boxeval *E) {
+    uint32_t l0[3], l1[3];
+    for (int d = 0; d < 3; ++d) {
+        const uint32_t half = B->nc[d] / 2;
+        l0[d] = (o >> d) & 1 ? half : 0;
+        l1[d] = (o >> d) & 1 ? B->nc[d] : half;
+    }
+    double omin[3], omax[3];
+    lb__node_box(g, B, l0, l1, omin, omax);
+    lb__boxeval_narrow(ev, E, outer, omin, omax);
+}
+
 void lb__block_box(const lb__grid *g, const lb__block *B, double bmin[3], double bmax[3]) {
     const uint32_t zero[3] = {0, 0, 0};
     lb__node_box(g, B, zero, B->nc, bmin, bmax);
@@ -161,16 +174,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
     for (int o = 0; o < ngroups && !s; ++o) {
         const size_t na = start[o + 1] - start[o];
         if (!na) continue;
-        if (narrow) {
-            uint32_t l0[3], l1[3];
-            for (int d = 0; d < 3; ++d) {
-                l0[d] = (o >> d) & 1 ? half[d] : 0;
-                l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
-            }
-            double omin[3], omax[3];
-            lb__node_box(g, B, l0, l1, omin, omax);
-            lb__boxeval_narrow(ev, &E, &outer, omin, omax);
-        }
+        if (narrow) lb__octant_narrow(ev, g, B, o, &outer, &E);
         s = refine_some(ev, g, &E, act + start[o], na, a, b, ga, gb, tol, t, lo, hi, x, y, z, v, gx,
                         gy, gz, pos, nrm, err);
     }
