@@ -25,15 +25,10 @@ import struct
 import subprocess
 import sys
 
-BLENDTOOL, SRC, WORK = sys.argv[1:4]
-os.makedirs(WORK, exist_ok=True)
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import args, check, finish  # noqa: E402
 
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL: " + what)
+BLENDTOOL, SRC, WORK = args()
 
 
 def export(scene, name):
@@ -164,7 +159,4 @@ r = subprocess.run([BLENDTOOL, "render", os.path.join(WORK, "defaults.json"), "-
                     "--width", "16", "--height", "12"], capture_output=True, text=True)
 check(r.returncode == 0 and os.path.exists(png), "POV-Ray renders the defaults: " + r.stderr[-400:])
 
-if failures:
-    print("test_pov_export: %d failures" % len(failures))
-    sys.exit(1)
-print("test_pov_export: all checks passed")
+finish("test_pov_export", "all checks passed")

@@ -28,17 +28,12 @@ import re
 import subprocess
 import sys
 
-BLENDTOOL, SRC, WORK = sys.argv[1:4]
-os.makedirs(WORK, exist_ok=True)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import args, check, finish  # noqa: E402
+
+BLENDTOOL, SRC, WORK = args()
 INC = os.path.join(SRC, "povray_include")
-failures = []
 worst = []
-
-
-def check(cond, what):
-    if not cond:
-        failures.append(what)
-        print("FAIL: " + what)
 
 
 def render(name, body):
@@ -211,19 +206,16 @@ for t in range(20):
     judge(name, text)
 
 # ---- bad input
-for args, want in (("<-1, -1, -1>, <1, 1, 1>, 1", "LB_MaxGradient: N = 1.000000000; allowed: a "
+for call, want in (("<-1, -1, -1>, <1, 1, 1>, 1", "LB_MaxGradient: N = 1.000000000; allowed: a "
                                                   "whole number from 2 to 200"),
                    ("<-1, -1, -1>, <1, 1, 1>, 2.5", "LB_MaxGradient: N = 2.500000000"),
                    ("<1, -1, -1>, <1, 1, 1>, 8", "LB_MaxGradient: the box <1.000000000, "
                     "-1.000000000, -1.000000000> .. <1.000000000, 1.000000000, 1.000000000> is "
                     "empty")):
     rc, text = render("bad", '#version 3.7;\n#include "libblend.inc"\n#declare S = '
-                      "LB_Sphere(<0, 0, 0>, 1)\n#declare M = LB_MaxGradient(S, %s);\n" % args)
-    check(rc != 0 and want in text, "refused with the helper's message: %s -> %s" % (args, text[-200:]))
+                      "LB_Sphere(<0, 0, 0>, 1)\n#declare M = LB_MaxGradient(S, %s);\n" % call)
+    check(rc != 0 and want in text, "refused with the helper's message: %s -> %s" % (call, text[-200:]))
 
 worst.sort(reverse=True)
 print("helper / POV-Ray's found gradient, largest: %s" % worst[:3])
-if failures:
-    print("test_pov_gradient: %d failures" % len(failures))
-    sys.exit(1)
-print("test_pov_gradient: all checks passed (%d scenes, 20 random blends)" % len(scenes))
+finish("test_pov_gradient", "all checks passed (%d scenes, 20 random blends)" % len(scenes))
