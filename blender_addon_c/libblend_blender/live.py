@@ -72,7 +72,7 @@ class _Job:
             with self.lib.parse_scene(self.text, self.name) as scene, scene.compile() as ev:
                 self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
                                     open_boundary=self.open_boundary, threads=self.threads,
-                                    cancel=self.cancel, edges=True)
+                                    cancel=self.cancel, edges=compat.takes_libblend_edges())
         except binding.Cancelled:
             self.error = None
         except binding.LibblendError as e:
