@@ -208,6 +208,18 @@ static lb_status c_scene_queries(unsigned mask, int size, lb_error *err, int *hs
     double v, g[3];
     return lb_scene_eval_reference(P(0, C.scene), P(1, C3), P(2, &v), P(3, g), P(5, err));
 }
+static lb_status c_materials(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 0;
+    lb_material m;
+    (void)lb_scene_material_count(P(0, C.scene));
+    const int got = lb_scene_material(P(0, C.scene), (size_t)size, P(1, &m));
+    if (mask & 3u) assert_int_equal(got, 0);
+    *hs = 1;
+    const double x[1] = {0}, y[1] = {0}, z[1] = {0};
+    uint32_t idx[1];
+    return lb_scene_material_index(P(0, C.scene), P(1, C.ev), 1, P(2, x), P(3, y), P(4, z),
+                                   P(5, idx), P(6, err));
+}
 static lb_status c_evaluator(unsigned mask, int size, lb_error *err, int *hs) {
     *hs = 1;
     (void)size;
@@ -339,6 +351,7 @@ static const fn_case CASES[] = {
     {"lb_scene_parse", 4, 0x05, c_scene_parse},
     {"lb_scene_load", 3, 0x03, c_scene_load},
     {"lb_scene_* queries and reference walk", 6, 0x07, c_scene_queries},
+    {"lb_scene_material*", 7, 0x3d, c_materials},
     {"lb_evaluator_create", 3, 0x03, c_evaluator},
     {"lb_evaluator_eval", 9, 0x1f, c_eval},
     {"lb_evaluator_bounds", 6, 0x1f, c_bounds},

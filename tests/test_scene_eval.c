@@ -322,8 +322,154 @@ static void test_bad_points(void **state) {
     unload(&L);
 }
 
+/* Materials: the index each point takes is the material of the argument
+ * that decides the set operation there, each argument evaluated as a scene
+ * of its own (union: the most inside; intersection: the most outside;
+ * difference: the most outside of the first and the complements), nested
+ * and inherited; equal materials share an index; a ref's material holds
+ * for its def unless the def names its own. */
+static lb_scene *parse_text(const char *text) {
+    lb_scene *sc = NULL;
+    lb_error e = {LB_OK, ""};
+    if (lb_scene_parse(text, strlen(text), "materials.json", &sc, &e))
+        fail_msg("materials.json: %s", e.message);
+    return sc;
+}
+
+static double eval1(const char *conv, const char *node, double x, double y, double z) {
+    char text[1024];
+    snprintf(text, sizeof text,
+             "{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": \"%s\", "
+             "\"root\": %s}",
+             conv, node);
+    lb_scene *sc = parse_text(text);
+    double v, g[3];
+    const double X[3] = {x, y, z};
+    lb_error e = {LB_OK, ""};
+    if (lb_scene_eval_reference(sc, X, &v, g, &e)) fail_msg("%s", e.message);
+    lb_scene_free(sc);
+    return v;
+}
+
+#define RED "{\"color\": [1, 0, 0]}"
+#define BLUE "{\"color\": [0, 0, 1], \"specular\": 0.9}"
+#define A_ZERO "{\"type\": \"sphere\", \"center\": [-0.5, 0, 0], \"radius\": 1"
+#define B_ZERO "{\"type\": \"sphere\", \"center\": [0.6, 0.1, 0], \"radius\": 0.8"
+#define C_ZERO "{\"type\": \"ellipsoid\", \"center\": [0, 0, 0.7], \"semi_axes\": [0.6, 0.4, 0.5]"
+
+static void test_materials(void **state) {
+    (void)state;
+    static const char *const ops[] = {"union", "intersection", "difference"};
+    rng_t g = {12345};
+    for (int o = 0; o < 3; ++o) {
+        char text[2048];
+        snprintf(text, sizeof text,
+                 "{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": "
+                 "\"zero\", \"render\": {\"material\": {\"color\": [0.5, 0.5, 0.5]}}, "
+                 "\"root\": {\"type\": \"displacement\", \"op\": \"%s\", \"r\": 0.3, "
+                 "\"args\": [" A_ZERO ", \"material\": " RED "}, " B_ZERO ", \"material\": " BLUE
+                 "}, " C_ZERO ", \"material\": " RED "}]}}",
+                 ops[o]);
+        lb_scene *sc = parse_text(text);
+        assert_int_equal(lb_scene_material_count(sc), 3); /* the two reds share one */
+        lb_material m;
+        assert_true(lb_scene_material(sc, 2, &m));
+        assert_true(m.color[2] == 1.0 && m.specular == 0.9 && m.ambient == 0.1);
+        assert_true(lb_scene_material(sc, 0, &m) && m.color[0] == 0.5);
+        assert_false(lb_scene_material(sc, 3, &m));
+        double x[400], y[400], z[400];
+        uint32_t idx[400];
+        for (int i = 0; i < 400; ++i) {
+            x[i] = rng_range(&g, -1.5, 1.5);
+            y[i] = rng_range(&g, -1.0, 1.0);
+            z[i] = rng_range(&g, -1.0, 1.3);
+        }
+        lb_error e = {LB_OK, ""};
+        assert_int_equal(lb_scene_material_index(sc, NULL, 400, x, y, z, idx, &e), LB_OK);
+        int seen[3] = {0, 0, 0};
+        for (int i = 0; i < 400; ++i) {
+            const double a = eval1("zero", A_ZERO "}", x[i], y[i], z[i]);
+            const double b = eval1("zero", B_ZERO "}", x[i], y[i], z[i]);
+            const double c = eval1("zero", C_ZERO "}", x[i], y[i], z[i]);
+            /* the score that decides: smallest wins */
+            double sa = a, sb = b, sc2 = c;
+            if (o == 1) sa = -a, sb = -b, sc2 = -c;
+            if (o == 2) sa = -a; /* complements of b, c: most outside = largest -b */
+            const uint32_t want = sa <= sb && sa <= sc2 ? 1 : sb <= sc2 ? 2 : 1;
+            assert_int_equal(idx[i], want);
+            seen[idx[i]]++;
+        }
+        assert_true(seen[1] > 20 && seen[2] > 20);
+        lb_scene_free(sc);
+    }
+    /* soft convention: a union's most inside is the largest value; nested
+     * inheritance: the green blend's plain argument is green, its red one red */
+    {
+        const char *text =
+            "{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": \"soft\", "
+            "\"root\": {\"type\": \"soft_sum\", \"args\": ["
+            "{\"type\": \"sphere\", \"center\": [-1, 0, 0], \"radius\": 1, \"kernel\": "
+            "\"wyvill\"},"
+            "{\"type\": \"max\", \"material\": {\"color\": [0, 1, 0]}, \"args\": ["
+            "{\"type\": \"sphere\", \"center\": [1, 0, 0], \"radius\": 1, \"kernel\": "
+            "\"wyvill\"},"
+            "{\"type\": \"sphere\", \"center\": [1, 0, 1], \"radius\": 0.7, \"kernel\": "
+            "\"wyvill\", \"material\": " RED "}]}]}}";
+        lb_scene *sc = parse_text(text);
+        assert_int_equal(lb_scene_material_count(sc), 3);
+        const double x[4] = {-1.2, 1.2, 1.0, 0.0}, y[4] = {0, 0, 0, 0}, z[4] = {0, -0.3, 1.2, 3};
+        uint32_t idx[4];
+        lb_error e = {LB_OK, ""};
+        assert_int_equal(lb_scene_material_index(sc, NULL, 4, x, y, z, idx, &e), LB_OK);
+        assert_int_equal(idx[0], 0); /* the plain sphere: the render section's */
+        assert_int_equal(idx[1], 1); /* the green max's own argument */
+        assert_int_equal(idx[2], 2); /* its red argument */
+        lb_scene_free(sc);
+    }
+    /* refs: the ref's material holds unless the def has one */
+    {
+        const char *text =
+            "{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": \"zero\", "
+            "\"defs\": {\"plain\": {\"type\": \"sphere\", \"radius\": 0.5}, "
+            "\"blue\": {\"type\": \"sphere\", \"radius\": 0.5, \"material\": " BLUE "}}, "
+            "\"root\": {\"type\": \"min\", \"args\": ["
+            "{\"ref\": \"plain\", \"material\": " RED "},"
+            "{\"ref\": \"blue\", \"translate\": [2, 0, 0], \"material\": " RED "},"
+            "{\"ref\": \"plain\", \"translate\": [4, 0, 0]}]}}";
+        lb_scene *sc = parse_text(text);
+        const double x[3] = {0.0, 2.0, 4.0}, y[3] = {0, 0, 0}, z[3] = {0, 0, 0};
+        uint32_t idx[3];
+        lb_error e = {LB_OK, ""};
+        assert_int_equal(lb_scene_material_index(sc, NULL, 3, x, y, z, idx, &e), LB_OK);
+        assert_int_equal(idx[0], 1);
+        assert_int_equal(idx[1], 2);
+        assert_int_equal(idx[2], 0);
+        lb_scene_free(sc);
+    }
+    /* a scene without node materials: zeros, and bad points refused */
+    {
+        lb_scene *sc = parse_text("{\"format\": \"libblend-scene\", \"version\": 1, "
+                                  "\"convention\": \"zero\", \"root\": " A_ZERO "}}");
+        const double x[2] = {0, NAN}, y[2] = {0, 0}, z[2] = {0, 0};
+        uint32_t idx[2] = {7, 7};
+        lb_error e = {LB_OK, ""};
+        assert_int_equal(lb_scene_material_count(sc), 1);
+        assert_int_equal(lb_scene_material_index(sc, NULL, 2, x, y, z, idx, &e), LB_OK);
+        assert_true(idx[0] == 0 && idx[1] == 0);
+        lb_scene_free(sc);
+        sc = parse_text("{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": "
+                        "\"zero\", \"root\": {\"type\": \"min\", \"args\": [" A_ZERO
+                        ", \"material\": " RED "}, " B_ZERO "}]}}");
+        assert_int_equal(lb_scene_material_index(sc, NULL, 2, x, y, z, idx, &e),
+                         LB_ERR_INVALID_ARGUMENT);
+        assert_non_null(strstr(e.message, "point 1"));
+        lb_scene_free(sc);
+    }
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_materials),
         cmocka_unit_test(test_compiled_matches_reference),
         cmocka_unit_test(test_gradients_against_differences),
         cmocka_unit_test(test_bounds_contain_samples),

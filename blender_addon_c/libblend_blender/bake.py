@@ -48,9 +48,12 @@ def frame_path(folder_, frame):
 class CachedMesh:
     """What the mesher returns (positions, normals, triangles), read from a file."""
 
-    def __init__(self, positions, normals, triangles, resolution):
+    def __init__(self, positions, normals, triangles, resolution, material_index=None,
+                 materials=None):
         self.positions, self.normals, self.triangles = positions, normals, triangles
         self.resolution = resolution
+        # the nodes' materials, when the scene names any (live.set_materials)
+        self.material_index, self.materials = material_index, materials
 
 
 def write(path, mesh, key, frame, resolution, name):
@@ -59,14 +62,19 @@ def write(path, mesh, key, frame, resolution, name):
     d = os.path.dirname(path)
     os.makedirs(d, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=".frame-", suffix=".tmp", dir=d)
-    meta = json.dumps({"format": FORMAT, "version": VERSION, "frame": frame,
-                       "resolution": resolution, "field": name})
+    info = {"format": FORMAT, "version": VERSION, "frame": frame, "resolution": resolution,
+            "field": name}
+    arrays = {}
+    if getattr(mesh, "materials", None):
+        info["materials"] = mesh.materials
+        arrays["material_index"] = np.asarray(mesh.material_index, dtype=np.uint32)
+    meta = json.dumps(info)
     try:
         with os.fdopen(fd, "wb") as f:
             np.savez(f, positions=np.asarray(mesh.positions, dtype=np.float32),
                      normals=np.asarray(mesh.normals, dtype=np.float32),
                      triangles=np.asarray(mesh.triangles, dtype=np.int32),
-                     key=np.array(key), meta=np.array(meta))
+                     key=np.array(key), meta=np.array(meta), **arrays)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -94,12 +102,16 @@ def read(path, key=None):
             if key is not None and str(z["key"]) != key:
                 return None
             pos, nrm, tri = z["positions"], z["normals"], z["triangles"]
+            mats = meta.get("materials")
+            midx = z["material_index"] if mats else None
     except (OSError, ValueError, KeyError) as e:
         raise CacheError("%s: unreadable bake file (%s). Fix: bake again" % (path, e)) from None
     if pos.ndim != 2 or pos.shape[1:] != (3,) or nrm.shape != pos.shape or tri.ndim != 2 or \
             tri.shape[1:] != (3,) or (len(tri) and (tri.min() < 0 or tri.max() >= len(pos))):
         raise CacheError("%s: damaged bake file (array shapes or indices). Fix: bake again" % path)
-    return CachedMesh(pos, nrm, tri, meta.get("resolution", 0))
+    if mats and (midx.shape != (len(tri),) or (len(tri) and int(midx.max()) >= len(mats))):
+        raise CacheError("%s: damaged bake file (material indices). Fix: bake again" % path)
+    return CachedMesh(pos, nrm, tri, meta.get("resolution", 0), midx, mats)
 
 
 def frames(folder_):

@@ -80,6 +80,11 @@ class _PovOptions(ctypes.Structure):
                 ("threads", ctypes.c_int)]
 
 
+class _Material(ctypes.Structure):
+    _fields_ = [("color", ctypes.c_double * 3), ("ambient", ctypes.c_double),
+                ("diffuse", ctypes.c_double), ("specular", ctypes.c_double)]
+
+
 class _Stats(ctypes.Structure):
     _fields_ = [("nodes", ctypes.c_size_t), ("primitives", ctypes.c_size_t),
                 ("operators", ctypes.c_size_t), ("depth", ctypes.c_size_t)]
@@ -102,6 +107,9 @@ _SIGNATURES = {
     "lb_scene_bounds": (ctypes.c_int, [_P, _D, _D]),
     "lb_scene_stats_get": (None, [_P, ctypes.POINTER(_Stats)]),
     "lb_scene_describe": (ctypes.c_size_t, [_P, ctypes.c_char_p, ctypes.c_size_t]),
+    "lb_scene_material_count": (ctypes.c_size_t, [_P]),
+    "lb_scene_material": (ctypes.c_int, [_P, ctypes.c_size_t, ctypes.POINTER(_Material)]),
+    "lb_scene_material_index": (ctypes.c_int, [_P, _P, ctypes.c_size_t, _D, _D, _D, _U32, _ERR]),
     "lb_evaluator_create": (ctypes.c_int, [_P, ctypes.POINTER(_P), _ERR]),
     "lb_evaluator_free": (None, [_P]),
     "lb_evaluator_size": (ctypes.c_size_t, [_P]),
@@ -268,6 +276,30 @@ class Scene(_Handle):
         self.lib._c.lb_scene_describe(self.ptr, buf, n + 1)
         return buf.value.decode("utf-8", "replace")
 
+    def materials(self):
+        """The scene's materials as dicts (color, ambient, diffuse, specular);
+        the first is the render section's, then those the nodes name."""
+        out = []
+        for i in range(self.lib._c.lb_scene_material_count(self.ptr)):
+            m = _Material()
+            self.lib._c.lb_scene_material(self.ptr, i, ctypes.byref(m))
+            out.append({"color": tuple(m.color), "ambient": m.ambient, "diffuse": m.diffuse,
+                        "specular": m.specular})
+        return out
+
+    def material_index(self, evaluator, points):
+        """The material (an index into materials()) each point's surface takes
+        (lb_scene_material_index); points: (n, 3). Returns uint32 (n,)."""
+        _need_numpy()
+        P = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3).T)
+        idx = np.zeros(P.shape[1], dtype=np.uint32)
+        err = _Error()
+        st = self.lib._c.lb_scene_material_index(
+            self.ptr, evaluator.ptr if evaluator is not None else None, P.shape[1], _dptr(P[0]),
+            _dptr(P[1]), _dptr(P[2]), idx.ctypes.data_as(_U32), ctypes.byref(err))
+        self.lib._check(st, err, "material index")
+        return idx
+
     def compile(self):
         """Compile into an Evaluator (independent of this scene afterwards)."""
         out, err = _P(), _Error()
@@ -396,6 +428,9 @@ class Mesh:
         # with mesh(edges=True): the unique edges (e, 2) uint32, smaller vertex
         # first, and each triangle corner's edge (3 t,) uint32 (lb_mesh_edges)
         self.edges = self.corner_edges = None
+        # set by the add-on when the scene's nodes name materials: each
+        # triangle's material index and the materials (Scene.materials)
+        self.material_index = self.materials = None
 
     def volume(self):
         """Enclosed volume (divergence theorem); exact for a closed mesh."""

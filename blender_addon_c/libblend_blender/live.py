@@ -67,12 +67,19 @@ class _Job:
         self.done = threading.Event()
 
     def run(self):
+        import numpy as np
         t0 = time.perf_counter()
         try:
             with self.lib.parse_scene(self.text, self.name) as scene, scene.compile() as ev:
                 self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
                                     open_boundary=self.open_boundary, threads=self.threads,
                                     cancel=self.cancel, edges=compat.takes_libblend_edges())
+                mats = scene.materials()
+                if len(mats) > 1 and len(self.mesh.triangles):
+                    # each triangle takes the material at its centroid
+                    P = self.mesh.positions[self.mesh.triangles.astype(np.int64)].mean(axis=1)
+                    self.mesh.material_index = scene.material_index(ev, P)
+                    self.mesh.materials = mats
         except binding.Cancelled:
             self.error = None
         except binding.LibblendError as e:
@@ -155,11 +162,44 @@ def set_mesh_data(me, mesh, normals="AUTO"):
         compat.set_triangles(me, nt)
         compat.set_edges(me, getattr(mesh, "edges", None), getattr(mesh, "corner_edges", None))
         me.polygons.foreach_set("use_smooth", np.ones(nt, dtype=bool))
+        if getattr(mesh, "materials", None):
+            set_materials(me, mesh)
         if wants_analytic(normals, nt):
             set_normals(me, mesh.normals)
         else:
             compat.clear_custom_normals(me)
     me.update()
+
+
+def set_materials(me, mesh):
+    """The nodes' materials as material slots (slot i is libblend's material
+    i; slot 0, the render section's, is kept when it is there) and each
+    face's slot. A slot's Blender material is made once and updated only
+    when the scene's material changes, so edits made in Blender stay."""
+    import numpy as np
+    for i, m in enumerate(mesh.materials):
+        if i == 0 and len(me.materials):
+            continue
+        name = "%s material %d" % (me.name, i)
+        key = json.dumps(m, sort_keys=True)
+        bm = me.materials[i] if i < len(me.materials) else None
+        if bm is None:
+            bm = bpy.data.materials.get(name) or bpy.data.materials.new(name)
+        if bm.get("libblend_material") != key:
+            bm["libblend_material"] = key
+            bm.use_nodes = True
+            bsdf = bm.node_tree.nodes.get("Principled BSDF")
+            names = compat.principled_inputs()
+            if bsdf is not None:
+                bsdf.inputs[names["color"]].default_value = list(m["color"]) + [1.0]
+                bsdf.inputs[names["specular"]].default_value = m["specular"]
+                bsdf.inputs[names["roughness"]].default_value = 0.4
+            bm.diffuse_color = list(m["color"]) + [1.0]
+        if i < len(me.materials):
+            me.materials[i] = bm
+        else:
+            me.materials.append(bm)
+    me.polygons.foreach_set("material_index", mesh.material_index.astype(np.int32))
 
 
 # --------------------------------------------------------------------------- jobs

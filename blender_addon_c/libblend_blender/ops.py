@@ -464,9 +464,9 @@ class LIBBLEND_OT_apply(bpy.types.Operator):
             return _refused(self, e, paths)
         name = out.name
         me = bpy.data.meshes.new(name)
-        live.set_mesh_data(me, job.mesh, out.libblend.normals)
-        for m in out.data.materials:
+        for m in out.data.materials:  # first: the nodes' materials reuse these slots
             me.materials.append(m)
+        live.set_mesh_data(me, job.mesh, out.libblend.normals)
         obj = bpy.data.objects.new(name + " mesh", me)
         for c in out.users_collection:
             c.objects.link(obj)

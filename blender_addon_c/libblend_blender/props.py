@@ -170,6 +170,18 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
     local_extra: StringProperty(name="More Keys", description="feature_size, limits and alpha "
                                 "of the scene file, kept for export (JSON)", update=_changed)
 
+    # ---- this node's own material (the scene file's "material" on the node)
+    has_material: BoolProperty(name="Own Material", description="this node's surface (and what "
+                               "it decides below it) takes its own colour and finish",
+                               default=False, update=_changed)
+    material_color: FloatVectorProperty(name="Colour", subtype="COLOR", size=3, min=0.0, max=1.0,
+                                        default=(0.8, 0.8, 0.8), update=_changed)
+    material_specular: FloatProperty(name="Specular", min=0.0, max=1.0, default=0.3,
+                                     update=_changed)
+    material_extra: StringProperty(name="Kept Finish", description="ambient and diffuse of the "
+                                   "scene file's material, kept for export (JSON)",
+                                   update=_changed)
+
     # ---- this node as an argument of its parent blend
     arg_override: BoolProperty(name="Own r / p / m", description="use this argument's own "
                                "r, p, m instead of the parent blend's", update=_changed)

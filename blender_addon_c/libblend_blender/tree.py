@@ -185,6 +185,21 @@ def _per_arg(blend, args, key):
     return vals[0] if all(v == vals[0] for v in vals) else vals
 
 
+def _material(obj, out):
+    """The node's own material into its scene dict."""
+    s = obj.libblend
+    if not s.has_material:
+        return
+    try:
+        mat = json.loads(s.material_extra) if s.material_extra else {}
+    except ValueError:
+        raise TreeError("object '%s': its kept finish is not JSON; clear it" % obj.name) from None
+    mat = {k: v for k, v in mat.items() if k in ("ambient", "diffuse")}
+    mat["color"] = vec(s.material_color)
+    mat["specular"] = f32(s.material_specular)
+    out["material"] = mat
+
+
 def _node(obj, path, paths, convention, depth, dg=None):
     if depth > 64:
         raise TreeError("object '%s': the tree is nested deeper than 64 levels; allowed: 64 "
@@ -199,6 +214,7 @@ def _node(obj, path, paths, convention, depth, dg=None):
         if convention == "soft":
             out["kernel"] = s.kernel
         _transform(obj, out, True)
+        _material(obj, out)
         if children(obj, "ARG", dg):
             raise TreeError("object '%s': a primitive cannot have arguments (child '%s'). Fix: "
                             "parent '%s' to a blend node instead"
@@ -248,6 +264,7 @@ def _node(obj, path, paths, convention, depth, dg=None):
                                 % obj.name) from None
             out.update({k: v for k, v in extra.items() if k in LOCAL_EXTRA})
     _transform(obj, out, False)
+    _material(obj, out)
     out["args"] = [_node(a, "%s.args[%d]" % (path, i), paths, convention, depth + 1, dg)
                    for i, a in enumerate(args)]
     if "bounds" in keys:
@@ -384,6 +401,9 @@ def from_scene(scene, collection, name="libblend field"):
         if "ref" in node:
             M = _basis(node) if outer is None else outer @ _basis(node)
             target = defs[node["ref"]]
+            if "material" in node and "material" not in target:
+                # a ref's material is its def's unless the def names one (libblend's rule)
+                target = dict(target, material=node["material"])
             if outer is None and "ref" not in target and not any(k in target for k in TKEYS):
                 # the common case: the ref's transform is the node's, exactly
                 target = dict(target, **{k: node[k] for k in TKEYS if k in node})
@@ -407,6 +427,13 @@ def from_scene(scene, collection, name="libblend field"):
             return build(node, wrap, "ARG", 0)
         st = obj.libblend
         st.role, st.order = role, order
+        if "material" in node:
+            m = node["material"]
+            st.has_material = True
+            st.material_color = m.get("color", (0.8, 0.8, 0.8))
+            st.material_specular = m.get("specular", 0.3)
+            kept = {k: m[k] for k in ("ambient", "diffuse") if k in m}
+            st.material_extra = json.dumps(kept) if kept else ""
         if "args" not in node:
             st.kind = "PRIMITIVE"
             st.prim_type = node["type"]

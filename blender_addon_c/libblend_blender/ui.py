@@ -81,6 +81,12 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
             self._primitive(layout, obj)
         else:
             self._blend(layout, obj)
+        if s.kind != "OUTPUT" and s.role == "ARG":
+            row = layout.row(align=True)
+            row.prop(s, "has_material")
+            if s.has_material:
+                row.prop(s, "material_color", text="")
+                row.prop(s, "material_specular")
         if s.kind != "OUTPUT" and obj.parent is not None and obj.parent.libblend.kind == "BLEND" \
                 and s.role == "ARG":
             self._as_argument(layout, obj)

@@ -17,6 +17,7 @@
 #define LIBBLEND_COMMON_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #if defined(_WIN32)
 #if defined(LIBBLEND_BUILDING)

@@ -49,11 +49,18 @@ extern "C" {
 #define LB_SCENE_MAX_COORD 1e9
 
 typedef struct lb_scene lb_scene;
+typedef struct lb_evaluator lb_evaluator;
 
 typedef enum lb_convention {
     LB_CONVENTION_ZERO = 0, /* inside f < 0, surface f = 0 */
     LB_CONVENTION_SOFT = 1  /* inside f > 0.5, surface f = 0.5, f in [0, 1] */
 } lb_convention;
+
+/* A surface material: colour and finish, each component in [0, 1]. */
+typedef struct lb_material {
+    double color[3];
+    double ambient, diffuse, specular;
+} lb_material;
 
 /* The optional "render" section, with defaults filled in (docs/scene-format.md). */
 typedef struct lb_render_light {
@@ -71,8 +78,8 @@ typedef struct lb_render {
     double angle;       /* horizontal field of view in degrees, (0, 180) */
     size_t light_count; /* 0: exporters use their default three-point lights */
     lb_render_light lights[LB_SCENE_MAX_LIGHTS];
-    double color[3];                   /* material colour, each in [0, 1] */
-    double ambient, diffuse, specular; /* material finish, each in [0, 1] */
+    double color[3];                   /* material 0's colour, each in [0, 1] */
+    double ambient, diffuse, specular; /* material 0's finish, each in [0, 1] */
     int floor;                         /* 1 (default): a floor under the surface, taking shadows */
     double floor_color[3];             /* default 0.75 grey */
     double background[3];              /* default a neutral 0.9 grey */
@@ -109,6 +116,32 @@ LB_API const lb_render *lb_scene_render(const lb_scene *scene);
 
 LB_API void lb_scene_stats_get(const lb_scene *scene, lb_scene_stats *stats);
 
+/* ---- materials (docs/scene-format.md, "Materials") --------------------------
+ * Material 0 is the render section's; every distinct "material" a node
+ * names is one more. A surface point takes the material of the node found
+ * by walking down from the root: at each operator, into the argument that
+ * decides the set operation there (a union's most-inside argument, an
+ * intersection's most-outside one, a difference's most-outside among the
+ * first and the complements of the others), until the subtree below holds
+ * no material of its own; a node without one takes its parent's. */
+
+/* Number of materials, 1 + those the nodes name (0 for NULL). */
+LB_API size_t lb_scene_material_count(const lb_scene *scene);
+
+/* Material i into *out; returns 1, or 0 (and leaves *out) when i is out of
+ * range or an argument is NULL. */
+LB_API int lb_scene_material(const lb_scene *scene, size_t i, lb_material *out);
+
+/* The material index of each of n points (structure of arrays) by the rule
+ * above, into index (n entries, caller-owned). ev is the scene's compiled
+ * evaluator (needed when the scene has a local_union; may be NULL
+ * otherwise). A scene whose nodes name no material fills zeros without
+ * evaluating. Cost: one reference walk of each decided operator's arguments
+ * per point; runs on the calling thread. */
+LB_API lb_status lb_scene_material_index(const lb_scene *scene, const lb_evaluator *ev, size_t n,
+                                         const double *x, const double *y, const double *z,
+                                         uint32_t *index, lb_error *err);
+
 /* Write the tree as indented text (one node per line, shared defs printed
  * once and referenced by name afterwards) into buf, NUL-terminated and
  * truncated to size. Returns the length the whole text needs (without the
@@ -124,8 +157,6 @@ LB_API lb_status lb_scene_eval_reference(const lb_scene *scene, const double X[3
                                          double grad[3], lb_error *err);
 
 /* ---- compiled evaluator ---------------------------------------------------- */
-
-typedef struct lb_evaluator lb_evaluator;
 
 /* Compile a scene into a flat instruction tape: every distinct node (a
  * shared def under the same transform) becomes one instruction, transforms

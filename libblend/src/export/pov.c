@@ -78,6 +78,7 @@ typedef struct pctx {
     int *lflag;
     size_t nl, lcap;
     lb_error *err;
+    int ntex; /* material textures written (tex) */
 } pctx;
 
 /* Does the subtree hold a local_union? (memoised: scenes are DAGs) Such
@@ -479,6 +480,129 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
     return LB_OK;
 }
 
+/* ---- materials: the material rule (scene/material.c) as textures ----
+ *
+ * A texture per operator where the material is decided: a function
+ * pattern that is 0.75 where the first group of arguments (those with the
+ * same texture) has the smallest score and 0.25 elsewhere, mapping to that
+ * group's texture or to the rest's. The arguments' functions are the ones
+ * the field is written with, called in the operator's frame. */
+
+#define LB_POV_MAX_TEXTURES 4096
+
+/* the id a node was written under for the world frame F (its own frame) */
+static int written_id(pctx *c, const lb__node *n, const lb__affine *F) {
+    const int keyed = has_local(c, n);
+    for (size_t i = 0; i < c->ndone; ++i)
+        if (c->done[i] == n && (!keyed || memcmp(&c->doneA[i], F, sizeof *F) == 0))
+            return c->ids[i];
+    return -1;
+}
+
+static void score_expr(pctx *c, const lb__node *n, size_t i, int fid, const lb__affine *A) {
+    double sign, off;
+    lb__material_score(n, c->sc->convention, i, &sign, &off);
+    sb(c->b, "%s%sLBn%d(", off != 0.0 ? "1" : "", sign < 0 ? "-" : off != 0.0 ? "+" : "", fid);
+    if (lb__affine_is_identity(A)) {
+        sb(c->b, "x, y, z)");
+        return;
+    }
+    for (int r = 0; r < 3; ++r)
+        sb(c->b, "%s%.17g * x + %.17g * y + %.17g * z + %.17g", r ? ", " : "", A->M[3 * r],
+           A->M[3 * r + 1], A->M[3 * r + 2], A->t[r]);
+    sb(c->b, ")");
+}
+
+/* the scores of the arguments in group g (their texture is names[g]) */
+static void group_expr(pctx *c, const lb__node *n, const int *group, int g, const int *fid,
+                       const lb__affine *A) {
+    int count = 0;
+    for (size_t i = 0; i < n->k; ++i) count += group[i] == g;
+    if (count > 1) sb(c->b, "min(");
+    for (size_t i = 0, w = 0; i < n->k; ++i)
+        if (group[i] == g) {
+            if (w++) sb(c->b, ", ");
+            score_expr(c, n, i, fid[i], A);
+        }
+    if (count > 1) sb(c->b, ")");
+}
+
+/* name (at least 24 bytes) receives the texture of n's surface: Ap maps
+ * world coordinates to n's parent frame, inh is the inherited material */
+static lb_status tex(pctx *c, const lb__node *n, const lb__affine *Ap, size_t inh, char *name) {
+    const size_t eff = n->mat ? n->mat : inh;
+    if (!n->mat_below) {
+        snprintf(name, 24, "LBmat%zu", eff);
+        return LB_OK;
+    }
+    lb__affine A = *Ap;
+    if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
+    if (n->k == 1) return tex(c, n->args[0], &A, eff, name);
+    const size_t k = n->k;
+    char(*sub)[24] = malloc(k * sizeof *sub);
+    int *fid = malloc(2 * k * sizeof *fid), *group = fid ? fid + k : NULL;
+    lb_status s = sub && fid ? LB_OK : lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    int G = 0;
+    for (size_t i = 0; i < k && !s; ++i) {
+        if ((s = tex(c, n->args[i], &A, eff, sub[i]))) break;
+        lb__affine F = A;
+        if (n->args[i]->has_transform) lb__affine_compose(&n->args[i]->to_local, &A, &F);
+        fid[i] = written_id(c, n->args[i], &F);
+        if (fid[i] < 0) {
+            s = lb__fail(c->err, LB_ERR_INTERNAL, "%s: %s: argument %zu was not written", FN,
+                         n->path, i);
+            break;
+        }
+        group[i] = -1;
+        for (size_t j = 0; j < i && group[i] < 0; ++j)
+            if (strcmp(sub[j], sub[i]) == 0) group[i] = group[j];
+        if (group[i] < 0) group[i] = G++;
+    }
+    if (!s && G == 1) memcpy(name, sub[0], 24);
+    /* the chain: group g against the groups after it, from the last pair up */
+    char rest[24] = "";
+    for (int g = G - 2; g >= 0 && !s; --g) {
+        if (++c->ntex > LB_POV_MAX_TEXTURES) {
+            s = lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
+                         "%s: %s: more than %d material textures (a def with materials used "
+                         "under many parents); allowed: at most %d",
+                         FN, n->path, LB_POV_MAX_TEXTURES, LB_POV_MAX_TEXTURES);
+            break;
+        }
+        if (g == G - 2)
+            for (size_t i = 0; i < k; ++i)
+                if (group[i] == G - 1) memcpy(rest, sub[i], 24);
+        const char *mine = NULL;
+        for (size_t i = 0; i < k && !mine; ++i)
+            if (group[i] == g) mine = sub[i];
+        const int t = c->ntex;
+        sb(c->b, "#declare LBq%d = function(x, y, z) { select(", t);
+        group_expr(c, n, group, g, fid, &A);
+        sb(c->b, " - %s", G - g > 2 ? "min(" : "");
+        for (int h = g + 1; h < G; ++h) {
+            if (h > g + 1) sb(c->b, ", ");
+            group_expr(c, n, group, h, fid, &A);
+        }
+        sb(c->b, "%s, 0.75, 0.25) }\n", G - g > 2 ? ")" : "");
+        sb(c->b,
+           "#declare LBt%d = texture { function { LBq%d(x, y, z) } texture_map { [0.5 %s] [0.5 "
+           "%s] } }\n",
+           t, t, rest, mine);
+        snprintf(rest, sizeof rest, "LBt%d", t);
+    }
+    if (!s && G > 1) memcpy(name, rest, 24);
+    free(sub);
+    free(fid);
+    return s;
+}
+
+static void material_texture(sbuf *b, const lb_material *m) {
+    sb(b,
+       "texture { pigment { rgb <%.17g, %.17g, %.17g> } finish { ambient %.17g diffuse %.17g "
+       "specular %.17g } }",
+       m->color[0], m->color[1], m->color[2], m->ambient, m->diffuse, m->specular);
+}
+
 void lb_pov_camera(const lb_scene *scene, double aspect, double loc[3], double at[3], double up[3],
                    double *angle) {
     (void)aspect;
@@ -667,8 +791,8 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
     for (int d = 0; d < 3; ++d) diag += (hi[d] - lo[d]) * (hi[d] - lo[d]);
     diag = sqrt(diag);
     sbuf b = {NULL, 0, 0, 0};
-    pctx c = {&b, scene,      NULL, NULL, 0,    0, 0, 1e-5 * diag,
-              ev, {{0}, {0}}, NULL, NULL, NULL, 0, 0, err};
+    pctx c = {&b,   scene, NULL, NULL, 0, 0,   0, 1e-5 * diag, ev, {{0}, {0}},
+              NULL, NULL,  NULL, 0,    0, err, 0};
     lb__affine_identity(&c.A);
     sb(&b, "// written by libblend %d.%d.%d (blendtool pov)\n", LB_VERSION_MAJOR, LB_VERSION_MINOR,
        LB_VERSION_PATCH);
@@ -740,17 +864,41 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
                up[0], up[1], up[2], h, R->floor_color[0], R->floor_color[1], R->floor_color[2]);
         }
         const int soft = scene->convention == LB_CONVENTION_SOFT;
-        sb(&b,
-           "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
-           "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
-           "  max_gradient %.17g\n  accuracy %.17g\n"
-           "  texture { pigment { rgb <%.17g, %.17g, %.17g> } finish { ambient %.17g diffuse "
-           "%.17g specular %.17g } }\n}\n",
-           soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
-           1e-4 * diag, o.silhouette ? 1.0 : R->color[0], o.silhouette ? 1.0 : R->color[1],
-           o.silhouette ? 1.0 : R->color[2], o.silhouette ? 1.0 : R->ambient,
-           o.silhouette ? 0.0 : R->diffuse, o.silhouette ? 0.0 : R->specular);
+        char texname[24] = "";
+        if (!o.silhouette && lb_scene_material_count(scene) > 1) {
+            sb(&b, "\n");
+            for (size_t i = 0; i < lb_scene_material_count(scene); ++i) {
+                lb_material m;
+                lb_scene_material(scene, i, &m);
+                sb(&b, "#declare LBmat%zu = ", i);
+                material_texture(&b, &m);
+                sb(&b, "\n");
+            }
+            lb__affine id;
+            lb__affine_identity(&id);
+            s = tex(&c, scene->root, &id, 0, texname);
+        }
+        if (s) goto out;
+        if (texname[0]) {
+            sb(&b,
+               "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
+               "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
+               "  max_gradient %.17g\n  accuracy %.17g\n  texture { %s }\n}\n",
+               soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
+               1e-4 * diag, texname);
+        } else
+            sb(&b,
+               "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
+               "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
+               "  max_gradient %.17g\n  accuracy %.17g\n"
+               "  texture { pigment { rgb <%.17g, %.17g, %.17g> } finish { ambient %.17g diffuse "
+               "%.17g specular %.17g } }\n}\n",
+               soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
+               1e-4 * diag, o.silhouette ? 1.0 : R->color[0], o.silhouette ? 1.0 : R->color[1],
+               o.silhouette ? 1.0 : R->color[2], o.silhouette ? 1.0 : R->ambient,
+               o.silhouette ? 0.0 : R->diffuse, o.silhouette ? 0.0 : R->specular);
     }
+out:
     free(c.done);
     free(c.ids);
     free(c.doneA);

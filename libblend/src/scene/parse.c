@@ -327,7 +327,8 @@ static lb_status get_transform(pctx *c, const cJSON *obj, lb__node *n) {
 
 /* ---- type table ---- */
 
-#define TRANSFORM_KEYS "translate", "rotate", "scale"
+/* keys every node takes: its transform and its material */
+#define TRANSFORM_KEYS "translate", "rotate", "scale", "material"
 
 typedef struct type_info {
     const char *name;
@@ -504,6 +505,55 @@ static lb_status parse_primitive(pctx *c, const cJSON *j, const type_info *t, lb
     return LB_OK;
 }
 
+/* ---- materials ---- */
+
+/* {"color", "ambient", "diffuse", "specular"} into *m; fields left out keep
+ * what *m holds. */
+static lb_status material_fields(pctx *c, const cJSON *mat, lb_material *m) {
+    static const char *const mat_keys[] = {"color", "ambient", "diffuse", "specular", NULL};
+    lb_status s;
+    if (!cJSON_IsObject(mat))
+        return perr(c, LB_ERR_INVALID_ARGUMENT,
+                    "expected an object, found %s; allowed: {\"color\": [r, g, b], "
+                    "\"ambient\": a, \"diffuse\": d, \"specular\": s}",
+                    json_kind(mat));
+    if ((s = check_keys(c, mat, mat_keys, "material")) ||
+        (s = get_vec3(c, mat, "color", 0, 0.0, 1.0, "0 <= value <= 1", m->color)) ||
+        (s = get_number(c, mat, "ambient", 0, 0.0, 1.0, "0 <= ambient <= 1", &m->ambient)) ||
+        (s = get_number(c, mat, "diffuse", 0, 0.0, 1.0, "0 <= diffuse <= 1", &m->diffuse)))
+        return s;
+    return get_number(c, mat, "specular", 0, 0.0, 1.0, "0 <= specular <= 1", &m->specular);
+}
+
+/* A node's own "material" (fields left out take the render section's):
+ * n->mat is its index, equal materials sharing one. */
+static lb_status node_material(pctx *c, const cJSON *j, lb__node *n) {
+    const cJSON *mat = cJSON_GetObjectItemCaseSensitive(j, "material");
+    if (!mat) return LB_OK;
+    const lb_render *R = &c->s->render;
+    lb_material m = {{R->color[0], R->color[1], R->color[2]}, R->ambient, R->diffuse, R->specular};
+    const size_t o = push_key(c, "material");
+    lb_status s = material_fields(c, mat, &m);
+    pop(c, o);
+    if (s) return s;
+    lb_scene *sc = c->s;
+    for (size_t i = 0; i < sc->nmats; ++i)
+        if (memcmp(&sc->mats[i], &m, sizeof m) == 0) {
+            n->mat = i + 1;
+            return LB_OK;
+        }
+    if (sc->nmats == sc->matcap) {
+        const size_t cap = sc->matcap ? 2 * sc->matcap : 8;
+        lb_material *a = realloc(sc->mats, cap * sizeof *a);
+        if (!a) return oom(c);
+        sc->mats = a;
+        sc->matcap = cap;
+    }
+    sc->mats[sc->nmats++] = m;
+    n->mat = sc->nmats;
+    return LB_OK;
+}
+
 /* ---- nodes ---- */
 
 static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **out);
@@ -565,17 +615,21 @@ static lb_status parse_ref(pctx *c, const cJSON *j, size_t depth, lb__node **out
     lb__node tmp;
     memset(&tmp, 0, sizeof tmp);
     if ((s = get_transform(c, j, &tmp))) return s;
-    if (!tmp.has_transform) {
+    const int has_mat = cJSON_GetObjectItemCaseSensitive(j, "material") != NULL;
+    if (!tmp.has_transform && !has_mat) {
         *out = target;
         return LB_OK;
     }
+    /* a ref with its own transform or material is a group over the def */
     lb__node *g = new_node(c, LB__F_GROUP, "ref");
     if (!g) return oom(c);
     g->k = 1;
     g->args = malloc(sizeof *g->args);
     if (!g->args) return oom(c);
     g->args[0] = target;
-    g->has_transform = 1;
+    if ((s = node_material(c, j, g))) return s;
+    g->mat_below = target->mat || target->mat_below;
+    g->has_transform = tmp.has_transform;
     g->to_local = tmp.to_local;
     g->to_parent = tmp.to_parent;
     g->depth = target->depth + 1;
@@ -882,7 +936,7 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
     }
     lb__node *n = new_node(c, t->family, t->name);
     if (!n) return oom(c);
-    if ((s = get_transform(c, j, n))) return s;
+    if ((s = get_transform(c, j, n)) || (s = node_material(c, j, n))) return s;
     if (t->family == LB__F_PRIMITIVE) {
         if ((s = parse_primitive(c, j, t, n))) return s;
         *out = n;
@@ -999,6 +1053,16 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
     }
     for (size_t i = 0; i < k; ++i) {
         const lb__node *a = n->args[i];
+        n->mat_below |= a->mat || a->mat_below;
+        if (n->bounds && (n->bounds[i]->mat || n->bounds[i]->mat_below)) {
+            const size_t o1 = push_key(c, "bounds"), o2 = push_index(c, i);
+            s = perr(c, LB_ERR_INVALID_ARGUMENT,
+                     "a bounding solid has a material, but it is never on the surface; "
+                     "allowed: materials on args (remove it here)");
+            pop(c, o2);
+            pop(c, o1);
+            return s;
+        }
         if (a->depth + 1 > n->depth) n->depth = a->depth + 1;
         if (a->bulge_depth > n->bulge_depth) n->bulge_depth = a->bulge_depth;
         if (n->bounds && n->bounds[i]->depth + 1 > n->depth) n->depth = n->bounds[i]->depth + 1;
@@ -1080,7 +1144,6 @@ static lb_status parse_render(pctx *c, const cJSON *root) {
     static const char *const cam_keys[] = {"location", "look_at", "up", "angle", NULL};
     static const char *const floor_keys[] = {"color", NULL};
     static const char *const light_keys[] = {"location", "color", NULL};
-    static const char *const mat_keys[] = {"color", "ambient", "diffuse", "specular", NULL};
     const double CM = LB_SCENE_MAX_COORD;
     const size_t old = push_key(c, "render");
     lb_status s = LB_OK;
@@ -1156,18 +1219,16 @@ static lb_status parse_render(pctx *c, const cJSON *root) {
     }
     const cJSON *mat = cJSON_GetObjectItemCaseSensitive(r, "material");
     if (mat) {
+        lb_material m = {
+            {R->color[0], R->color[1], R->color[2]}, R->ambient, R->diffuse, R->specular};
         const size_t o = push_key(c, "material");
-        if (!cJSON_IsObject(mat))
-            s = perr(c, LB_ERR_INVALID_ARGUMENT, "expected an object, found %s", json_kind(mat));
-        else if (!(s = check_keys(c, mat, mat_keys, "material")) &&
-                 !(s = get_vec3(c, mat, "color", 0, 0.0, 1.0, "0 <= value <= 1", R->color)) &&
-                 !(s = get_number(c, mat, "ambient", 0, 0.0, 1.0, "0 <= ambient <= 1",
-                                  &R->ambient)) &&
-                 !(s = get_number(c, mat, "diffuse", 0, 0.0, 1.0, "0 <= diffuse <= 1",
-                                  &R->diffuse)))
-            s = get_number(c, mat, "specular", 0, 0.0, 1.0, "0 <= specular <= 1", &R->specular);
+        s = material_fields(c, mat, &m);
         pop(c, o);
         if (s) goto done;
+        memcpy(R->color, m.color, sizeof m.color);
+        R->ambient = m.ambient;
+        R->diffuse = m.diffuse;
+        R->specular = m.specular;
     }
     const cJSON *fl = cJSON_GetObjectItemCaseSensitive(r, "floor");
     if (fl) {

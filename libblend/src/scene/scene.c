@@ -21,6 +21,7 @@ void lb_scene_free(lb_scene *s) {
         free(n);
     }
     free(s->nodes);
+    free(s->mats);
     free(s->name);
     free(s);
 }
@@ -243,6 +244,16 @@ static lb_status ref_local(const lb__node *n, lb_convention conv, const lb__affi
         gv[d] = kout * (kin * du + dv);
     }
     return LB_OK;
+}
+
+static lb_status ref_eval(const lb__node *n, lb_convention conv, const lb__affine *Ap,
+                          const lb_evaluator *ev, const double X[3], double *v, double g[3],
+                          lb_error *err);
+
+lb_status lb__ref_eval(const lb__node *n, lb_convention conv, const lb__affine *Ap,
+                       const lb_evaluator *ev, const double X[3], double *v, double g[3],
+                       lb_error *err) {
+    return ref_eval(n, conv, Ap, ev, X, v, g, err);
 }
 
 static lb_status ref_eval(const lb__node *n, lb_convention conv, const lb__affine *Ap,

@@ -71,6 +71,8 @@ struct lb__node {
     size_t bulge_depth;  /* bulge nodes on the longest path down (4 re-evaluations each) */
     double walk_cost;    /* nodes the reference walk visits per point (shared nodes per use) */
     lb__local_params lp; /* LB__F_LOCAL, LB__F_CLEAN */
+    size_t mat;          /* its own "material": index into the scene's materials, 0 = inherited */
+    int mat_below;       /* some node strictly below (args only) has its own material */
 };
 
 struct lb_scene {
@@ -82,6 +84,10 @@ struct lb_scene {
     lb__node **nodes; /* every node, for freeing */
     size_t nnodes, cap;
     char *name; /* file name for messages */
+    /* materials named by nodes: mats[i - 1] is material i (0 is the render
+     * section's); equal materials share one index */
+    lb_material *mats;
+    size_t nmats, matcap;
 };
 
 /* affine helpers (scene/affine.c) */
@@ -99,6 +105,19 @@ LB_INTERNAL int lb__affine_is_identity(const lb__affine *a);
 LB_INTERNAL lb_status lb__node_apply(const lb__node *n, lb_convention conv, const double *x,
                                      const double *c, const double *g, double *value, double *dx,
                                      double *dc, double *dg, lb_error *err);
+
+/* the reference walk of one node (scene/scene.c): Ap maps world
+ * coordinates to the node's parent frame; ev is needed for local_union */
+LB_INTERNAL lb_status lb__ref_eval(const lb__node *n, lb_convention conv, const lb__affine *Ap,
+                                   const lb_evaluator *ev, const double X[3], double *v,
+                                   double g[3], lb_error *err);
+
+/* materials (scene/material.c): the set operation n applies for the
+ * material rule, and the score (sign * a + offset, smallest decides) of
+ * argument i's value a */
+LB_INTERNAL lb_setop lb__material_op(const lb__node *n);
+LB_INTERNAL void lb__material_score(const lb__node *n, lb_convention conv, size_t i, double *sign,
+                                    double *offset);
 
 /* local_union / clean_union (scene/apply.c): children in the soft form the
  * operators take (zero convention: g = C (1 - f / zero_scale), C = 0.5),
