@@ -56,6 +56,8 @@ BLENDS_BOTH = [
     ("local_union", "Local Union", "blends only around the intersection curves (Bernhardt et al. "
      "2010): the exact union elsewhere"),
     ("clean_union", "Clean Union", "the exact union surface, C1 elsewhere, no blend"),
+    ("level", "Level", "its argument's level set at Level is the surface (zero: an offset "
+     "surface; soft: another threshold)"),
 ]
 BLENDS = BLENDS_ZERO + [b for b in BLENDS_SOFT] + BLENDS_BOTH
 OPS = [("union", "Union", ""), ("intersection", "Intersection", ""),
@@ -149,6 +151,9 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
     conic_p: FloatProperty(name="Conic p", description="conic shape, below r1 r2 (0 = quarter "
                            "ellipse)", default=0.0, update=_changed)
     ricci_n: FloatProperty(name="n", default=2.0, min=1.0, max=1000.0, update=_changed)
+    level: FloatProperty(name="Level", description="the argument's level set taken as the "
+                         "surface (zero convention: any value, an offset surface; soft: in (0, 1))",
+                         default=0.0, soft_min=-1.0, soft_max=1.0, update=_changed)
     bulge: BoolProperty(name="Bulge Elimination", default=False, update=_changed)
     bulge_range: BoolProperty(name="Range", default=True, update=_changed)
     bulge_slope: BoolProperty(name="Slope", default=False, update=_changed)

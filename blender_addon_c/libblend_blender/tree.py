@@ -30,6 +30,7 @@ BLEND_KEYS = {
     "soft_conic": ("op", "r", "conic_p", "m"),
     "soft_sum": (), "ricci": ("n",), "perlin": ("op",),
     "local_union": ("local", "zero_scale"), "clean_union": ("zero_scale",),
+    "level": ("level",),
 }
 #: local_union keys the panel does not show, kept as JSON text
 LOCAL_EXTRA = ("feature_size", "limits", "alpha")
@@ -243,6 +244,8 @@ def _node(obj, path, paths, convention, depth, dg=None):
         out["p"] = f32(s.conic_p)
     if "n" in keys:
         out["n"] = f32(s.ricci_n)
+    if "level" in keys:
+        out["level"] = f32(s.level)
     if "bulge" in keys and s.bulge:
         out["bulge"] = {"range": s.bulge_range, "slope": s.bulge_slope, "omega": f32(s.bulge_omega)}
     if "bulge_range" in keys and s.bulge:
@@ -459,6 +462,8 @@ def from_scene(scene, collection, name="libblend field"):
             st.conic_p = node["p"]
         if "n" in node:
             st.ricci_n = node["n"]
+        if "level" in node:
+            st.level = node["level"]
         if t == "local_union":
             st.local_support = node.get("support", "progressive")
             st.local_support_factor = node.get("support_factor", 0.25)

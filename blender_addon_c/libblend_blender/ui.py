@@ -180,6 +180,8 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
             layout.prop(s, "conic_p")
         if "n" in keys:
             layout.prop(s, "ricci_n")
+        if "level" in keys:
+            layout.prop(s, "level")
         if "local" in keys:
             layout.prop(s, "local_exponent")
             layout.prop(s, "local_support")

@@ -168,6 +168,29 @@ static void bounded_bounds(const lb__node *n, const iv *x, const iv *c, iv *out)
         }
         out->lo = unknown ? -BIG : L;
         out->hi = H;
+        /* Where every bounding value stays above -1 the union is monotone
+         * (non-decreasing) in each x_i and each c_i: with y = x + 1 and
+         * y_c = c + 1, R_i = y_i / y_ci - 1 turns argument i's term into
+         * [y_i (h - y_ci) / (h (y_i - y_ci))]+^p_i, which falls as y_i or
+         * y_ci grows (h <= y_i), so the root h rises; where R_i is floored
+         * at omega it no longer depends on c_i. The corners then bound it
+         * exactly; the brackets above stay as a safeguard. */
+        int mono = 1;
+        double xl[LB_MAX_ARITY], xh[LB_MAX_ARITY], cl[LB_MAX_ARITY], ch[LB_MAX_ARITY];
+        for (size_t i = 0; i < k && mono; ++i) {
+            mono = c[i].lo > -1.0;
+            xl[i] = x[i].lo;
+            xh[i] = x[i].hi;
+            cl[i] = c[i].lo;
+            ch[i] = c[i].hi;
+        }
+        double v1, v2;
+        if (mono &&
+            !lb__node_apply(n, LB_CONVENTION_ZERO, xl, cl, NULL, &v1, NULL, NULL, NULL, NULL) &&
+            !lb__node_apply(n, LB_CONVENTION_ZERO, xh, ch, NULL, &v2, NULL, NULL, NULL, NULL)) {
+            if (v1 > out->lo) out->lo = v1;
+            if (v2 < out->hi) out->hi = v2;
+        }
         return;
     }
     double pmin = n->p[0];

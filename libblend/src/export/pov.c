@@ -402,6 +402,15 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
         else
             sb(b, "#declare %s%d = function(x, y, z) { max(0, 1 - LBn%d(x, y, z)) }\n", name, id,
                a);
+    } else if (n->family == LB__F_LEVEL) {
+        int a;
+        if ((s = emit(c, n->args[0], &a))) return s;
+        if (c->sc->convention == LB_CONVENTION_ZERO)
+            sb(b, "#declare %s%d = function(x, y, z) { LBn%d(x, y, z) - %.17g }\n", name, id, a,
+               n->shape);
+        else
+            sb(b, "#declare %s%d = function(x, y, z) { max(0, LBn%d(x, y, z) - %.17g) }\n", name,
+               id, a, n->shape - 0.5);
     } else if (n->family == LB__F_RFUNCTION) {
         int a, d;
         if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;

@@ -92,6 +92,15 @@ lb_status lb__node_apply(const lb__node *n, lb_convention conv, const double *x,
     case LB__F_LOCAL: /* without its curves (the compiled evaluator has them): UC */
     case LB__F_CLEAN:
         return lb__clean_apply(n, conv, x, value, dx, err);
+    case LB__F_LEVEL: {
+        /* the argument's h-level set becomes the surface: zero f - h; soft
+         * f - h + 0.5, floored at 0 so the result stays a soft field */
+        const double v = conv == LB_CONVENTION_ZERO ? x[0] - n->shape : x[0] - n->shape + 0.5;
+        const int floored = conv == LB_CONVENTION_SOFT && v < 0.0;
+        *value = floored ? 0.0 : v;
+        if (dx) dx[0] = floored ? 0.0 : 1.0;
+        return LB_OK;
+    }
     case LB__F_GROUP:
         *value = x[0];
         if (dx) dx[0] = 1.0;

@@ -366,6 +366,7 @@ static const char *const k_soft[] = {"type", "op", "args", "r", "p", "m", TRANSF
 static const char *const k_args[] = {"type", "args", TRANSFORM_KEYS, NULL};
 static const char *const k_opargs[] = {"type", "op", "args", TRANSFORM_KEYS, NULL};
 static const char *const k_ricci[] = {"type", "args", "n", TRANSFORM_KEYS, NULL};
+static const char *const k_level[] = {"type", "args", "level", TRANSFORM_KEYS, NULL};
 static const char *const k_local[] = {"type",   "args",       "feature_size",   "limits",
                                       "radius", "support",    "support_factor", "exponent",
                                       "alpha",  "zero_scale", TRANSFORM_KEYS,   NULL};
@@ -398,13 +399,15 @@ static const type_info TYPES[] = {
     {"complement", LB__F_COMPLEMENT, 0, CONV_BOTH, 0, 1, 1, k_args},
     {"local_union", LB__F_LOCAL, 0, CONV_BOTH, 0, 2, LB_MAX_ARITY, k_local},
     {"clean_union", LB__F_CLEAN, 0, CONV_BOTH, 0, 2, LB_MAX_ARITY, k_clean},
+    {"level", LB__F_LEVEL, 0, CONV_BOTH, 0, 1, 1, k_level},
 };
 #define NTYPES (sizeof TYPES / sizeof TYPES[0])
 
 static const char TYPE_LIST[] =
     "sphere, ellipsoid, lp, superquadric, slab, halfspace, cylinder, capsule, torus, "
     "displacement, conic, scale, bounded, soft_hyper, soft_conic, min, max, rfunction, "
-    "soft_sum, ricci, perlin, complement, local_union, clean_union (or {\"ref\": NAME})";
+    "soft_sum, ricci, perlin, complement, local_union, clean_union, level (or {\"ref\": "
+    "NAME})";
 
 /* ---- primitives ---- */
 
@@ -928,9 +931,9 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
                  t->name, t->conv == CONV_ZERO ? "zero" : "soft",
                  conv_bit == CONV_ZERO ? "zero" : "soft",
                  conv_bit == CONV_ZERO ? "displacement, conic, scale, bounded, rfunction, min, "
-                                         "max, complement, local_union, clean_union"
+                                         "max, complement, local_union, clean_union, level"
                                        : "soft_hyper, soft_conic, soft_sum, ricci, perlin, min, "
-                                         "max, complement, local_union, clean_union");
+                                         "max, complement, local_union, clean_union, level");
         pop(c, old);
         return s;
     }
@@ -1047,6 +1050,17 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
     case LB__F_RICCI:
         n->shape = 2.0;
         if ((s = get_number(c, j, "n", 1, 1.0, 1000.0, "1 <= n <= 1000", &n->shape))) return s;
+        break;
+    case LB__F_LEVEL:
+        /* zero: any level (an offset surface); soft: inside the field's [0, 1] */
+        if (c->s->convention == LB_CONVENTION_ZERO)
+            s = get_number(c, j, "level", 1, -1e9, 1e9, "|level| <= 1e9", &n->shape);
+        else
+            s = get_number(c, j, "level", 1, 1e-6, 1.0 - 1e-6,
+                           "0 < level < 1 (soft fields lie "
+                           "in [0, 1])",
+                           &n->shape);
+        if (s) return s;
         break;
     default:
         break;

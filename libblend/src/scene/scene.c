@@ -127,6 +127,7 @@ static void describe(lb__text *b, const lb__node *n, int indent, const char *rol
         if (n->family == LB__F_CONIC || n->family == LB__F_SOFT_CONIC)
             lb__text_put(b, " p=%g", n->shape);
         if (n->family == LB__F_RICCI) lb__text_put(b, " n=%g", n->shape);
+        if (n->family == LB__F_LEVEL) lb__text_put(b, " level=%g", n->shape);
         if (n->bulge)
             lb__text_put(b, " bulge(%s%s omega=%g)", n->bp.flags & LB_BULGE_RANGE ? "range " : "",
                          n->bp.flags & LB_BULGE_SLOPE ? "slope" : "", n->bp.omega);

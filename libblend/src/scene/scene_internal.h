@@ -26,6 +26,7 @@ typedef enum lb__family {
     LB__F_GROUP,        /* a transform applied to one arg (a transformed ref) */
     LB__F_LOCAL,        /* local blend around the intersection curves, binary, both */
     LB__F_CLEAN,        /* clean union UC, binary, both */
+    LB__F_LEVEL,        /* its argument's h-level set as the surface (shape = h), one arg, both */
     LB__F_COUNT
 } lb__family;
 
