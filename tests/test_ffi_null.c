@@ -220,6 +220,16 @@ static lb_status c_materials(unsigned mask, int size, lb_error *err, int *hs) {
     return lb_scene_material_index(P(0, C.scene), P(1, C.ev), 1, P(2, x), P(3, y), P(4, z),
                                    P(5, idx), P(6, err));
 }
+static lb_status c_render(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    const double loc[3] = {0, -5, 1}, at[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+    const double lo[3] = {-2, -2, -2}, hi[3] = {2, 2, 2};
+    lb_render_light L[3];
+    lb_render_three_point(P(0, loc), P(1, at), P(2, up), P(3, L));
+    *hs = 1;
+    double h;
+    return lb_render_floor_height(P(0, C.ev), P(1, lo), P(2, hi), P(3, up), 1, P(4, &h), P(5, err));
+}
 static lb_status c_evaluator(unsigned mask, int size, lb_error *err, int *hs) {
     *hs = 1;
     (void)size;
@@ -352,6 +362,7 @@ static const fn_case CASES[] = {
     {"lb_scene_load", 3, 0x03, c_scene_load},
     {"lb_scene_* queries and reference walk", 6, 0x07, c_scene_queries},
     {"lb_scene_material*", 7, 0x3d, c_materials},
+    {"lb_render_three_point / floor_height", 6, 0x1f, c_render},
     {"lb_evaluator_create", 3, 0x03, c_evaluator},
     {"lb_evaluator_eval", 9, 0x1f, c_eval},
     {"lb_evaluator_bounds", 6, 0x1f, c_bounds},

@@ -85,6 +85,10 @@ class _Material(ctypes.Structure):
                 ("diffuse", ctypes.c_double), ("specular", ctypes.c_double)]
 
 
+class _Light(ctypes.Structure):
+    _fields_ = [("location", ctypes.c_double * 3), ("color", ctypes.c_double * 3)]
+
+
 class _Stats(ctypes.Structure):
     _fields_ = [("nodes", ctypes.c_size_t), ("primitives", ctypes.c_size_t),
                 ("operators", ctypes.c_size_t), ("depth", ctypes.c_size_t)]
@@ -123,6 +127,8 @@ _SIGNATURES = {
     "lb_mesh_edges": (ctypes.c_int, [ctypes.POINTER(_Mesh), _U32, _U32,
                                      ctypes.POINTER(ctypes.c_size_t), _ERR]),
     "lb_mesh_write": (ctypes.c_int, [ctypes.POINTER(_Mesh), ctypes.c_char_p, ctypes.c_int, _ERR]),
+    "lb_render_three_point": (None, [_D, _D, _D, ctypes.POINTER(_Light)]),
+    "lb_render_floor_height": (ctypes.c_int, [_P, _D, _D, _D, ctypes.c_int, _D, _ERR]),
     "lb_scene_write_pov": (ctypes.c_int, [_P, _P, ctypes.POINTER(_PovOptions), ctypes.c_char_p,
                                           _D, _ERR]),
 }
@@ -198,6 +204,14 @@ class Library:
         msg = err.message.decode("utf-8", "replace") or self._c.lb_status_string(status).decode()
         cls = Cancelled if status == STATUS_CANCELLED else LibblendError
         raise cls(msg if msg.startswith(what) else "%s: %s" % (what, msg), status)
+
+    def three_point(self, location, look_at, up):
+        """The default key, fill and rim lights for a camera
+        (lb_render_three_point): [(location, strength, casts_shadows)] * 3."""
+        v = [(ctypes.c_double * 3)(*map(float, a)) for a in (location, look_at, up)]
+        out = (_Light * 3)()
+        self._c.lb_render_three_point(v[0], v[1], v[2], out)
+        return [(tuple(L.location), L.color[0], i == 0) for i, L in enumerate(out)]
 
     def parse_scene(self, text, name=None):
         """Parse and validate a scene from a str or bytes (JSON, docs/scene-format.md)."""
@@ -361,6 +375,17 @@ class Evaluator(_Handle):
                                            int(threads), ctypes.byref(err))
         self.lib._check(st, err, "eval")
         return (v, np.stack(g, axis=1)) if gradient else (v, None)
+
+    def floor_height(self, bmin, bmax, up, threads=0):
+        """The floor's height along up under the surface in [bmin, bmax]
+        (lb_render_floor_height: a 48-cell mesh's lowest vertex less half a
+        cell, or the box's lowest corner)."""
+        lo, hi, u = ((ctypes.c_double * 3)(*map(float, a)) for a in (bmin, bmax, up))
+        h, err = ctypes.c_double(0.0), _Error()
+        st = self.lib._c.lb_render_floor_height(self.ptr, lo, hi, u, int(threads), ctypes.byref(h),
+                                                ctypes.byref(err))
+        self.lib._check(st, err, "floor height")
+        return h.value
 
     def bounds(self, bmin, bmax):
         """(lo, hi): an interval containing the field everywhere in the box."""

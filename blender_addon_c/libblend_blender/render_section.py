@@ -75,12 +75,6 @@ def camera_basis(location, look_at, up):
     return f, r, r.cross(f)
 
 
-# the default three-point lights, in units of the camera's distance to its
-# target along (right, up, forward), with their strengths (the same numbers
-# as libblend's POV-Ray writer, pov.c)
-THREE_POINT = (((-0.7, 0.9, -0.5), 0.85, True), ((1.0, 0.2, -0.6), 0.35, False),
-               ((0.4, 1.0, 1.1), 0.5, False))
-
 
 def _same_vec(a, b, tol=1e-6):
     return len(a) == len(b) and all(abs(x - y) <= tol * max(1.0, abs(y)) for x, y in zip(a, b))
@@ -141,44 +135,43 @@ def create(output, section, collection, scene):
 
 
 def _three_point(output, cam, collection):
-    """The default lights around the camera (THREE_POINT), as suns aimed at
-    the camera's target; the key's 5 degree disc gives soft shadows. They
-    are not the section's lights: export leaves "lights" out, as read."""
+    """The default lights around the camera (libblend's
+    lb_render_three_point, the POV-Ray writer's too), as suns aimed at the
+    camera's target; the key's 5 degree disc gives soft shadows. They are
+    not the section's lights: export leaves "lights" out, as read."""
+    from . import live
     at = cam.get("look_at", [0, 0, 0])
-    f, r, u = camera_basis(cam["location"], at, cam.get("up", [0, 0, 1]))
-    dist = (Vector(at) - Vector(cam["location"])).length
-    for i, ((a, b, c), strength, shadows) in enumerate(THREE_POINT):
+    lights = live.library().three_point(cam["location"], at, cam.get("up", [0, 0, 1]))
+    for i, (location, strength, shadows) in enumerate(lights):
         data = bpy.data.lights.new("%s %s light" % (output.name, ("key", "fill", "rim")[i]), "SUN")
         data.energy = SUN_STRENGTH * strength
         data.angle = math.radians(5.0) if shadows else 0.0
         data.use_shadow = shadows
         obj = bpy.data.objects.new(data.name, data)
         collection.objects.link(obj)
-        obj.location = Vector(at) + dist * (a * r + b * u + c * f)
+        obj.location = location
         _aim(obj, at, "Z")
 
 
 def floor_height(output, up):
-    """The floor's height along up: the lowest vertex of a 48-cell mesh of
-    the field less half a cell (as libblend's POV-Ray writer), or the
-    region's lowest corner when there is no surface."""
+    """The floor's height along up (world): libblend's lb_render_floor_height
+    (as the POV-Ray writer) over the field's region, with up taken into the
+    field's frame, or the region's lowest corner when the tree is broken."""
     from . import live
     s = output.libblend
+    M = output.matrix_world
     corners = [Vector((x, y, z)) for x in (s.bounds_min[0], s.bounds_max[0])
                for y in (s.bounds_min[1], s.bounds_max[1]) for z in (s.bounds_min[2], s.bounds_max[2])]
-    h = min((output.matrix_world @ c).dot(Vector(up)) for c in corners)
+    h = min((M @ c).dot(Vector(up)) for c in corners)
+    # up . (A p + t) = (A^T up) . p + up . t
+    local_up = M.to_3x3().transposed() @ Vector(up)
     try:
-        job = live.prepare(output, 48)
-        job.run()
+        text, _ = tree.to_json(output, render=False)
+        with live.library().parse_scene(text, output.name + ".json") as sc, sc.compile() as ev:
+            return ev.floor_height(s.bounds_min, s.bounds_max, local_up, live.threads()) + \
+                M.translation.dot(Vector(up))
     except Exception:  # no library or a tree error: the region's corner, as documented
         return h
-    if job.error or job.mesh is None or not len(job.mesh.positions):
-        return h
-    import numpy as np
-    P = np.asarray(job.mesh.positions) @ np.asarray(output.matrix_world.to_3x3()).T + \
-        np.asarray(output.matrix_world.translation)
-    cell = max(job.mesh.cell)
-    return max(h, float((P @ np.asarray(up)).min()) - 0.5 * cell)
 
 
 def _floor(output, section, collection):

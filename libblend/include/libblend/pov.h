@@ -44,6 +44,28 @@ typedef struct lb_pov_options {
     int threads;         /* for the gradient sampling: 0 = all CPUs, 1 = caller only */
 } lb_pov_options;
 
+/* ---- render defaults every exporter shares (the POV-Ray writer and the
+ * Blender add-on call these; docs/scene-format.md, "Defaults that read
+ * shape") ---- */
+
+/* The three-point lights for a camera at location looking at look_at with
+ * up direction up: lights[0] the key (the one that casts soft shadows),
+ * lights[1] the fill, lights[2] the rim, each at look_at + L (a right +
+ * b up + c forward) of the camera's basis (L its distance to look_at), with
+ * its strength as a grey colour. Writes nothing when a pointer is NULL or
+ * the camera looks along up or at itself. */
+LB_API void lb_render_three_point(const double location[3], const double look_at[3],
+                                  const double up[3], lb_render_light lights[3]);
+
+/* The floor's height along the direction up (any length: heights are
+ * up . X): the lowest vertex of a 48-cell mesh of the field over [bmin,
+ * bmax], less half the largest cell side times |up|, so the surface rests on
+ * the floor; the box's lowest corner when there is no surface or the mesh
+ * fails. threads as lb_mesh_options. */
+LB_API lb_status lb_render_floor_height(const lb_evaluator *ev, const double bmin[3],
+                                        const double bmax[3], const double up[3], int threads,
+                                        double *height, lb_error *err);
+
 /* The camera the exporter uses: the scene's render section, or one framing
  * the bounds from the front (-y), above (+z) and to the right (+x). The
  * scene is right-handed with up `up` (unit; +z unless the section says

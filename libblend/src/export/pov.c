@@ -640,18 +640,6 @@ void lb_pov_camera(const lb_scene *scene, double aspect, double loc[3], double a
     }
 }
 
-static void cross3(const double *a, const double *b, double *c) {
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static void unit3(double *a) {
-    const double l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-    if (l > 0.0)
-        for (int d = 0; d < 3; ++d) a[d] /= l;
-}
-
 /* Every number in b (outside // comments) in its shortest form that reads
  * back as the same double: the writer prints 17 significant digits, which
  * always round-trip, and this keeps the fewest that still do (0.3, not
@@ -718,37 +706,6 @@ static void shorten_numbers(sbuf *b) {
 
 /* The floor's height along up: the lowest point of a coarse mesh of the
  * surface (48 cells), or of the bounds when there is no surface. */
-static double floor_height(const lb_scene *scene, const lb_evaluator *ev, const double up[3],
-                           int threads) {
-    double h = INFINITY;
-    for (int c = 0; c < 8; ++c) {
-        double t = 0.0;
-        for (int d = 0; d < 3; ++d) t += up[d] * ((c >> d) & 1 ? scene->bmax[d] : scene->bmin[d]);
-        if (t < h) h = t;
-    }
-    lb_mesh_options o;
-    lb_mesh_options_init(&o);
-    memcpy(o.bmin, scene->bmin, sizeof o.bmin);
-    memcpy(o.bmax, scene->bmax, sizeof o.bmax);
-    o.resolution = 48;
-    o.threads = threads;
-    lb_mesh *m = NULL;
-    if (lb_mesh_create(ev, &o, &m, NULL) == LB_OK && m->nvertices) {
-        double lo = INFINITY;
-        for (size_t i = 0; i < m->nvertices; ++i) {
-            const double *X = m->positions + 3 * i;
-            const double t = up[0] * X[0] + up[1] * X[1] + up[2] * X[2];
-            if (t < lo) lo = t;
-        }
-        /* a coarse mesh's lowest vertex is within a cell of the surface's */
-        const double cell = m->cell[0] > m->cell[1] ? m->cell[0] : m->cell[1];
-        lo -= 0.5 * (cell > m->cell[2] ? cell : m->cell[2]);
-        if (lo > h) h = lo;
-    }
-    lb_mesh_free(m);
-    return h;
-}
-
 /* the largest |grad f| on a grid over the box */
 static lb_status max_gradient(const lb_evaluator *ev, const double lo[3], const double hi[3],
                               int threads, double *g, lb_error *err) {
@@ -819,13 +776,9 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
         const double aspect = o.aspect > 0.0 ? o.aspect : 4.0 / 3.0;
         double loc[3], at[3], up[3], angle;
         lb_pov_camera(scene, aspect, loc, at, up, &angle);
-        /* the camera's basis: forward, right (right-handed), true up */
-        double F[3] = {at[0] - loc[0], at[1] - loc[1], at[2] - loc[2]}, Rt[3], U[3];
+        /* the camera's distance to its target (the key light's size) */
+        const double F[3] = {at[0] - loc[0], at[1] - loc[1], at[2] - loc[2]};
         const double L = sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
-        unit3(F);
-        cross3(F, up, Rt);
-        unit3(Rt);
-        cross3(Rt, F, U);
         const double *bg = R->background;
         /* POV-Ray is left-handed: a negated right vector makes the image the
          * right-handed view; sky is the scene's up (the look_at keeps both) */
@@ -849,24 +802,23 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
              * light is 3 x 3, not adaptive: every shadow sample is an
              * isosurface intersection, and a soft-object scene took 7x a
              * hard shadow's time at 5 x 5 adaptive (4x at 3 x 3). */
-            static const double P[3][3] = {{-0.7, 0.9, -0.5}, {1.0, 0.2, -0.6}, {0.4, 1.0, 1.1}};
-            static const double I[3] = {0.85, 0.35, 0.5};
+            lb_render_light key[3];
+            lb_render_three_point(loc, at, up, key);
             for (int k = 0; k < 3; ++k) {
-                double X[3];
-                for (int d = 0; d < 3; ++d)
-                    X[d] = at[d] + L * (P[k][0] * Rt[d] + P[k][1] * U[d] + P[k][2] * F[d]);
+                const double *X = key[k].location;
                 if (k == 0)
                     sb(&b,
                        "light_source { <%.17g, %.17g, %.17g> rgb %.17g area_light <%.17g, 0, 0>, "
                        "<0, %.17g, 0>, 3, 3 adaptive 0 jitter circular orient }\n",
-                       X[0], X[1], X[2], I[k], 0.2 * L, 0.2 * L);
+                       X[0], X[1], X[2], key[k].color[0], 0.2 * L, 0.2 * L);
                 else
                     sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb %.17g shadowless }\n", X[0],
-                       X[1], X[2], I[k]);
+                       X[1], X[2], key[k].color[0]);
             }
         }
         if (R->floor && !o.silhouette) {
-            const double h = floor_height(scene, ev, up, o.threads);
+            double h = 0.0;
+            lb_render_floor_height(ev, scene->bmin, scene->bmax, up, o.threads, &h, NULL);
             sb(&b,
                "plane { <%.17g, %.17g, %.17g>, %.17g pigment { rgb <%.17g, %.17g, %.17g> } "
                "finish { ambient 0.15 diffuse 0.75 } }\n",
