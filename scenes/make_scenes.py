@@ -163,6 +163,52 @@ write("hsu-bounded-fig7-stool.json", scene(
     "zero", root, ([-1.4, -1.4, -1.5], [1.4, 1.4, 0.8]),
     cam=camera([4.6, -3.4, -0.5], [0, 0, -0.35], 38)))
 
+# hsu-bounded Fig. 8: a bounding solid shapes the contour of a union's
+# transition. A column stands on a plate in one bounded union; the plate's
+# bounding solid is a taller box, so the column blends into the plate
+# wherever its own bounding solid reaches: the fillet's footprint on the
+# plate takes that solid's cross-section (round, square, elliptical). The
+# plain scale-method union, unbounded, is the reference.
+column = {"type": "capsule", "start": [0, 0, -0.1], "end": [0, 0, 1.0], "radius": 0.25}
+board = {"type": "superquadric", "center": [0, 0, 0], "semi_axes": [1.4, 1.4, 0.15],
+         "e1": 0.1, "e2": 0.1}
+board_bound = {"type": "superquadric", "center": [0, 0, 0], "semi_axes": [1.45, 1.45, 0.6],
+               "e1": 0.1, "e2": 0.1}
+contour_bounds = {
+    "round": {"type": "capsule", "start": [0, 0, -0.1], "end": [0, 0, 1.0], "radius": 0.6},
+    "square": {"type": "superquadric", "center": [0, 0, 0.45], "semi_axes": [0.6, 0.6, 0.9],
+               "e1": 0.1, "e2": 0.1},
+    "ellipse": {"type": "ellipsoid", "center": [0, 0, 0.5], "semi_axes": [0.95, 0.4, 1.0]},
+}
+contour_cam = camera([2.3, -3.1, 2.6], [0, 0, 0.15], 36)
+write("hsu-bounded-fig8-plain.json", scene(
+    "hsu-bounded Fig. 8, plain union",
+    "a column on a plate, the scale method's union without bounding solids (r = 0.35)",
+    "zero", {"type": "scale", "op": "union", "r": 0.35, "p": 2, "args": [board, column]},
+    ([-1.6, -1.6, -0.4], [1.6, 1.6, 1.4]), cam=contour_cam))
+for shape, cb in contour_bounds.items():
+    write("hsu-bounded-fig8-%s.json" % shape, scene(
+        "hsu-bounded Fig. 8, %s bound" % shape,
+        "a column on a plate in a bounded union; the column's bounding solid (%s) gives the "
+        "fillet's contour on the plate" % shape,
+        "zero", {"type": "bounded", "op": "union", "p": 2, "args": [board, column],
+                 "bounds": [board_bound, cb]},
+        ([-1.6, -1.6, -0.4], [1.6, 1.6, 1.4]), cam=contour_cam))
+
+# hsu-nonuniform Fig. 5: the level surfaces B_A3(f1, f2, f3) = h, h = 0.5 to
+# 0.3, of a soft intersection of three pairs of planes with m1 = 0.6 and
+# m2 = 2.8: the f2 faces (y) dilate farther and faster than the f1 faces
+# (x). A level node makes the h-level set the surface.
+for h in (0.5, 0.45, 0.4, 0.35, 0.3):
+    cube = {"type": "soft_hyper", "op": "intersection", "r": 0.5, "p": 2, "m": [0.6, 2.8, 1],
+            "args": [slab(0, kernel="wyvill"), slab(1, kernel="wyvill"), slab(2, kernel="wyvill")]}
+    write("hsu-nonuniform-fig5-h%s.json" % h, scene(
+        "hsu-nonuniform Fig. 5, h = %s" % h,
+        "the level set B_A3(f1, f2, f3) = %s of soft slabs, m1 = 0.6, m2 = 2.8" % h,
+        # from above, the +x and -y faces in view
+        "soft", {"type": "level", "level": h, "args": [cube]},
+        ([-2.4, -2.4, -2.4], [2.4, 2.4, 2.4]), cam=camera([5.0, -6.5, 5.5], [0, 0, 0], 38)))
+
 # hsu-nonuniform Fig. 6: B_S2(B_A3(f1, f2, f3), f4) = 0.5 on soft slabs and a
 # soft super-ellipsoid, m2 = 2.8 fixed, m1 = 0.3, 0.65, 1, 1.5.
 for m1 in (0.3, 0.65, 1, 1.5):
