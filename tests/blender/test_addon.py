@@ -766,6 +766,24 @@ def sil_scene(camera):
 
 
 SW, SH = 160, 120
+
+
+def cycles_render(path, samples, transparent):
+    """the scene's camera view, SW x SH, by Cycles on the CPU (Blender 4.x's
+    Workbench needs a GPU context, EGL, even in background mode); returns path"""
+    sc = bpy.context.scene
+    sc.render.engine = "CYCLES"
+    sc.cycles.samples = samples
+    sc.cycles.use_denoising = False
+    sc.render.film_transparent = transparent
+    sc.render.resolution_x, sc.render.resolution_y, sc.render.resolution_percentage = SW, SH, 100
+    sc.render.image_settings.file_format = "PNG"
+    sc.render.image_settings.color_mode = "RGBA" if transparent else "RGB"
+    sc.render.filepath = path
+    bpy.ops.render.render(write_still=True)
+    return path
+
+
 views = {"front (from -y, up +z)": {"location": [0.3, -6, 0.4], "look_at": [0.2, 0, 0.2], "angle": 40},
          "top (from +z, up +y)": {"location": [0.2, -0.1, 6], "look_at": [0.2, -0.1, 0],
                                   "up": [0, 1, 0], "angle": 40}}
@@ -789,19 +807,8 @@ for vi, (side, camera) in enumerate(views.items()):
     vobj = active()
     vobj.libblend.live = False
     vobj.libblend.render_resolution = 96
-    sc = bpy.context.scene
-    # Cycles (on the CPU): Blender 4.x's Workbench needs a GPU context (EGL) even
-    # in background mode
-    sc.render.engine = "CYCLES"
-    sc.cycles.samples = 4
-    sc.cycles.use_denoising = False
-    sc.render.film_transparent = True
-    sc.render.resolution_x, sc.render.resolution_y, sc.render.resolution_percentage = SW, SH, 100
-    sc.render.image_settings.file_format = "PNG"
-    sc.render.image_settings.color_mode = "RGBA"
-    sc.render.filepath = os.path.join(WORK, "view-%d-blender.png" % vi)
-    bpy.ops.render.render(write_still=True)
-    bl = addon_env.image_pixels(sc.render.filepath)[:, :, 3] > 0.5
+    bl = addon_env.image_pixels(cycles_render(os.path.join(WORK, "view-%d-blender.png" % vi), 4,
+                                              True))[:, :, 3] > 0.5
     inter, union = (bl & pov).sum(), (bl | pov).sum()
     mirror = pov[:, ::-1]
     iou, iou_m = inter / union, (bl & mirror).sum() / (bl | mirror).sum()
@@ -912,16 +919,7 @@ r = subprocess.run(["povray", "+I" + pov_file, "+O" + pov_png, "+W%d" % SW, "+H%
                     "-D", "+L" + os.path.join(SRC, "povray_include")], capture_output=True,
                    text=True)
 check(r.returncode == 0, "POV-Ray renders the material scene: %s" % r.stderr[-300:])
-sc = bpy.context.scene
-sc.render.engine = "CYCLES"
-sc.cycles.samples = 16
-sc.cycles.use_denoising = False
-sc.render.film_transparent = False
-sc.render.resolution_x, sc.render.resolution_y, sc.render.resolution_percentage = SW, SH, 100
-sc.render.image_settings.file_format = "PNG"
-sc.render.image_settings.color_mode = "RGB"
-sc.render.filepath = os.path.join(WORK, "materials-blender.png")
-bpy.ops.render.render(write_still=True)
+bl_png = cycles_render(os.path.join(WORK, "materials-blender.png"), 16, False)
 
 
 def hue_class(img):
@@ -937,7 +935,7 @@ def hue_class(img):
 
 
 hp = hue_class(addon_env.image_pixels(pov_png))
-hb = hue_class(addon_env.image_pixels(sc.render.filepath))
+hb = hue_class(addon_env.image_pixels(bl_png))
 # two pixels away from POV-Ray's class boundaries: Blender's boundary runs
 # along faces (a 96-cell mesh: a cell is 1.2 pixels here) and the
 # antialiasing mixes the colours there
