@@ -1495,9 +1495,11 @@ static void local_blend(void) {
 }
 
 int main(int argc, char **argv) {
-    if (argc != 2) {
-        fprintf(stderr, "usage: povgen OUT.inc\n");
-        return 2;
+    if (argc != 2 || argv[1][0] == '-') {
+        /* an option is never a file name: "povgen --help" once wrote the
+         * include to a file called --help */
+        fprintf(stderr, "usage: povgen OUT.inc (writes libblend.inc there)\n");
+        return argc == 2 && strcmp(argv[1], "--help") == 0 ? 0 : 2;
     }
     const int steps = choose_steps();
     const int ssteps = choose_soft_steps();
