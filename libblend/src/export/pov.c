@@ -291,18 +291,34 @@ static lb_status emit_local(pctx *c, const lb__node *n, int id, const char *name
 
 static lb_status emit_node(pctx *c, const lb__node *n, int id);
 
+/* the id n was written under for the world frame F (n's own frame), or -1:
+ * a node holding a local_union is written once per frame, others once */
+static int written_id(pctx *c, const lb__node *n, const lb__affine *F) {
+    const int keyed = has_local(c, n);
+    for (size_t i = 0; i < c->ndone; ++i)
+        if (c->done[i] == n && (!keyed || memcmp(&c->doneA[i], F, sizeof *F) == 0))
+            return c->ids[i];
+    return -1;
+}
+
+/* the three coordinates y = M x + t as function arguments */
+static void affine_args(sbuf *b, const lb__affine *A) {
+    for (int r = 0; r < 3; ++r)
+        sb(b, "%s%.17g * x + %.17g * y + %.17g * z + %.17g", r ? ", " : "", A->M[3 * r],
+           A->M[3 * r + 1], A->M[3 * r + 2], A->t[r]);
+}
+
 /* One declaration per node (per node and world frame under a local_union):
  * shared defs stay shared. */
 static lb_status emit(pctx *c, const lb__node *n, int *out) {
     const lb__affine saved = c->A;
     lb__affine A = saved;
     if (n->has_transform) lb__affine_compose(&n->to_local, &saved, &A);
-    const int keyed = has_local(c, n);
-    for (size_t i = 0; i < c->ndone; ++i)
-        if (c->done[i] == n && (!keyed || memcmp(&c->doneA[i], &A, sizeof A) == 0)) {
-            *out = c->ids[i];
-            return LB_OK;
-        }
+    const int known = written_id(c, n, &A);
+    if (known >= 0) {
+        *out = known;
+        return LB_OK;
+    }
     const int id = c->next++;
     c->A = A;
     lb_status s = emit_node(c, n, id);
@@ -479,11 +495,8 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
         }
     }
     if (n->has_transform) {
-        const double *M = n->to_local.M, *t = n->to_local.t;
         sb(b, "#declare LBn%d = function(x, y, z) { LBl%d(", id, id);
-        for (int r = 0; r < 3; ++r)
-            sb(b, "%s%.17g * x + %.17g * y + %.17g * z + %.17g", r ? ", " : "", M[3 * r],
-               M[3 * r + 1], M[3 * r + 2], t[r]);
+        affine_args(b, &n->to_local);
         sb(b, ") }\n");
     }
     return LB_OK;
@@ -499,26 +512,14 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
 
 #define LB_POV_MAX_TEXTURES 4096
 
-/* the id a node was written under for the world frame F (its own frame) */
-static int written_id(pctx *c, const lb__node *n, const lb__affine *F) {
-    const int keyed = has_local(c, n);
-    for (size_t i = 0; i < c->ndone; ++i)
-        if (c->done[i] == n && (!keyed || memcmp(&c->doneA[i], F, sizeof *F) == 0))
-            return c->ids[i];
-    return -1;
-}
-
 static void score_expr(pctx *c, const lb__node *n, size_t i, int fid, const lb__affine *A) {
     double sign, off;
     lb__material_score(n, c->sc->convention, i, &sign, &off);
     sb(c->b, "%s%sLBn%d(", off != 0.0 ? "1" : "", sign < 0 ? "-" : off != 0.0 ? "+" : "", fid);
-    if (lb__affine_is_identity(A)) {
-        sb(c->b, "x, y, z)");
-        return;
-    }
-    for (int r = 0; r < 3; ++r)
-        sb(c->b, "%s%.17g * x + %.17g * y + %.17g * z + %.17g", r ? ", " : "", A->M[3 * r],
-           A->M[3 * r + 1], A->M[3 * r + 2], A->t[r]);
+    if (lb__affine_is_identity(A))
+        sb(c->b, "x, y, z");
+    else
+        affine_args(c->b, A);
     sb(c->b, ")");
 }
 
@@ -840,24 +841,22 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
             s = tex(&c, scene->root, &id, 0, texname);
         }
         if (s) goto out;
+        sb(&b,
+           "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
+           "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
+           "  max_gradient %.17g\n  accuracy %.17g\n  ",
+           soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
+           1e-4 * diag);
         if (texname[0]) {
-            sb(&b,
-               "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
-               "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
-               "  max_gradient %.17g\n  accuracy %.17g\n  texture { %s }\n}\n",
-               soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
-               1e-4 * diag, texname);
-        } else
-            sb(&b,
-               "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
-               "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
-               "  max_gradient %.17g\n  accuracy %.17g\n"
-               "  texture { pigment { rgb <%.17g, %.17g, %.17g> } finish { ambient %.17g diffuse "
-               "%.17g specular %.17g } }\n}\n",
-               soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
-               1e-4 * diag, o.silhouette ? 1.0 : R->color[0], o.silhouette ? 1.0 : R->color[1],
-               o.silhouette ? 1.0 : R->color[2], o.silhouette ? 1.0 : R->ambient,
-               o.silhouette ? 0.0 : R->diffuse, o.silhouette ? 0.0 : R->specular);
+            sb(&b, "texture { %s }", texname);
+        } else {
+            /* one material (the silhouette: its ambient white) */
+            const lb_material white = {{1.0, 1.0, 1.0}, 1.0, 0.0, 0.0};
+            lb_material m0;
+            lb_scene_material(scene, 0, &m0);
+            material_texture(&b, o.silhouette ? &white : &m0);
+        }
+        sb(&b, "\n}\n");
     }
 out:
     free(c.done);
