@@ -74,7 +74,7 @@ static size_t counted_runs(const lb_evaluator *ev) {
         y[i] = 0.05 * (i % 7);
         z[i] = 0.03 * (i % 5);
     }
-    double *regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
+    double *regs = malloc(lb__regs_len(ev) * sizeof *regs);
     assert_non_null(regs);
     size_t count = 0;
     lb_error e = {LB_OK, ""};

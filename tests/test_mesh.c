@@ -805,6 +805,110 @@ static void test_min_feature(void **state) {
     assert_int_equal(kept, 400);
 }
 
+/* A flat union of 4096 spheres (one BT_4096 node: 16^3 lattice, spacing
+ * 0.5, radius 0.3, range 0.1, p = 2): its values satisfy the operator's
+ * defining equation sum_i [(r - x_i + h)/r]+^2 = 1 at random points, with
+ * the spheres' fields x_i = |X - c_i| / radius - 1 computed here; the mesh is closed, oriented and
+ * manifold, every vertex on the surface, the same for 1 and 2 threads. */
+static void test_wide_union(void **state) {
+    (void)state;
+    enum { N = 16, K = N * N * N };
+    const double sp = 0.5, rad = 0.3, r = 0.1;
+    size_t cap = (size_t)K * 96 + 512, len = 0;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    len += (size_t)snprintf(text, cap,
+                            HEAD "\"convention\": \"zero\", \"root\": {\"type\": "
+                                 "\"displacement\", \"op\": \"union\", \"r\": %g, \"p\": 2, "
+                                 "\"args\": [",
+                            r);
+    for (int i = 0; i < K; ++i)
+        len += (size_t)snprintf(
+            text + len, cap - len,
+            "%s{\"type\": \"sphere\", \"center\": [%g, %g, %g], \"radius\": %g}", i ? ", " : "",
+            sp * (i % N), sp * (i / N % N), sp * (i / (N * N)), rad);
+    len += (size_t)snprintf(text + len, cap - len, "]}}");
+    assert_true(len < cap);
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -0.5;
+        o.bmax[d] = sp * (N - 1) + 0.5;
+    }
+    o.resolution = 96;
+    o.threads = 1;
+    built A;
+    build_text(text, &o, &A);
+    free(text);
+    /* values against the defining equation */
+    rng_t g = {4096};
+    enum { P = 2000 };
+    double *X = malloc(7 * P * sizeof *X);
+    assert_non_null(X);
+    double *Y = X + P, *Z = Y + P, *V = Z + P, *GX = V + P, *GY = GX + P, *GZ = GY + P;
+    for (int j = 0; j < P; ++j) {
+        X[j] = rng_range(&g, -0.5, 8.0);
+        Y[j] = rng_range(&g, -0.5, 8.0);
+        Z[j] = rng_range(&g, -0.5, 8.0);
+    }
+    lb_error e = {LB_OK, ""};
+    assert_int_equal(lb_evaluator_eval(A.ev, P, X, Y, Z, V, GX, GY, GZ, 2, &e), LB_OK);
+    double worst = 0.0;
+    int blended = 0;
+    for (int j = 0; j < P; ++j) {
+        double sum = 0.0, xmin = INFINITY;
+        int active = 0;
+        for (int i = 0; i < K; ++i) {
+            const double dx = X[j] - sp * (i % N), dy = Y[j] - sp * (i / N % N),
+                         dz = Z[j] - sp * (i / (N * N));
+            const double xi = sqrt(dx * dx + dy * dy + dz * dz) / rad - 1.0; /* rho - 1 */
+            if (xi < xmin) xmin = xi;
+            const double t = (r - xi + V[j]) / r;
+            if (t > 0.0) {
+                sum += t * t;
+                ++active;
+            }
+        }
+        if (!(V[j] <= xmin + 1e-15))
+            fail_msg("point %d (%.17g, %.17g, %.17g): BT = %.17g above min x_i = %.17g", j, X[j],
+                     Y[j], Z[j], V[j], xmin);
+        if (fabs(sum - 1.0) > worst) worst = fabs(sum - 1.0);
+        blended += active > 1;
+    }
+    if (!(worst < 1e-9)) fail_msg("defining equation off by %g", worst);
+    assert_true(blended > 50); /* the sample reaches the blends */
+    free(X);
+    expect_closed_manifold("4096 spheres", A.m);
+    assert_true(A.m->ntriangles > 100000);
+    /* every vertex on the surface */
+    const size_t nv = A.m->nvertices;
+    double *w = malloc(7 * nv * sizeof *w);
+    assert_non_null(w);
+    for (size_t v = 0; v < nv; ++v)
+        for (int d = 0; d < 3; ++d) w[d * nv + v] = A.m->positions[3 * v + d];
+    assert_int_equal(lb_evaluator_eval(A.ev, nv, w, w + nv, w + 2 * nv, w + 3 * nv, w + 4 * nv,
+                                       w + 5 * nv, w + 6 * nv, 2, &e),
+                     LB_OK);
+    const double h = (o.bmax[0] - o.bmin[0]) / o.resolution;
+    for (size_t v = 0; v < nv; ++v) {
+        const double gn = sqrt(w[4 * nv + v] * w[4 * nv + v] + w[5 * nv + v] * w[5 * nv + v] +
+                               w[6 * nv + v] * w[6 * nv + v]);
+        if (!(fabs(w[3 * nv + v]) <= 1e-6 * h * gn))
+            fail_msg("vertex %zu: |f| = %g, |grad f| = %g", v, fabs(w[3 * nv + v]), gn);
+    }
+    free(w);
+    /* thread independence */
+    o.threads = 2;
+    lb_mesh *m2 = NULL;
+    assert_int_equal(lb_mesh_create(A.ev, &o, &m2, &e), LB_OK);
+    assert_int_equal(m2->nvertices, A.m->nvertices);
+    assert_int_equal(m2->ntriangles, A.m->ntriangles);
+    assert_memory_equal(m2->positions, A.m->positions, 3 * nv * sizeof *m2->positions);
+    assert_memory_equal(m2->triangles, A.m->triangles, 3 * A.m->ntriangles * sizeof *m2->triangles);
+    lb_mesh_free(m2);
+    unbuild(&A);
+}
+
 /* lb_mesh_edges against a sort of the corners' vertex pairs done here: the
  * same set of edges, each corner's edge joining that corner's two vertices,
  * first-appearance numbering, and on a closed manifold mesh every edge used
@@ -992,6 +1096,7 @@ int main(void) {
         cmocka_unit_test(test_memory_cap_and_empty),
         cmocka_unit_test(test_min_feature),
         cmocka_unit_test(test_edges),
+        cmocka_unit_test(test_wide_union),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

@@ -151,7 +151,7 @@ static const bad BAD[] = {
     {"no args",
      ZERO(DISP("\"r\": 0.1, \"args\": []")),
      LB_ERR_INVALID_ARGUMENT,
-     {"$.root.args: displacement \"args\" has 0 arguments", "allowed: an array of 1 to 256"}},
+     {"$.root.args: displacement \"args\" has 0 arguments", "allowed: an array of 1 to 65535"}},
     {"arg not an object",
      ZERO(DISP("\"r\": 0.1, \"args\": [" SPH ", 7]")),
      LB_ERR_INVALID_ARGUMENT,
@@ -443,6 +443,23 @@ static void test_limits(void **state) {
            (const char *const[3]){"more than 100000 nodes", "allowed: at most 100000 nodes"});
     free(inner);
     free(many);
+    /* arity: 257 arguments of a family capped at LB_MAX_ARITY name the wide
+     * families; 65536 of a wide one are refused */
+    char *scale257 = repeat(HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"scale\", "
+                                 "\"op\": \"union\", \"r\": 0.1, \"args\": [" SPH,
+                            ", " SPH, 256, "]}}");
+    expect(scale257, strlen(scale257), LB_ERR_INVALID_ARGUMENT,
+           (const char *const[3]){"$.root.args: scale \"args\" has 257 arguments",
+                                  "allowed: an array of 1 to 256 nodes",
+                                  "displacement, min, max, soft_sum and ricci take up to 65535"});
+    free(scale257);
+    char *min65536 = repeat(HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"min\", "
+                                 "\"args\": [" SPH,
+                            ", " SPH, 65535, "]}}");
+    expect(min65536, strlen(min65536), LB_ERR_INVALID_ARGUMENT,
+           (const char *const[3]){"$.root.args: min \"args\" has 65536 arguments",
+                                  "allowed: an array of 1 to 65535 nodes"});
+    free(min65536);
     /* text larger than LB_SCENE_MAX_BYTES: refused before it is read */
     static const char small[] = "{}";
     expect(

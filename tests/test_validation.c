@@ -18,8 +18,14 @@ static double out;
         __VA_ARGS__                                                                                \
     }
 CALL(k0, return lb_displacement(LB_UNION, 0, X2, R2, P2, M2, &out, NULL, err);)
-CALL(kbig, static double big[LB_MAX_ARITY + 1];
-     return lb_displacement(LB_UNION, LB_MAX_ARITY + 1, big, big, big, big, &out, NULL, err);)
+CALL(kbig, static double big[LB_MAX_ARITY_WIDE + 1];
+     return lb_displacement(LB_UNION, LB_MAX_ARITY_WIDE + 1, big, big, big, big, &out, NULL, err);)
+CALL(kscale, static double big[LB_MAX_ARITY + 1];
+     return lb_scale(LB_UNION, LB_MAX_ARITY + 1, big, big, big, &out, NULL, err);)
+CALL(kperlin, static double big[LB_MAX_ARITY + 1];
+     return lb_classic(LB_PERLIN_UNION, LB_MAX_ARITY + 1, big, 0.0, &out, NULL, err);)
+CALL(kmin, static double big[LB_MAX_ARITY_WIDE + 1];
+     return lb_classic(LB_MIN, LB_MAX_ARITY_WIDE + 1, big, 0.0, &out, NULL, err);)
 CALL(rneg, const double r[2] = {0.5, -1};
      return lb_displacement(LB_UNION, 2, X2, r, P2, M2, &out, NULL, err);)
 CALL(rzero, const double r[2] = {0, 1};
@@ -109,8 +115,14 @@ CALL(kern, lb_primitive_sphere(&prim, C0, 1, NULL);
      return lb_primitive_soften(&prim, (lb_kernel)5, err);)
 
 static const row_t rows[] = {
-    {"k = 0", k0, LB_ERR_INVALID_ARGUMENT, "k = 0 arguments; allowed: 1 <= k <= 256"},
-    {"k too large", kbig, LB_ERR_INVALID_ARGUMENT, "k = 257"},
+    {"k = 0", k0, LB_ERR_INVALID_ARGUMENT, "k = 0 arguments; allowed: 1 <= k <= 65535"},
+    {"k too large", kbig, LB_ERR_INVALID_ARGUMENT, "k = 65536"},
+    {"scale k too large", kscale, LB_ERR_INVALID_ARGUMENT,
+     "k = 257 arguments; allowed: 1 <= k <= 256"},
+    {"perlin k too large", kperlin, LB_ERR_INVALID_ARGUMENT,
+     "k = 257 arguments; allowed: 1 <= k <= 256"},
+    {"min k too large", kmin, LB_ERR_INVALID_ARGUMENT,
+     "k = 65536 arguments; allowed: 1 <= k <= 65535"},
     {"negative r", rneg, LB_ERR_INVALID_ARGUMENT,
      "lb_displacement: r[1] = -1 is out of range; allowed: 1e-09 <= r <= 1e+09"},
     {"zero r", rzero, LB_ERR_INVALID_ARGUMENT, "r[0] = 0 is out of range"},

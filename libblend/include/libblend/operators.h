@@ -37,8 +37,12 @@
 extern "C" {
 #endif
 
-/* Largest number of arguments one operator call takes. */
+/* Largest number of arguments one operator call takes: LB_MAX_ARITY, and
+ * LB_MAX_ARITY_WIDE for the k-ary unions scenes use with thousands of
+ * primitives: lb_displacement, and lb_classic's LB_MIN, LB_MAX,
+ * LB_SOFT_SUM and LB_RICCI_UNION (the same in scenes: docs/scene-format.md). */
 #define LB_MAX_ARITY 256
+#define LB_MAX_ARITY_WIDE 65535
 /* Largest curvature exponent p accepted. */
 #define LB_MAX_EXPONENT 1000.0
 /* Largest |argument| accepted (field values, bounding values, gradients):
@@ -74,7 +78,8 @@ typedef enum lb_setop {
  * -union(-x), difference -union(-x_0, x_1, ..., x_{k-1}).
  * Fast paths: all p_i = 2 is solved in closed form per active set; integer
  * p_i use products instead of pow().
- * Parameters: 1 <= k <= LB_MAX_ARITY; r_i > 0; 1 < p_i <= LB_MAX_EXPONENT;
+ * Parameters: 1 <= k <= LB_MAX_ARITY_WIDE (beyond LB_MAX_ARITY the call
+ * allocates 56 bytes of scratch per argument); r_i > 0; 1 < p_i <= LB_MAX_EXPONENT;
  * m_i > 0 (m may be NULL). */
 LB_API lb_status lb_displacement(lb_setop op, size_t k, const double *x, const double *r,
                                  const double *p, const double *m, double *value, double *grad,
@@ -183,7 +188,9 @@ LB_API lb_status lb_soft_conic(lb_setop op, const double x[2], const double r[2]
  * 1 - prod(1 - x_i), intersection prod x_i, difference x_0 prod_{i>0}(1 - x_i).
  * At ties, min/max differentiate with respect to the first extreme argument;
  * the R-functions' gradient at (0, 0) is taken as (1/2, 1/2) times the limit
- * along the diagonal, i.e. (1 - 1/sqrt 2) for union. */
+ * along the diagonal, i.e. (1 - 1/sqrt 2) for union. k: 2 for the
+ * R-functions; up to LB_MAX_ARITY_WIDE for min, max, the sum and Ricci's
+ * union; up to LB_MAX_ARITY for Perlin's operators. */
 typedef enum lb_classic_kind {
     LB_MIN = 0,
     LB_MAX = 1,

@@ -92,9 +92,9 @@ static inline int lb__in_range(double v, double lo, double hi) {
  * 0 < r_i <= rmax, 1 < p_i <= LB_MAX_EXPONENT (p may be NULL when the family
  * has none), m_i > 0 finite or m NULL. Callers run the detailed checks only
  * when this fails, to produce the message. */
-static inline int lb__fast_ok(size_t k, const double *x, const double *r, const double *p,
-                              const double *m, double rmax) {
-    if (!x || !r || k == 0 || k > LB_MAX_ARITY) return 0;
+static inline int lb__fast_ok_n(size_t kmax, size_t k, const double *x, const double *r,
+                                const double *p, const double *m, double rmax) {
+    if (!x || !r || k == 0 || k > kmax) return 0;
     const double rhi = rmax < LB_MAX_RANGE ? rmax : LB_MAX_RANGE;
     const uint64_t xmax = lb__bits(LB_MAX_ABS_ARG) << 1;
     int ok = 1;
@@ -105,6 +105,11 @@ static inline int lb__fast_ok(size_t k, const double *x, const double *r, const 
         if (m) ok &= lb__in_range(m[i], LB_MIN_SLOPE, LB_MAX_SLOPE);
     }
     return ok;
+}
+/* The same for operators of at most LB_MAX_ARITY arguments. */
+static inline int lb__fast_ok(size_t k, const double *x, const double *r, const double *p,
+                              const double *m, double rmax) {
+    return lb__fast_ok_n(LB_MAX_ARITY, k, x, r, p, m, rmax);
 }
 
 /* How the exponents of one operator call can be evaluated. */
@@ -123,10 +128,14 @@ static inline int lb__exponent_mode(size_t k, const double *p) {
 
 /* lb__fast_ok for blend parameters (p required), returning the exponent
  * mode, or -1 when a check fails. */
+static inline int lb__fast_mode_n(size_t kmax, size_t k, const double *x, const double *r,
+                                  const double *p, const double *m, double rmax) {
+    if (!p || !lb__fast_ok_n(kmax, k, x, r, p, m, rmax)) return -1;
+    return lb__exponent_mode(k, p);
+}
 static inline int lb__fast_mode(size_t k, const double *x, const double *r, const double *p,
                                 const double *m, double rmax) {
-    if (!p || !lb__fast_ok(k, x, r, p, m, rmax)) return -1;
-    return lb__exponent_mode(k, p);
+    return lb__fast_mode_n(LB_MAX_ARITY, k, x, r, p, m, rmax);
 }
 
 /* |v| of a 3-vector without overflow or underflow of the squares. */
@@ -170,7 +179,12 @@ LB_INTERNAL double lb__kernel(lb_kernel kernel, double rho, double *df);
 
 /* ---- kernels (unchecked). Gradient outputs may be NULL. ---- */
 
-/* BT_k union (displacement). m must be non-NULL. dx, dr, dm: d/dx_i, d/dr_i, d/dm_i. */
+/* BT_k union (displacement). m must be non-NULL. dx, dr, dm: d/dx_i, d/dr_i, d/dm_i.
+ * k <= LB_MAX_ARITY (NAN beyond); lb__bt_union_ws takes any k with 4k
+ * doubles of the caller's scratch, and computes the same bits. */
+LB_INTERNAL double lb__bt_union_ws(size_t k, const double *x, const double *r, const double *p,
+                                   const double *m, int mode, double *dx, double *dr, double *dm,
+                                   double *ws);
 LB_INTERNAL LB_READS(2, 1) LB_READS(3, 1) LB_READS(4, 1)
     LB_READS(5, 1) double lb__bt_union(size_t k, const double *x, const double *r, const double *p,
                                        const double *m, int mode, double *dx, double *dr,

@@ -361,6 +361,7 @@ static lb_status allocate_registers(lb_evaluator *ev, uint32_t root, lb_error *e
         in->dst = reg_of[i];
         in->aoff = ev->total_k;
         if (in->code == LB__I_OP) ev->total_k += in->op.k;
+        if (in->code == LB__I_OP && in->op.k > ev->kmax) ev->kmax = in->op.k;
         if (in->code == LB__I_OP) {
             const size_t ns = in->op.k * (in->op.family == LB__F_BOUNDED ? 2 : 1);
             for (size_t j = 0; j < ns; ++j) {

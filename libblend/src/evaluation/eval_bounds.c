@@ -216,12 +216,32 @@ static int is_difference_family(lb__family f) {
            f == LB__F_SOFT_HYPER || f == LB__F_SOFT_CONIC || f == LB__F_PERLIN;
 }
 
+/* Per-argument scratch of the passes, after the interval registers
+ * (tape.h, LB__IV_SCRATCH doubles per argument of the widest operator):
+ * the arguments' and bounding values' intervals, the culled list,
+ * fast_bounds' 9 and op_bounds' 2. */
+typedef struct bscr {
+    iv *x, *c;
+    uint16_t *act;
+    double *fb, *xl;
+} bscr;
+static bscr scratch(const lb_evaluator *ev, iv *R) {
+    double *S = lb__iv_scratch(ev, R);
+    const size_t K = ev->kmax;
+    return (bscr){(iv *)(void *)S, (iv *)(void *)(S + 2 * K), (uint16_t *)(void *)(S + 4 * K),
+                  S + 5 * K, S + 14 * K};
+}
+
 /* Displacement and conic (no bulge) on the arguments a box can reach
  * (cull's list): the culled ones are inactive at both corners, so the
- * kernel on the rest gives the same values, without re-validation. */
-static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, size_t na, iv *out) {
+ * kernel on the rest gives the same values, without re-validation. ws: 9k
+ * doubles of scratch. */
+static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, size_t na, iv *out,
+                        double *ws) {
     const lb__node *n = &in->op;
-    double lo[LB_MAX_ARITY], hi[LB_MAX_ARITY], r[LB_MAX_ARITY], p[LB_MAX_ARITY], m[LB_MAX_ARITY];
+    const size_t K = n->k;
+    double *lo = ws, *hi = lo + K, *r = hi + K, *p = r + K, *m = p + K;
+    ws = m + K;
     for (size_t j = 0; j < na; ++j) {
         const iv u = dual_iv(n->op, act[j], x[act[j]]);
         lo[j] = u.lo;
@@ -235,8 +255,8 @@ static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, s
         v1 = lo[0] / m[0];
         v2 = hi[0] / m[0];
     } else if (in->fast == LB__FAST_DISPLACEMENT) {
-        v1 = lb__bt_union(na, lo, r, p, m, in->mode, NULL, NULL, NULL);
-        v2 = lb__bt_union(na, hi, r, p, m, in->mode, NULL, NULL, NULL);
+        v1 = lb__bt_union_ws(na, lo, r, p, m, in->mode, NULL, NULL, NULL, ws);
+        v2 = lb__bt_union_ws(na, hi, r, p, m, in->mode, NULL, NULL, NULL, ws);
     } else {
         v1 = lb__conic_union(lo, r, n->shape, m, NULL, NULL, NULL);
         v2 = lb__conic_union(hi, r, n->shape, m, NULL, NULL, NULL);
@@ -259,7 +279,8 @@ static int any_above_one(const iv *x, size_t k) {
     return 0;
 }
 
-static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const iv *c, iv *out) {
+static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const iv *c, iv *out,
+                      double *xl) {
     const size_t k = n->k;
     if (n->bulge) {
         bulge_bounds(n, x, out);
@@ -291,7 +312,7 @@ static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const 
         out->lo = P.lo > 0.0 ? P.lo : 0.0;
         out->hi = P.hi > 0.0 ? P.hi : 0.0;
     } else {
-        double xl[LB_MAX_ARITY], xh[LB_MAX_ARITY], v1 = 0.0, v2 = 0.0;
+        double *xh = xl + k, v1 = 0.0, v2 = 0.0; /* xl: the caller's 2k doubles */
         for (size_t i = 0; i < k; ++i) {
             const int dec = n->op == LB_DIFFERENCE && i > 0 && is_difference_family(n->family);
             xl[i] = dec ? x[i].hi : x[i].lo;
@@ -353,11 +374,15 @@ static uint16_t cull(const lb__node *n, const iv *x, uint16_t *act) {
     return na;
 }
 
-/* What the root needs, backwards from the plan's argument lists. */
-static void plan_needs(const lb_evaluator *ev, lb__plan *plan) {
-    memset(plan->need, 0, ev->n);
+/* What the root needs, backwards from the plan's argument lists: need and
+ * the list. Only instructions of parent's list can be needed when parent
+ * is given (a box inside parent's), so only they are visited. */
+static void plan_needs(const lb_evaluator *ev, lb__plan *plan, const lb__plan *parent) {
+    for (uint32_t q = 0; q < plan->nlist; ++q) plan->need[plan->list[q]] = 0;
+    const size_t m = parent ? parent->nlist : ev->n;
     plan->need[ev->n - 1] = 1;
-    for (size_t i = ev->n; i-- > 0;) {
+    for (size_t q = m; q-- > 0;) {
+        const size_t i = parent ? parent->list[q] : q;
         const lb__instr *in = &ev->ins[i];
         if (!plan->need[i] || in->code != LB__I_OP) continue;
         const uint16_t *act = plan->act + in->aoff;
@@ -368,11 +393,18 @@ static void plan_needs(const lb_evaluator *ev, lb__plan *plan) {
         if (in->op.bulge) /* the Hessian terms re-run both arguments' prefixes */
             for (size_t a = 0; a < in->op.k; ++a) plan->need[in->srci[a]] = 1;
     }
+    uint32_t c = 0;
+    for (size_t q = 0; q < m; ++q) {
+        const uint32_t i = parent ? parent->list[q] : (uint32_t)q;
+        if (plan->need[i]) plan->list[c++] = i;
+    }
+    plan->nlist = c;
 }
 
 void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br[3], iv *R,
                      lb__plan *plan) {
-    iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
+    const bscr S = scratch(ev, R);
+    iv *x = S.x, *c = S.c;
     for (size_t i = 0; i < ev->n; ++i) {
         const lb__instr *in = &ev->ins[i];
         iv o;
@@ -384,16 +416,15 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
             if (in->op.family == LB__F_BOUNDED)
                 for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
             if (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC) {
-                uint16_t local[LB_MAX_ARITY];
-                uint16_t *act = plan ? plan->act + in->aoff : local;
+                uint16_t *act = plan ? plan->act + in->aoff : S.act;
                 const uint16_t na = cull(&in->op, x, act);
                 if (plan) plan->nact[i] = na;
-                fast_bounds(in, x, act, na, &o);
+                fast_bounds(in, x, act, na, &o, S.fb);
             } else if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN) {
                 lb__local_bounds(ev, in, x, bc, br, &o);
                 if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
             } else {
-                op_bounds(ev->conv, &in->op, x, c, &o);
+                op_bounds(ev->conv, &in->op, x, c, &o, S.xl);
                 if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
             }
         }
@@ -401,13 +432,14 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
         o.hi = clampd(o.hi);
         R[in->dst] = o;
     }
-    if (plan) plan_needs(ev, plan);
+    if (plan) plan_needs(ev, plan, NULL);
 }
 
 /* An operator over all its arguments' intervals (no culling). */
 static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const double bc[3],
-                            const double br[3], const iv *R, iv *o) {
-    iv x[LB_MAX_ARITY], c[LB_MAX_ARITY];
+                            const double br[3], iv *R, iv *o) {
+    const bscr S = scratch(ev, R);
+    iv *x = S.x, *c = S.c;
     const size_t k = in->op.k;
     for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
     if (in->op.family == LB__F_BOUNDED)
@@ -415,7 +447,7 @@ static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const d
     if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN)
         lb__local_bounds(ev, in, x, bc, br, o);
     else
-        op_bounds(ev->conv, &in->op, x, c, o);
+        op_bounds(ev->conv, &in->op, x, c, o, S.xl);
 }
 
 /* The same pass over a box inside the box of `parent` (a plan made by
@@ -427,9 +459,10 @@ static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const d
  * of the parent's), every other operator the parent's list. */
 void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const double bc[3],
                          const double br[3], iv *R, lb__plan *child) {
-    iv x[LB_MAX_ARITY];
-    for (size_t i = 0; i < ev->n; ++i) {
-        if (!parent->need[i]) continue;
+    const bscr S = scratch(ev, R);
+    iv *x = S.x;
+    for (uint32_t q = 0; q < parent->nlist; ++q) {
+        const uint32_t i = parent->list[q];
         const lb__instr *in = &ev->ins[i];
         iv o;
         if (in->code != LB__I_OP) {
@@ -456,14 +489,14 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                     const double t = u.hi / n->m[pa[j]];
                     if (t < H) H = t;
                 }
-                uint16_t act[LB_MAX_ARITY], na = 0;
+                uint16_t *act = S.act, na = 0;
                 for (uint16_t j = 0; j < pn; ++j) {
                     const uint16_t a = pa[j];
                     const iv u = dual_iv(n->op, a, x[a]);
                     const double reach = u.lo - n->m[a] * H;
                     if (!(reach >= n->r[a] * (1.0 + 1e-9) + 1e-12 * fabs(u.lo))) act[na++] = a;
                 }
-                fast_bounds(in, x, act, na, &o);
+                fast_bounds(in, x, act, na, &o, S.fb);
                 if (child) {
                     memcpy(child->act + in->aoff, act, na * sizeof *act);
                     child->nact[i] = na;
@@ -486,7 +519,7 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
         o.hi = clampd(o.hi);
         R[in->dst] = o;
     }
-    if (child) plan_needs(ev, child);
+    if (child) plan_needs(ev, child, parent);
 }
 
 void lb__bounds_pass_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist,
@@ -528,7 +561,7 @@ lb_status lb__bounds_box(const lb_evaluator *ev, const double bmin[3], const dou
                             "xyz"[d], bmin[d], "xyz"[d], bmax[d]);
     }
     lb__box_centre(bmin, bmax, bc, br);
-    iv *R = malloc(ev->nregs * sizeof *R);
+    iv *R = malloc(lb__ivs_len(ev) * sizeof *R);
     if (!R) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", fn);
     lb__bounds_pass(ev, bc, br, R, NULL);
     *lo = R[ev->out].lo;

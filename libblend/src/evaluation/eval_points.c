@@ -132,12 +132,14 @@ static void run_prim(const lb__instr *in, size_t n, const double *x, const doubl
 
 /* The fast kernels: the same arithmetic as the public functions, without
  * re-validating parameters the compiler already checked. x, r, p, m hold the
- * k active arguments (all of them unless a plan culled some). */
+ * k active arguments (all of them unless a plan culled some); ws is 6k
+ * doubles of scratch. */
 static double fast_op(const lb__instr *in, size_t k, const uint16_t *act, const double *x,
                       const double *r, const double *p, const double *m, const double *ir,
-                      const double *im, double *dx) {
+                      const double *im, double *dx, double *ws) {
     const lb__node *n = &in->op;
-    double xt[LB_MAX_ARITY], sg[LB_MAX_ARITY];
+    double *xt = ws, *sg = ws + k;
+    ws += 2 * k;
     switch (in->fast) {
     case LB__FAST_MINMAX: {
         size_t j = 0;
@@ -165,9 +167,9 @@ static double fast_op(const lb__instr *in, size_t k, const uint16_t *act, const 
             h = u[0] / m[0];
             dx[0] = 1.0 / m[0];
         } else if (disp && ir)
-            h = lb__bt_two_union_recip(k, u, r, m, ir, im, dx);
+            h = lb__bt_two_union_recip(k, u, r, m, ir, im, dx, ws);
         else if (disp)
-            h = lb__bt_union(k, u, r, p, m, in->mode, dx, NULL, NULL);
+            h = lb__bt_union_ws(k, u, r, p, m, in->mode, dx, NULL, NULL, ws);
         else
             h = lb__conic_union(u, r, n->shape, m, dx, NULL, NULL);
         if (n->op == LB_UNION) return h;
@@ -243,8 +245,16 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
         return lb__local_run(ev, in, n, px, py, pz, regs, err);
     const size_t kf = nd->k;
     const int bounded = nd->family == LB__F_BOUNDED;
+    /* per-argument arrays in the scratch after the registers (tape.h): the
+     * argument indices, values, bounding values and their derivatives, the
+     * parameters, the reciprocals, fast_op's 6, the registers' columns */
+    double *S = lb__op_scratch(ev, regs);
+    uint16_t *all = (uint16_t *)(void *)S;
+    double *x = S + kf, *c = x + kf, *dx = c + kf, *dc = dx + kf, *r = dc + kf, *p = r + kf,
+           *m = p + kf, *irb = m + kf, *imb = irb + kf, *fws = imb + kf;
+    const double **vs = (const double **)(void *)(fws + 6 * kf), **gxs = vs + kf, **gys = gxs + kf,
+                 **gzs = gys + kf;
     /* the active arguments: all, or those the plan kept (fast kernels only) */
-    uint16_t all[LB_MAX_ARITY];
     const uint16_t *act = all;
     size_t k = kf;
     if (plan && in->fast) {
@@ -253,9 +263,6 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
     } else {
         for (size_t i = 0; i < kf; ++i) all[i] = (uint16_t)i;
     }
-    double x[LB_MAX_ARITY], c[LB_MAX_ARITY], dx[LB_MAX_ARITY], dc[LB_MAX_ARITY];
-    double r[LB_MAX_ARITY], p[LB_MAX_ARITY], m[LB_MAX_ARITY];
-    const double *vs[LB_MAX_ARITY], *gxs[LB_MAX_ARITY], *gys[LB_MAX_ARITY], *gzs[LB_MAX_ARITY];
     for (size_t i = 0; i < k; ++i) {
         const uint16_t a = act[i];
         vs[i] = lb__reg(regs, in->src[a], 0);
@@ -299,14 +306,13 @@ static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__p
         if (!dgall) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", nd->path);
     }
     /* every p = 2 displacement: the reciprocals of r and m once for the chunk */
-    double irb[LB_MAX_ARITY], imb[LB_MAX_ARITY];
     const int recip = in->fast == LB__FAST_DISPLACEMENT && in->mode == LB__P_TWO && k > 1;
     if (recip) lb__bt_recip(k, r, m, irb, imb);
     for (size_t j = 0; j < n; ++j) {
         for (size_t i = 0; i < k; ++i) x[i] = vs[i][j];
         double v;
         if (in->fast && point_ok(x, k)) {
-            v = fast_op(in, k, act, x, r, p, m, recip ? irb : NULL, imb, dx);
+            v = fast_op(in, k, act, x, r, p, m, recip ? irb : NULL, imb, dx, fws);
         } else {
             if (bounded)
                 for (size_t i = 0; i < k; ++i) c[i] = lb__reg(regs, in->src[k + i], 0)[j];
@@ -371,7 +377,7 @@ static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n
                            const double *y, const double *z, const double *dg, double *G,
                            size_t *count, lb_error *err) {
     memset(G, 0, 3 * n * sizeof *G);
-    double *regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
+    double *regs = malloc(lb__regs_len(ev) * sizeof *regs);
     if (!regs) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
     double sx[LB__CHUNK], sy[LB__CHUNK], sz[LB__CHUNK], eps[LB__CHUNK], len[LB__CHUNK];
     lb_status s = LB_OK;
@@ -446,7 +452,8 @@ lb_status lb__tape_run_counted(const lb_evaluator *ev, size_t n, const double *x
 
 lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *plan, size_t n, const double *x,
                             const double *y, const double *z, double *regs, lb_error *err) {
-    return run_list(ev, plan, NULL, ev->n - 1, n, x, y, z, regs, NULL, err);
+    if (!plan->nlist) return LB_OK;
+    return run_list(ev, plan, plan->list, plan->nlist - 1, n, x, y, z, regs, NULL, err);
 }
 
 /* ---- batches and threads ----
@@ -531,16 +538,15 @@ static uint32_t *morton_order(size_t n, const double *x, const double *y, const 
 
 static void run_blocks(job *J) {
     const lb_evaluator *ev = J->ev;
-    const size_t chunk_bytes = ev->nregs * 4 * LB__CHUNK * sizeof(double);
-    double *regs = malloc(chunk_bytes);
-    lb__iv *R = malloc(ev->nregs * sizeof *R);
-    lb__plan plan = {malloc(ev->n), malloc(ev->n * sizeof *plan.nact),
-                     malloc((ev->total_k ? ev->total_k : 1) * sizeof *plan.act)};
+    double *regs = malloc(lb__regs_len(ev) * sizeof *regs);
+    lb__iv *R = malloc(lb__ivs_len(ev) * sizeof *R);
+    lb__plan plan;
+    lb__plan_alloc(ev, &plan, NULL);
     /* a block's points gathered into visiting order, and its results: the
      * random reads and writes of a Morton order happen in two tight loops
      * (many loads in flight) instead of between chunks */
     double *buf = J->order ? malloc(7 * BLOCK_CHUNKS * LB__CHUNK * sizeof *buf) : NULL;
-    const int ok = regs && R && plan.need && plan.nact && plan.act && (buf || !J->order);
+    const int ok = regs && R && plan.need && (buf || !J->order);
     const size_t nblocks = (J->n + BLOCK_CHUNKS * LB__CHUNK - 1) / (BLOCK_CHUNKS * LB__CHUNK);
     for (;;) {
         const size_t b = atomic_fetch_add(&J->next, 1);
@@ -628,9 +634,7 @@ static void run_blocks(job *J) {
     free(regs);
     free(R);
     free(buf);
-    free(plan.need);
-    free(plan.nact);
-    free(plan.act);
+    lb__plan_free(&plan);
 }
 
 static void *worker(void *arg) {
@@ -697,25 +701,79 @@ lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const double *x, c
     return LB_OK;
 }
 
+static lb_status boxeval_alloc(const lb_evaluator *ev, lb__boxeval *E, lb_error *err) {
+    memset(E, 0, sizeof *E);
+    E->regs = malloc(lb__regs_len(ev) * sizeof *E->regs);
+    E->iv = malloc(lb__ivs_len(ev) * sizeof *E->iv);
+    if (!E->regs || !E->iv || lb__plan_alloc(ev, &E->plan, NULL)) {
+        lb__boxeval_free(E);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_evaluator_eval: out of memory");
+    }
+    return LB_OK;
+}
+
 /* Points known to lie in one box (a mesher's block): one interval pass for
  * the box decides the culling for every chunk; no reordering, no threads.
  * The caller guarantees every point is inside [bmin, bmax]. */
 lb_status lb__boxeval_init(const lb_evaluator *ev, const double bmin[3], const double bmax[3],
                            lb__boxeval *E, lb_error *err) {
-    memset(E, 0, sizeof *E);
-    E->regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *E->regs);
-    E->iv = malloc(ev->nregs * sizeof *E->iv);
-    E->plan.need = malloc(ev->n);
-    E->plan.nact = malloc(ev->n * sizeof *E->plan.nact);
-    E->plan.act = malloc((ev->total_k ? ev->total_k : 1) * sizeof *E->plan.act);
-    if (!E->regs || !E->iv || !E->plan.need || !E->plan.nact || !E->plan.act) {
-        lb__boxeval_free(E);
-        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_evaluator_eval: out of memory");
-    }
+    lb_status s = boxeval_alloc(ev, E, err);
+    if (s) return s;
     double bc[3], br[3];
     lb__box_centre(bmin, bmax, bc, br);
     lb__bounds_pass(ev, bc, br, E->iv, &E->plan);
     return LB_OK;
+}
+
+lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E,
+                                lb_error *err) {
+    lb_status s = boxeval_alloc(ev, E, err);
+    if (s) return s;
+    const uint16_t *a = C->act;
+    for (uint32_t q = 0; q < C->nlist; ++q) {
+        const uint32_t i = C->list[q];
+        E->plan.need[i] = 1;
+        E->plan.list[q] = i;
+        if (ev->ins[i].code != LB__I_OP) continue;
+        const uint16_t na = *a++;
+        E->plan.nact[i] = na;
+        memcpy(E->plan.act + ev->ins[i].aoff, a, na * sizeof *a);
+        a += na;
+    }
+    E->plan.nlist = C->nlist;
+    return LB_OK;
+}
+
+lb_status lb__cplan_make(const lb_evaluator *ev, const lb__plan *P, lb__cplan *C, lb_error *err) {
+    size_t na = 0;
+    for (uint32_t q = 0; q < P->nlist; ++q)
+        if (ev->ins[P->list[q]].code == LB__I_OP) na += 1u + P->nact[P->list[q]];
+    C->nlist = P->nlist;
+    C->nact_total = (uint32_t)na;
+    C->list = malloc((P->nlist ? P->nlist : 1) * sizeof *C->list);
+    C->act = malloc((na ? na : 1) * sizeof *C->act);
+    if (!C->list || !C->act) {
+        lb__cplan_free(C);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+    }
+    uint16_t *a = C->act;
+    for (uint32_t q = 0; q < P->nlist; ++q) {
+        const uint32_t i = P->list[q];
+        C->list[q] = i;
+        if (ev->ins[i].code != LB__I_OP) continue;
+        *a++ = P->nact[i];
+        memcpy(a, P->act + ev->ins[i].aoff, P->nact[i] * sizeof *a);
+        a += P->nact[i];
+    }
+    return LB_OK;
+}
+
+void lb__cplan_free(lb__cplan *C) {
+    free(C->list);
+    free(C->act);
+    C->list = NULL;
+    C->act = NULL;
+    C->nlist = C->nact_total = 0;
 }
 
 lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n, const double *x,
@@ -743,22 +801,38 @@ void lb__boxeval_narrow(const lb_evaluator *ev, lb__boxeval *E, const lb__plan *
 
 size_t lb__plan_prims(const lb_evaluator *ev, const lb__plan *P) {
     size_t c = 0;
-    for (size_t i = 0; i < ev->n; ++i) c += P->need[i] && ev->ins[i].code != LB__I_OP;
+    for (uint32_t q = 0; q < P->nlist; ++q) c += ev->ins[P->list[q]].code != LB__I_OP;
     return c;
 }
 
-lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P, lb_error *err) {
+lb_status lb__plan_alloc(const lb_evaluator *ev, lb__plan *P, lb_error *err) {
     const size_t nk = ev->total_k ? ev->total_k : 1;
-    P->need = malloc(ev->n);
+    P->need = calloc(ev->n, 1);
     P->nact = malloc(ev->n * sizeof *P->nact);
     P->act = malloc(nk * sizeof *P->act);
-    if (!P->need || !P->nact || !P->act) {
+    P->list = malloc(ev->n * sizeof *P->list);
+    P->nlist = 0;
+    if (!P->need || !P->nact || !P->act || !P->list) {
         lb__plan_free(P);
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
     }
-    memcpy(P->need, from->need, ev->n);
-    memcpy(P->nact, from->nact, ev->n * sizeof *P->nact);
-    memcpy(P->act, from->act, nk * sizeof *P->act);
+    return LB_OK;
+}
+
+lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P, lb_error *err) {
+    lb_status s = lb__plan_alloc(ev, P, err);
+    if (s) return s;
+    /* only what the plan lists: its cost, not the tape's */
+    for (uint32_t q = 0; q < from->nlist; ++q) {
+        const uint32_t i = from->list[q];
+        P->need[i] = 1;
+        P->list[q] = i;
+        if (ev->ins[i].code != LB__I_OP) continue;
+        P->nact[i] = from->nact[i];
+        memcpy(P->act + ev->ins[i].aoff, from->act + ev->ins[i].aoff,
+               from->nact[i] * sizeof *P->act);
+    }
+    P->nlist = from->nlist;
     return LB_OK;
 }
 
@@ -766,16 +840,17 @@ void lb__plan_free(lb__plan *P) {
     free(P->need);
     free(P->nact);
     free(P->act);
+    free(P->list);
     P->need = NULL;
     P->nact = P->act = NULL;
+    P->list = NULL;
+    P->nlist = 0;
 }
 
 void lb__boxeval_free(lb__boxeval *E) {
     free(E->regs);
     free(E->iv);
-    free(E->plan.need);
-    free(E->plan.nact);
-    free(E->plan.act);
+    lb__plan_free(&E->plan);
     memset(E, 0, sizeof *E);
 }
 

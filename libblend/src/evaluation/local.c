@@ -685,8 +685,8 @@ static lb_status make_bvh(child_eval *E, struct lb__curves *C) {
 static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double bmin[3],
                              const double bmax[3], lb_error *err) {
     struct lb__curves *C = calloc(1, sizeof *C);
-    double *regs = malloc(ev->nregs * 4 * LB__CHUNK * sizeof *regs);
-    lb__iv *R = malloc(ev->nregs * sizeof *R);
+    double *regs = malloc(lb__regs_len(ev) * sizeof *regs);
+    lb__iv *R = malloc(lb__ivs_len(ev) * sizeof *R);
     builder B;
     memset(&B, 0, sizeof B);
     cellset S = {NULL, 0, 0};

@@ -59,6 +59,7 @@ struct lb_evaluator {
     size_t nregs;
     uint32_t out;   /* register of the root */
     size_t total_k; /* sum of operator arities */
+    size_t kmax;    /* largest operator arity (sizes the scratch after the registers) */
     int cullable;   /* some operator can drop arguments per box (lb__bounds_pass) */
     double cost;    /* instruction runs per point for the whole tape (the cost model) */
 };
@@ -70,13 +71,33 @@ typedef struct lb__iv {
 
 /* What one box needs (argument culling, libfive-style tape specialisation):
  * need[i] says whether instruction i contributes to the root anywhere in the
- * box; act + ins[i].aoff lists the nact[i] arguments of operator i that can
- * contribute (the others provably leave value and gradient unchanged). */
+ * box, and list[0..nlist) names those i in tape order (need[i] is 1 for
+ * exactly the listed i), so passes and runs under a plan cost what the plan
+ * keeps, not the tape's length; act + ins[i].aoff lists the nact[i]
+ * arguments of operator i that can contribute (the others provably leave
+ * value and gradient unchanged). */
 typedef struct lb__plan {
     uint8_t *need;
     uint16_t *nact;
     uint16_t *act;
+    uint32_t *list;
+    uint32_t nlist;
 } lb__plan;
+
+/* A plan with nothing needed yet (allocated for ev; NULL members and
+ * LB_ERR_NO_MEMORY when memory is short). */
+LB_INTERNAL lb_status lb__plan_alloc(const lb_evaluator *ev, lb__plan *P, lb_error *err);
+
+/* A plan kept small, for many boxes at once (the mesher's blocks): the
+ * listed instructions, then each listed operator's argument list. */
+typedef struct lb__cplan {
+    uint32_t nlist, nact_total;
+    uint32_t *list;
+    uint16_t *act;
+} lb__cplan;
+LB_INTERNAL lb_status lb__cplan_make(const lb_evaluator *ev, const lb__plan *P, lb__cplan *C,
+                                     lb_error *err);
+LB_INTERNAL void lb__cplan_free(lb__cplan *C);
 
 /* Interval pass over the box centre bc, half-size br: R (nregs entries)
  * receives every register's interval; the root's is R[ev->out]. With a plan,
@@ -180,6 +201,9 @@ typedef struct lb__boxeval {
 } lb__boxeval;
 LB_INTERNAL lb_status lb__boxeval_init(const lb_evaluator *ev, const double bmin[3],
                                        const double bmax[3], lb__boxeval *E, lb_error *err);
+/* The same with the box's plan already made (lb__cplan_make), no pass. */
+LB_INTERNAL lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C,
+                                            lb__boxeval *E, lb_error *err);
 LB_INTERNAL lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n,
                                       const double *x, const double *y, const double *z, double *v,
                                       double *gx, double *gy, double *gz, lb_error *err);
@@ -207,6 +231,28 @@ LB_INTERNAL lb_status lb__eval_in_box(const lb_evaluator *ev, const double bmin[
 
 static inline double *lb__reg(double *regs, uint32_t r, int comp) {
     return regs + ((size_t)r * 4u + (size_t)comp) * LB__CHUNK;
+}
+
+/* Per-argument scratch of the operators lives after the registers, in the
+ * caller's allocation, so an operator of any arity needs no stack arrays
+ * and no allocation of its own: a point register file is lb__regs_len(ev)
+ * doubles (the registers, then LB__OP_SCRATCH doubles per argument of the
+ * widest operator, from lb__op_scratch), an interval register file
+ * lb__ivs_len(ev) intervals (then LB__IV_SCRATCH doubles per argument, from
+ * lb__iv_scratch). */
+#define LB__OP_SCRATCH 24
+#define LB__IV_SCRATCH 16
+static inline size_t lb__regs_len(const lb_evaluator *ev) {
+    return ev->nregs * 4u * LB__CHUNK + LB__OP_SCRATCH * ev->kmax;
+}
+static inline double *lb__op_scratch(const lb_evaluator *ev, double *regs) {
+    return regs + ev->nregs * 4u * LB__CHUNK;
+}
+static inline size_t lb__ivs_len(const lb_evaluator *ev) {
+    return ev->nregs + LB__IV_SCRATCH / 2 * ev->kmax;
+}
+static inline double *lb__iv_scratch(const lb_evaluator *ev, lb__iv *R) {
+    return (double *)(void *)(R + ev->nregs);
 }
 
 #endif

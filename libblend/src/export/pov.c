@@ -114,15 +114,31 @@ static void arr(sbuf *b, size_t k, const double *v, double fallback) {
 
 static lb_status emit(pctx *c, const lb__node *n, int *out);
 
-static lb_status emit_args(pctx *c, const lb__node *n, lb__node *const *args, int aid) {
-    int ids[LB_MAX_ARITY];
-    for (size_t i = 0; i < n->k; ++i) {
-        lb_status s = emit(c, args[i], &ids[i]);
-        if (s) return s;
+/* The k nodes args written, their function numbers into *ids (the caller
+ * frees it; NULL on failure). */
+static lb_status emit_list(pctx *c, size_t k, lb__node *const *args, int **ids) {
+    *ids = malloc(k * sizeof **ids);
+    if (!*ids) return lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    for (size_t i = 0; i < k; ++i) {
+        const lb_status s = emit(c, args[i], &(*ids)[i]);
+        if (s) {
+            free(*ids);
+            *ids = NULL;
+            return s;
+        }
     }
-    sb(c->b, "#declare LBa%d = array[%zu] {", aid, n->k);
-    for (size_t i = 0; i < n->k; ++i) sb(c->b, "%sLBn%d", i ? ", " : "", ids[i]);
+    return LB_OK;
+}
+
+/* The nodes args written, then an array of them named LB<tag><aid>. */
+static lb_status emit_array(pctx *c, size_t k, lb__node *const *args, char tag, int aid) {
+    int *ids;
+    const lb_status s = emit_list(c, k, args, &ids);
+    if (s) return s;
+    sb(c->b, "#declare LB%c%d = array[%zu] {", tag, aid, k);
+    for (size_t i = 0; i < k; ++i) sb(c->b, "%sLBn%d", i ? ", " : "", ids[i]);
     sb(c->b, "};\n");
+    free(ids);
     return LB_OK;
 }
 
@@ -403,13 +419,13 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
         if ((s = emit(c, n->args[0], &a))) return s;
         sb(b, "#declare %s%d = LBn%d;\n", name, id, a);
     } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
-        int ids[LB_MAX_ARITY];
-        for (size_t i = 0; i < n->k; ++i)
-            if ((s = emit(c, n->args[i], &ids[i]))) return s;
+        int *ids;
+        if ((s = emit_list(c, n->k, n->args, &ids))) return s;
         sb(b, "#declare %s%d = function(x, y, z) { %s(", name, id,
            n->family == LB__F_MIN ? "min" : "max");
         for (size_t i = 0; i < n->k; ++i) sb(b, "%sLBn%d(x, y, z)", i ? ", " : "", ids[i]);
         sb(b, "%s) }\n", n->k > 1 ? "" : n->family == LB__F_MIN ? ", 1e300" : ", -1e300");
+        free(ids);
     } else if (n->family == LB__F_COMPLEMENT) {
         int a;
         if ((s = emit(c, n->args[0], &a))) return s;
@@ -452,15 +468,10 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
         arr(b, 2, n->m, 1.0);
         sb(b, ")\n");
     } else {
-        if ((s = emit_args(c, n, n->args, id))) return s;
+        if ((s = emit_array(c, n->k, n->args, 'a', id))) return s;
         if (n->family == LB__F_BOUNDED) {
-            int ids[LB_MAX_ARITY];
-            for (size_t i = 0; i < n->k; ++i)
-                if ((s = emit(c, n->bounds[i], &ids[i]))) return s;
-            sb(b, "#declare LBc%d = array[%zu] {", id, n->k);
-            for (size_t i = 0; i < n->k; ++i) sb(b, "%sLBn%d", i ? ", " : "", ids[i]);
-            sb(b, "};\n#declare %s%d = LB_Bounded(%d, LBa%d, LBc%d, ", name, id, (int)n->op, id,
-               id);
+            if ((s = emit_array(c, n->k, n->bounds, 'c', id))) return s;
+            sb(b, "#declare %s%d = LB_Bounded(%d, LBa%d, LBc%d, ", name, id, (int)n->op, id, id);
             arr(b, n->k, n->p, 2.0);
             sb(b, ")\n");
         } else if (n->family == LB__F_DISPLACEMENT || n->family == LB__F_SOFT_HYPER) {

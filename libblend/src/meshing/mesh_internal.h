@@ -56,6 +56,7 @@ typedef struct lb__block {
     double *grads;  /* their gradients, 3 per node */
     uint8_t *nmask; /* nodes evaluated (corners of cells that may cross) */
     uint8_t *cmask; /* cells that may cross the surface, nc[0] * nc[1] * nc[2] */
+    lb__cplan plan; /* the block box's plan, from the block selection's descent */
     /* output: vertices keyed by grid edge, triangles by local vertex index */
     size_t nv, nt;
     uint64_t *vkey;

@@ -125,38 +125,57 @@ static void phi_interval(const lb__grid *g, const double bl[3], const double bh[
     *hi = phi;
 }
 
-/* An interval of phi_c over the nodes [n0, n1] (inclusive) of the grid. */
-static lb_status box_phi(const lb_evaluator *ev, const lb__grid *g, const uint64_t n0[3],
-                         const uint64_t n1[3], double *lo, double *hi, lb_error *err) {
-    double bl[3], bh[3];
-    lb__node_pos(g, n0[0], n0[1], n0[2], bl);
-    lb__node_pos(g, n1[0], n1[1], n1[2], bh);
-    double flo, fhi;
-    lb_status s = lb__bounds_box(ev, bl, bh, &flo, &fhi, err);
-    if (s) return s;
-    phi_interval(g, bl, bh, flo, fhi, lo, hi);
-    return LB_OK;
-}
-
-/* ---- block selection (octree over block ranges) ---- */
+/* ---- block selection (octree over block ranges) ----
+ * Each box's interval pass runs under its parent box's plan (the root's
+ * over the whole tape), so a box looks only at the blend arguments that
+ * can reach its parent: the octree is the spatial index over the
+ * arguments, and a kept block leaves with its own plan (kept small, in
+ * lb__block.plan) for its node values and refinement. */
 
 typedef struct blist {
     lb__block *b;
     size_t n, cap;
 } blist;
 
-static lb_status select_blocks(const lb_evaluator *ev, const lb__grid *g, const uint32_t r0[3],
-                               const uint32_t r1[3], const uint32_t nb[3], blist *L,
-                               size_t max_blocks, lb_error *err) {
+typedef struct sel {
+    const lb_evaluator *ev;
+    const lb__grid *g;
+    const uint32_t *nb;
+    blist *L;
+    size_t max_blocks;
+    lb__plan *pool; /* one plan per depth */
+    lb__iv *R;
+    int keep; /* store each block's plan */
+} sel;
+
+/* Depths of the octree over nb blocks: each level halves one side. */
+static int sel_depth(const uint32_t nb[3]) {
+    int d = 1;
+    for (int a = 0; a < 3; ++a)
+        for (uint32_t s = 1; s < nb[a]; s *= 2) ++d;
+    return d;
+}
+
+static lb_status select_blocks(sel *S, const uint32_t r0[3], const uint32_t r1[3],
+                               const lb__plan *parent, int depth, lb_error *err) {
+    const lb__grid *g = S->g;
     uint64_t n0[3], n1[3];
     for (int d = 0; d < 3; ++d) {
         n0[d] = (uint64_t)r0[d] * LB__MB;
         n1[d] = (uint64_t)r1[d] * LB__MB;
         if (n1[d] > g->cells[d]) n1[d] = g->cells[d];
     }
+    double bl[3], bh[3], bc[3], br[3];
+    lb__node_pos(g, n0[0], n0[1], n0[2], bl);
+    lb__node_pos(g, n1[0], n1[1], n1[2], bh);
+    lb__box_centre(bl, bh, bc, br);
+    lb__plan *own = &S->pool[depth];
+    if (parent)
+        lb__bounds_pass_sub(S->ev, parent, bc, br, S->R, own);
+    else
+        lb__bounds_pass(S->ev, bc, br, S->R, own);
     double lo, hi;
-    lb_status s = box_phi(ev, g, n0, n1, &lo, &hi, err);
-    if (s) return s;
+    phi_interval(g, bl, bh, S->R[S->ev->out].lo, S->R[S->ev->out].hi, &lo, &hi);
     if (lo >= 0.0 || hi < 0.0) return LB_OK; /* all outside, or all inside */
     int axis = -1;
     uint32_t span = 1;
@@ -165,9 +184,10 @@ static lb_status select_blocks(const lb_evaluator *ev, const lb__grid *g, const 
             span = r1[d] - r0[d];
             axis = d;
         }
+    blist *L = S->L;
     if (axis < 0) {
-        if (L->n >= max_blocks)
-            return lb__fail(err, LB_ERR_NO_MEMORY, "%s: more than %zu blocks", FN, max_blocks);
+        if (L->n >= S->max_blocks)
+            return lb__fail(err, LB_ERR_NO_MEMORY, "%s: more than %zu blocks", FN, S->max_blocks);
         if (L->n == L->cap) {
             const size_t nc = L->cap ? 2 * L->cap : 256;
             lb__block *q = realloc(L->b, nc * sizeof *q);
@@ -175,21 +195,57 @@ static lb_status select_blocks(const lb_evaluator *ev, const lb__grid *g, const 
             L->b = q;
             L->cap = nc;
         }
-        lb__block *B = &L->b[L->n++];
+        lb__block *B = &L->b[L->n];
         memset(B, 0, sizeof *B);
+        if (S->keep) {
+            lb_status s = lb__cplan_make(S->ev, own, &B->plan, err);
+            if (s) return s;
+        }
+        ++L->n;
         for (int d = 0; d < 3; ++d) {
             B->b[d] = r0[d];
             B->nc[d] = (uint32_t)(n1[d] - n0[d]);
         }
-        B->id = ((uint64_t)r0[2] * nb[1] + r0[1]) * nb[0] + r0[0];
+        B->id = ((uint64_t)r0[2] * S->nb[1] + r0[1]) * S->nb[0] + r0[0];
         return LB_OK;
     }
     const uint32_t mid = r0[axis] + span / 2;
     uint32_t a1[3] = {r1[0], r1[1], r1[2]}, b0[3] = {r0[0], r0[1], r0[2]};
     a1[axis] = mid;
     b0[axis] = mid;
-    if ((s = select_blocks(ev, g, r0, a1, nb, L, max_blocks, err))) return s;
-    return select_blocks(ev, g, b0, r1, nb, L, max_blocks, err);
+    lb_status s = select_blocks(S, r0, a1, own, depth + 1, err);
+    if (s) return s;
+    return select_blocks(S, b0, r1, own, depth + 1, err);
+}
+
+static void blist_free(blist *L) {
+    for (size_t i = 0; i < L->n; ++i) lb__cplan_free(&L->b[i].plan);
+    free(L->b);
+    L->b = NULL;
+    L->n = L->cap = 0;
+}
+
+/* The blocks of grid g (nb per axis) that the surface may cross, into L
+ * (with their plans when keep). */
+static lb_status select_all(const lb_evaluator *ev, const lb__grid *g, const uint32_t nb[3],
+                            blist *L, size_t max_blocks, int keep, lb_error *err) {
+    const int depth = sel_depth(nb);
+    sel S = {ev,
+             g,
+             nb,
+             L,
+             max_blocks,
+             calloc((size_t)depth, sizeof(lb__plan)),
+             malloc(lb__ivs_len(ev) * sizeof(lb__iv)),
+             keep};
+    lb_status s = S.pool && S.R ? LB_OK : lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    for (int d = 0; d < depth && !s && S.pool; ++d) s = lb__plan_alloc(ev, &S.pool[d], err);
+    const uint32_t zero[3] = {0, 0, 0};
+    if (!s) s = select_blocks(&S, zero, nb, NULL, 0, err);
+    for (int d = 0; d < depth && S.pool; ++d) lb__plan_free(&S.pool[d]);
+    free(S.pool);
+    free(S.R);
+    return s;
 }
 
 static int cmp_block(const void *a, const void *b) {
@@ -316,10 +372,8 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     B->grads = malloc(3 * n * sizeof *B->grads);
     if (!B->nmask || !B->cmask || !B->vals || !B->grads)
         return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    double bmin[3], bmax[3];
-    lb__block_box(g, B, bmin, bmax);
     lb__boxeval E;
-    lb_status s = lb__boxeval_init(ev, bmin, bmax, &E, err);
+    lb_status s = lb__boxeval_init_plan(ev, &B->plan, &E, err);
     if (s) return s;
     const uint32_t zero[3] = {0, 0, 0};
     /* few primitives: no narrower plans (LB__NARROW_MIN_PRIMS), here or below */
@@ -377,7 +431,7 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
                 }
     }
     start[ngroups] = w;
-    lb__plan outer = {NULL, NULL, NULL};
+    lb__plan outer = {0};
     if (narrow) s = lb__plan_copy(ev, &E.plan, &outer, err);
     for (int o = 0; o < ngroups && !s; ++o) {
         const size_t c = start[o + 1] - start[o];
@@ -461,6 +515,7 @@ static void do_block(run *R, size_t i, size_t t) {
         free(B->cmask);
         B->vals = B->grads = NULL;
         B->nmask = B->cmask = NULL;
+        lb__cplan_free(&B->plan);
     }
     if (s) {
         pthread_mutex_lock(&R->lock);
@@ -696,9 +751,8 @@ static int fits(const lb_evaluator *ev, const lb_mesh_options *opt, unsigned res
     uint32_t nb[3];
     for (int d = 0; d < 3; ++d) nb[d] = (g.cells[d] + LB__MB - 1) / LB__MB;
     blist L = {NULL, 0, 0};
-    const uint32_t zero[3] = {0, 0, 0};
-    const lb_status s = select_blocks(ev, &g, zero, nb, nb, &L, max_blocks, NULL);
-    free(L.b);
+    const lb_status s = select_all(ev, &g, nb, &L, max_blocks, 0, NULL);
+    blist_free(&L);
     return s == LB_OK;
 }
 
@@ -750,8 +804,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     for (int d = 0; d < 3; ++d) R.nb[d] = (g.cells[d] + LB__MB - 1) / LB__MB;
     progress P = {opt->progress, opt->user, 0.0, 0.05, 0};
     blist L = {NULL, 0, 0};
-    const uint32_t zero[3] = {0, 0, 0};
-    s = select_blocks(ev, &g, zero, R.nb, R.nb, &L, max_blocks, err);
+    s = select_all(ev, &g, R.nb, &L, max_blocks, 1, err);
     if (s == LB_ERR_NO_MEMORY && L.n >= max_blocks) {
         const unsigned fit = largest_fit(ev, opt, max_blocks);
         if (fit)
@@ -770,7 +823,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
                          max_memory >> 20);
     }
     if (s) {
-        free(L.b);
+        blist_free(&L);
         return s;
     }
     if (L.n) qsort(L.b, L.n, sizeof *L.b, cmp_block); /* an empty mesh is valid output */
@@ -806,6 +859,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         free(B->vpos);
         free(B->vnrm);
         free(B->tri);
+        lb__cplan_free(&B->plan);
     }
     free(R.blocks);
     for (size_t t = 0; t < R.nctx; ++t) lb__bctx_free(R.ctx[t]);

@@ -131,10 +131,8 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
         if (!(t0 < 1.0 - 1e-9)) t0 = 1.0 - 1e-9;
         t[i] = t0;
     }
-    double bmin[3], bmax[3];
-    lb__block_box(g, B, bmin, bmax);
     lb__boxeval E;
-    lb_status s = lb__boxeval_init(ev, bmin, bmax, &E, err);
+    lb_status s = lb__boxeval_init_plan(ev, &B->plan, &E, err);
     if (s) {
         free(mem);
         return s;
@@ -144,7 +142,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
      * with few primitives keeps all the edges in one group. */
     const int narrow = lb__plan_prims(ev, &E.plan) >= LB__NARROW_MIN_PRIMS;
     const int ngroups = narrow ? 8 : 1;
-    lb__plan outer = {NULL, NULL, NULL};
+    lb__plan outer = {0};
     size_t start[9] = {0};
     const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
     if (narrow) {

@@ -68,15 +68,15 @@ static inline int lb__bt_alone(size_t k, const double *x, const double *m, const
  * is the answer when every term of S is still active there; otherwise
  * T > 0 at the largest breakpoint of S to the right of that root, so move h
  * there and drop that term. Each pass drops a term: no sorting. */
-static inline double lb__bt_two(size_t k, const double *b, const double *m, const double *ir,
-                                double lo, double hi) {
-    unsigned char act[LB_MAX_ARITY];
+static inline double lb__bt_two(size_t k, double *b, const double *m, const double *ir, double lo,
+                                double hi) {
+    /* S = the terms with b_i < hi; a dropped term gets b_i = +inf (b is the
+     * caller's scratch, read by nothing after this) */
     double h = hi;
-    for (size_t i = 0; i < k; ++i) act[i] = b[i] < hi;
     for (size_t pass = 0; pass <= k; ++pass) {
         double A = 0.0, B = 0.0, C = 0.0;
         for (size_t i = 0; i < k; ++i) {
-            if (!act[i]) continue;
+            if (!(b[i] < hi)) continue;
             const double c = m[i] * ir[i], c2 = c * c, d = h - b[i];
             A += c2;
             B += c2 * d;
@@ -94,7 +94,7 @@ static inline double lb__bt_two(size_t k, const double *b, const double *m, cons
         size_t drop = k;
         double bd = -INFINITY;
         for (size_t i = 0; i < k; ++i)
-            if (act[i] && b[i] > hq && b[i] > bd) {
+            if (b[i] < hi && b[i] > hq && b[i] > bd) {
                 bd = b[i];
                 drop = i;
             }
@@ -102,7 +102,7 @@ static inline double lb__bt_two(size_t k, const double *b, const double *m, cons
             h = hq;
             break;
         }
-        act[drop] = 0;
+        b[drop] = INFINITY;
         h = bd;
     }
     if (h < lo) h = lo;
@@ -110,14 +110,13 @@ static inline double lb__bt_two(size_t k, const double *b, const double *m, cons
     return h;
 }
 
-/* Derivatives at the root h from w_i (or recomputed when w is NULL; p NULL
- * means every p_i = 2). */
+/* Derivatives at the root h from w_i (wl, or recomputed when wl is NULL;
+ * p NULL means every p_i = 2); w is k doubles of scratch (may be wl). */
 static inline void lb__bt_grads(size_t k, const double *x, const double *r, const double *p,
                                 const double *m, const double *ir, int mode, double h,
-                                size_t argmin, const double *wl, double *dx, double *dr,
+                                size_t argmin, const double *wl, double *w, double *dx, double *dr,
                                 double *dm) {
     if (!dx && !dr && !dm) return;
-    double w[LB_MAX_ARITY];
     double D = 0.0;
     for (size_t i = 0; i < k; ++i) {
         if (wl) {
@@ -145,31 +144,41 @@ static inline void lb__bt_grads(size_t k, const double *x, const double *r, cons
 
 /* BT_k union with every p_i = 2 (lb__bt_union's LB__P_TWO path, also the
  * compiled evaluator's batch loop): the value, and the derivatives by the
- * arguments, ranges and slopes (each of dx, dr, dm may be NULL). */
-static inline double lb__bt_two_union(size_t k, const double *x, const double *r, const double *m,
-                                      double *dx, double *dr, double *dm) {
-    double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY];
+ * arguments, ranges and slopes (each of dx, dr, dm may be NULL). ws: 4k
+ * doubles of scratch. */
+static inline double lb__bt_two_union_ws(size_t k, const double *x, const double *r,
+                                         const double *m, double *dx, double *dr, double *dm,
+                                         double *ws) {
+    double *ir = ws, *im = ws + k, *b = ws + 2 * k, *w = ws + 3 * k;
     double lo, hi;
     size_t j;
     lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
     if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
     const double h = lb__bt_two(k, b, m, ir, lo, hi);
-    lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, dx, dr, dm);
+    lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, w, dx, dr, dm);
     return h;
 }
 
+/* The same for k <= LB_MAX_ARITY, with scratch on the stack. */
+static inline double lb__bt_two_union(size_t k, const double *x, const double *r, const double *m,
+                                      double *dx, double *dr, double *dm) {
+    double ws[4 * LB_MAX_ARITY];
+    return lb__bt_two_union_ws(k, x, r, m, dx, dr, dm, ws);
+}
+
 /* lb__bt_two_union with the reciprocals of r and m given (lb__bt_recip):
- * the same value and derivatives by the arguments, bit for bit. */
+ * the same value and derivatives by the arguments, bit for bit. ws: 2k
+ * doubles of scratch. */
 static inline double lb__bt_two_union_recip(size_t k, const double *x, const double *r,
                                             const double *m, const double *ir, const double *im,
-                                            double *dx) {
-    double b[LB_MAX_ARITY];
+                                            double *dx, double *ws) {
+    double *b = ws, *w = ws + k;
     double lo, hi;
     size_t j;
     lb__bt_setup_recip(k, x, r, im, b, &lo, &hi, &j);
     if (lb__bt_alone(k, x, m, b, hi, j, dx, NULL, NULL)) return x[j] / m[j];
     const double h = lb__bt_two(k, b, m, ir, lo, hi);
-    lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, dx, NULL, NULL);
+    lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, w, dx, NULL, NULL);
     return h;
 }
 

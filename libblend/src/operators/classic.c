@@ -87,7 +87,11 @@ lb_status lb_classic(lb_classic_kind kind, size_t k, const double *x, double par
                         "%s: kind = %d; allowed: LB_MIN (0) .. LB_PERLIN_DIFFERENCE (8)", fn,
                         (int)kind);
     const int binary = kind == LB_RFUNC_UNION || kind == LB_RFUNC_INTERSECTION;
-    if ((s = lb__check_k(fn, k, binary ? 2 : 1, binary ? 2 : LB_MAX_ARITY, err)) ||
+    /* min, max, the sum and Ricci's union need no per-argument scratch */
+    const int wide =
+        kind == LB_MIN || kind == LB_MAX || kind == LB_SOFT_SUM || kind == LB_RICCI_UNION;
+    const size_t kmax = binary ? 2 : wide ? LB_MAX_ARITY_WIDE : LB_MAX_ARITY;
+    if ((s = lb__check_k(fn, k, binary ? 2 : 1, kmax, err)) ||
         (s = lb__check_out(fn, value, err)) || (s = lb__check_finite(fn, "x", k, x, err)))
         return s;
     if (kind == LB_RICCI_UNION &&

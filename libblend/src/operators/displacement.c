@@ -17,6 +17,8 @@
 #include "../solver/root.h"
 #include "bt_two.h"
 
+#include <stdlib.h>
+
 typedef struct {
     size_t k;
     const double *x, *r, *p, *m, *ir, *im; /* ir = 1/r, im = 1/m */
@@ -55,9 +57,10 @@ static LB__ALWAYS_INLINE void bt_T(double h, const void *vctx, double *T, double
     *smooth = 0.5 * rad;
 }
 
-double lb__bt_union_newton(size_t k, const double *x, const double *r, const double *p,
-                           const double *m, int mode, double *dx, double *dr, double *dm) {
-    double ir[LB_MAX_ARITY], im[LB_MAX_ARITY], b[LB_MAX_ARITY], w[LB_MAX_ARITY];
+static double bt_newton_ws(size_t k, const double *x, const double *r, const double *p,
+                           const double *m, int mode, double *dx, double *dr, double *dm,
+                           double *ws) {
+    double *ir = ws, *im = ws + k, *b = ws + 2 * k, *w = ws + 3 * k;
     double lo, hi;
     size_t j;
     lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
@@ -81,14 +84,28 @@ double lb__bt_union_newton(size_t k, const double *x, const double *r, const dou
         if (fabs(pm * u) > 1e-4) reuse = 0;
         w[i] *= 1.0 + pm * u * (1.0 + 0.5 * (pm - 1.0) * u);
     }
-    lb__bt_grads(k, x, r, p, m, ir, ctx.mode, h, j, reuse ? w : NULL, dx, dr, dm);
+    lb__bt_grads(k, x, r, p, m, ir, ctx.mode, h, j, reuse ? w : NULL, w, dx, dr, dm);
     return h;
+}
+
+double lb__bt_union_newton(size_t k, const double *x, const double *r, const double *p,
+                           const double *m, int mode, double *dx, double *dr, double *dm) {
+    double ws[4 * LB_MAX_ARITY];
+    if (k > LB_MAX_ARITY) return NAN;
+    return bt_newton_ws(k, x, r, p, m, mode, dx, dr, dm, ws);
+}
+
+double lb__bt_union_ws(size_t k, const double *x, const double *r, const double *p, const double *m,
+                       int mode, double *dx, double *dr, double *dm, double *ws) {
+    if (mode != LB__P_TWO) return bt_newton_ws(k, x, r, p, m, mode, dx, dr, dm, ws);
+    return lb__bt_two_union_ws(k, x, r, m, dx, dr, dm, ws); /* every p_i is 2 in this mode */
 }
 
 double lb__bt_union(size_t k, const double *x, const double *r, const double *p, const double *m,
                     int mode, double *dx, double *dr, double *dm) {
-    if (mode != LB__P_TWO) return lb__bt_union_newton(k, x, r, p, m, mode, dx, dr, dm);
-    return lb__bt_two_union(k, x, r, m, dx, dr, dm); /* every p_i is 2 in this mode */
+    double ws[4 * LB_MAX_ARITY];
+    if (k > LB_MAX_ARITY) return NAN; /* wider calls bring their scratch (lb__bt_union_ws) */
+    return lb__bt_union_ws(k, x, r, p, m, mode, dx, dr, dm, ws);
 }
 
 lb_status lb__check_blend_params(const char *fn, size_t k, const double *r, const double *p,
@@ -101,29 +118,34 @@ lb_status lb__check_blend_params(const char *fn, size_t k, const double *r, cons
 lb_status lb_displacement(lb_setop op, size_t k, const double *x, const double *r, const double *p,
                           const double *m, double *value, double *grad, lb_error *err) {
     static const char fn[] = "lb_displacement";
-    const int mode = lb__fast_mode(k, x, r, p, m, INFINITY);
+    const int mode = lb__fast_mode_n(LB_MAX_ARITY_WIDE, k, x, r, p, m, INFINITY);
     if (!((unsigned)op <= LB_DIFFERENCE && value && mode >= 0)) {
         lb_status s;
-        if ((s = lb__check_setop(fn, op, err)) || (s = lb__check_k(fn, k, 1, LB_MAX_ARITY, err)) ||
+        if ((s = lb__check_setop(fn, op, err)) ||
+            (s = lb__check_k(fn, k, 1, LB_MAX_ARITY_WIDE, err)) ||
             (s = lb__check_out(fn, value, err)) || (s = lb__check_finite(fn, "x", k, x, err)) ||
             (s = lb__check_blend_params(fn, k, r, p, m, INFINITY, err)))
             return s;
         return lb__fail(err, LB_ERR_INTERNAL, "%s: parameter check disagreement", fn);
     }
-    double ones[LB_MAX_ARITY], xt[LB_MAX_ARITY], sg[LB_MAX_ARITY];
+    /* scratch: m's ones, the duals and their signs, the kernel's 4k; on the
+     * stack up to LB_MAX_ARITY arguments, on the heap beyond */
+    double stack[7 * LB_MAX_ARITY], *ws = stack;
+    if (k > LB_MAX_ARITY && !(ws = malloc(7 * k * sizeof *ws)))
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory for %zu arguments", fn, k);
+    double *ones = ws + 4 * k, *xt = ones + k, *sg = xt + k;
     if (!m) {
         for (size_t i = 0; i < k; ++i) ones[i] = 1.0;
         m = ones;
     }
     if (op == LB_UNION) {
-        *value = lb__bt_union(k, x, r, p, m, mode, grad, NULL, NULL);
-        return LB_OK;
+        *value = lb__bt_union_ws(k, x, r, p, m, mode, grad, NULL, NULL, ws);
+    } else {
+        lb__dual_args(op, k, x, xt, sg);
+        *value = -lb__bt_union_ws(k, xt, r, p, m, mode, grad, NULL, NULL, ws);
+        if (grad)
+            for (size_t i = 0; i < k; ++i) grad[i] *= -sg[i];
     }
-    lb__dual_args(op, k, x, xt, sg);
-    const double h = lb__bt_union(k, xt, r, p, m, mode, grad, NULL, NULL);
-    const double out = op == LB_UNION ? 1.0 : -1.0;
-    *value = out * h;
-    if (grad)
-        for (size_t i = 0; i < k; ++i) grad[i] *= out * sg[i];
+    if (ws != stack) free(ws);
     return LB_OK;
 }

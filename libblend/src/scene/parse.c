@@ -384,17 +384,17 @@ static const type_info TYPES[] = {
     {"cylinder", LB__F_PRIMITIVE, LB_PRIM_CYLINDER, CONV_BOTH, 0, 0, 0, k_cylinder},
     {"capsule", LB__F_PRIMITIVE, LB_PRIM_CAPSULE, CONV_BOTH, 0, 0, 0, k_capsule},
     {"torus", LB__F_PRIMITIVE, LB_PRIM_TORUS, CONV_BOTH, 0, 0, 0, k_torus},
-    {"displacement", LB__F_DISPLACEMENT, 0, CONV_ZERO, 1, 1, LB_MAX_ARITY, k_displacement},
+    {"displacement", LB__F_DISPLACEMENT, 0, CONV_ZERO, 1, 1, LB_MAX_ARITY_WIDE, k_displacement},
     {"conic", LB__F_CONIC, 0, CONV_ZERO, 1, 2, 2, k_displacement},
     {"scale", LB__F_SCALE, 0, CONV_ZERO, 1, 1, LB_MAX_ARITY, k_scale},
     {"bounded", LB__F_BOUNDED, 0, CONV_ZERO, 1, 1, LB_MAX_ARITY, k_bounded},
     {"soft_hyper", LB__F_SOFT_HYPER, 0, CONV_SOFT, 1, 1, LB_MAX_ARITY, k_soft},
     {"soft_conic", LB__F_SOFT_CONIC, 0, CONV_SOFT, 1, 2, 2, k_soft},
-    {"min", LB__F_MIN, 0, CONV_BOTH, 0, 1, LB_MAX_ARITY, k_args},
-    {"max", LB__F_MAX, 0, CONV_BOTH, 0, 1, LB_MAX_ARITY, k_args},
+    {"min", LB__F_MIN, 0, CONV_BOTH, 0, 1, LB_MAX_ARITY_WIDE, k_args},
+    {"max", LB__F_MAX, 0, CONV_BOTH, 0, 1, LB_MAX_ARITY_WIDE, k_args},
     {"rfunction", LB__F_RFUNCTION, 0, CONV_ZERO, 2, 2, 2, k_opargs},
-    {"soft_sum", LB__F_SOFT_SUM, 0, CONV_SOFT, 0, 1, LB_MAX_ARITY, k_args},
-    {"ricci", LB__F_RICCI, 0, CONV_SOFT, 0, 1, LB_MAX_ARITY, k_ricci},
+    {"soft_sum", LB__F_SOFT_SUM, 0, CONV_SOFT, 0, 1, LB_MAX_ARITY_WIDE, k_args},
+    {"ricci", LB__F_RICCI, 0, CONV_SOFT, 0, 1, LB_MAX_ARITY_WIDE, k_ricci},
     {"perlin", LB__F_PERLIN, 0, CONV_SOFT, 1, 1, LB_MAX_ARITY, k_opargs},
     {"complement", LB__F_COMPLEMENT, 0, CONV_BOTH, 0, 1, 1, k_args},
     {"local_union", LB__F_LOCAL, 0, CONV_BOTH, 0, 2, LB_MAX_ARITY, k_local},
@@ -661,8 +661,12 @@ static lb_status parse_args(pctx *c, const cJSON *j, const char *key, const type
     } else {
         const size_t k = (size_t)cJSON_GetArraySize(a);
         if (k < t->kmin || k > t->kmax) {
-            s = perr(c, LB_ERR_INVALID_ARGUMENT, "%s \"%s\" has %zu argument%s; allowed: %s",
-                     t->name, key, k, k == 1 ? "" : "s", allowed);
+            s = perr(c, LB_ERR_INVALID_ARGUMENT, "%s \"%s\" has %zu argument%s; allowed: %s%s",
+                     t->name, key, k, k == 1 ? "" : "s", allowed,
+                     k > t->kmax && t->kmax == LB_MAX_ARITY
+                         ? " (displacement, min, max, soft_sum and ricci take up to 65535; "
+                           "or nest this node)"
+                         : "");
         } else {
             lb__node **v = calloc(k, sizeof *v);
             if (!v) {
@@ -1098,14 +1102,18 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
     }
     /* backstop: the operator itself accepts the parameters at a neutral point */
     {
-        double x[LB_MAX_ARITY], cb[LB_MAX_ARITY], g[6] = {1, 0, 0, 0, 1, 0}, v = 0.0;
+        double *x = malloc(2 * k * sizeof *x), g[6] = {1, 0, 0, 0, 1, 0}, v = 0.0;
+        if (!x) return oom(c);
+        double *cb = x + k;
         for (size_t i = 0; i < k; ++i) {
             x[i] = c->s->convention == LB_CONVENTION_ZERO ? 0.0 : 0.5;
             cb[i] = 0.5;
         }
         lb_error e = {LB_OK, ""};
-        if (lb__node_apply(n, c->s->convention, x, cb, g, &v, NULL, NULL, NULL, &e))
-            return perr(c, LB_ERR_INVALID_ARGUMENT, "%s", e.message);
+        const lb_status as =
+            lb__node_apply(n, c->s->convention, x, cb, g, &v, NULL, NULL, NULL, &e);
+        free(x);
+        if (as) return perr(c, LB_ERR_INVALID_ARGUMENT, "%s", e.message);
     }
     *out = n;
     return LB_OK;
