@@ -135,6 +135,18 @@ run pov "$T/scale17.json" -o "$T/scale17.pov"
 check "a 17-argument scale blend is refused for POV-Ray with exit 2" rc 2
 check "the refusal names the node and the limit" err_has "\$.root: a scale blend of 17 arguments; allowed in POV-Ray: at most 16"
 check "no .pov written for a refused scene" test ! -e "$T/scale17.pov"
+args=""
+for i in $(seq 0 299); do args="$args${args:+, }{\"type\": \"sphere\", \"center\": [$i, 0, 0], \"radius\": 0.6}"; done
+printf '{"format": "libblend-scene", "version": 1, "convention": "zero", "bounds": {"min": [-2, -2, -2], "max": [302, 2, 2]}, "root": {"type": "displacement", "op": "union", "r": 0.1, "p": 2, "args": [%s]}}\n' "$args" > "$T/wide300.json"
+run validate "$T/wide300.json"
+check "a 300-argument displacement union is a valid scene" rc 0
+run mesh "$T/wide300.json" -o "$T/wide300.ply" --resolution 600
+check "it meshes" rc 0
+run pov "$T/wide300.json" -o "$T/wide300.pov"
+check "it is refused for POV-Ray with exit 2" rc 2
+check "the refusal names the node, the limit and the way out" err_has "\$.root: a displacement node of 300 arguments; allowed in POV-Ray: at most 256"
+check "the refusal points to meshing" err_has "mesh the scene instead (blendtool mesh)"
+check "no .pov written for it" test ! -e "$T/wide300.pov"
 run pov "$SRC/scenes/bench-s2-64-spheres.json" -o "$T/s2.pov"
 check "a 64-argument displacement blend exports" rc 0
 check "its macro call has the 64 functions" grep -q "#declare LBa0 = array\[64\]" "$T/s2.pov"

@@ -110,6 +110,38 @@ for path in scenes:
                 os.path.basename(path), what, "accepts" if s_ok else "rejects",
                 "accepts" if l_ok else "rejects", msg))
 
+# arity: the wide families take 257 and 65535 arguments (per-argument
+# parameter arrays too), nobody 65536; the others stop at 256
+def wide_scene(conv, kind, k, per_arg):
+    sph = {"type": "sphere", "radius": 1}
+    node = {"type": kind, "args": [sph] * k}
+    if kind in ("displacement", "scale"):
+        node.update({"op": "union", "r": [0.1] * k if per_arg else 0.1})
+        if kind == "displacement":
+            node["p"] = [2] * k if per_arg else 2
+    if kind == "perlin":
+        node["op"] = "union"
+    if kind == "ricci":
+        node["n"] = 2
+    return {"format": "libblend-scene", "version": 1, "convention": conv, "root": node}
+
+
+arity = 0
+for conv, kind, k, want in (("zero", "displacement", 257, True), ("zero", "displacement", 65535, True),
+                            ("zero", "displacement", 65536, False), ("zero", "min", 4096, True),
+                            ("zero", "max", 65536, False), ("soft", "soft_sum", 4096, True),
+                            ("soft", "ricci", 300, True), ("soft", "max", 300, True),
+                            ("zero", "scale", 257, False), ("soft", "perlin", 257, False)):
+    for per_arg in ((False, True) if kind == "displacement" and k < 65536 else (False,)):
+        d = wide_scene(conv, kind, k, per_arg)
+        arity += 1
+        s_ok, (l_ok, msg) = schema_accepts(d), library_accepts(d)
+        if s_ok != want or l_ok != want:
+            failures.append("%s %s with %d arguments%s: schema %s, library %s (%s); want %s" % (
+                conv, kind, k, " (per-argument r, p)" if per_arg else "",
+                "accepts" if s_ok else "rejects", "accepts" if l_ok else "rejects", msg,
+                "accepted" if want else "refused"))
+
 # the complete scenes in docs/scene-format.md are valid for both
 doc_scenes = 0
 for block in re.findall(r"```json\n(.*?)```", open(os.path.join(src, "docs", "scene-format.md")).read(), re.S):
@@ -137,5 +169,6 @@ if not library_kinds or library_kinds != schema_kinds:
 
 for f in failures:
     print("FAIL:", f)
-print("%d scenes, %d mutations, %d node kinds, %d failures" % (len(scenes), mutations, len(schema_kinds), len(failures)))
+print("%d scenes, %d mutations, %d arity cases, %d node kinds, %d failures" % (
+    len(scenes), mutations, arity, len(schema_kinds), len(failures)))
 sys.exit(1 if failures else 0)

@@ -16,11 +16,11 @@
  * mirroring the evaluator's box hierarchy, so POV-Ray's field equals the
  * evaluator's to rounding; clean unions are one call of lb_clean_uc.
  *
- * Limits of the include: displacement blends take any number of arguments
- * (past LB_POV_MAX_ARITY each solver step evaluates the arguments again, so
- * they render slower); scale, bounded and soft hyper blends take at most
- * LB_POV_MAX_ARITY, and a scene with a larger one is refused with a message
- * naming the node. */
+ * Limits of the include: displacement blends, min and max take up to
+ * LB_MAX_ARITY arguments (past LB_POV_MAX_ARITY each solver step evaluates
+ * the arguments again, so they render slower); scale, bounded and soft hyper
+ * blends take at most LB_POV_MAX_ARITY. A scene with a larger node (scenes
+ * allow up to LB_MAX_ARITY_WIDE) is refused with a message naming the node. */
 #ifndef LIBBLEND_POV_H
 #define LIBBLEND_POV_H
 

@@ -370,6 +370,12 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
                         "%s: %s: a %s blend of %zu arguments; allowed in POV-Ray: at most %d "
                         "(the include's limit; POV-Ray functions take at most 56 parameters)",
                         FN, n->path, n->type, n->k, LB_POV_MAX_ARITY);
+    if (n->k > LB_MAX_ARITY)
+        return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: %s: a %s node of %zu arguments; allowed in POV-Ray: at most %d (the "
+                        "include's functions run every argument at every point); mesh the scene "
+                        "instead (blendtool mesh)",
+                        FN, n->path, n->type, n->k, LB_MAX_ARITY);
     lb_status s = LB_OK;
     if (n->family == LB__F_PRIMITIVE) {
         const lb_primitive *P = &n->prim;
