@@ -102,7 +102,12 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
                       (li + (mask & 1));
     memcpy(C->ga + 3 * e, B->grads + 3 * (pin ? np : nq), 3 * sizeof(double));
     memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
-    C->key[e] = lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask;
+    /* on a block face (some axis the edge does not run along at 0 or nc):
+     * other blocks may cut it too, and the merge must find their copies */
+    const uint32_t loc[3] = {li, lj, lk};
+    int shared = 0;
+    for (int d = 0; d < 3; ++d) shared |= !((mask >> d) & 1) && (loc[d] == 0 || loc[d] == B->nc[d]);
+    C->key[e] = (lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask) | (uint64_t)shared << 63;
     C->emap[lid] = (int32_t)e;
     C->estamp[lid] = C->stamp;
     return (int64_t)e;

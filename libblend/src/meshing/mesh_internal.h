@@ -57,6 +57,8 @@ typedef struct lb__block {
     uint8_t *nmask; /* nodes evaluated (corners of cells that may cross) */
     uint8_t *cmask; /* cells that may cross the surface, nc[0] * nc[1] * nc[2] */
     lb__cplan plan; /* the block box's plan, from the block selection's descent */
+    uint32_t slot;  /* its place in its layer's slab of node data (mesher.c) */
+    uint8_t half;   /* which of the two slabs: its layer's parity */
     /* output: vertices keyed by grid edge, triangles by local vertex index */
     size_t nv, nt;
     uint64_t *vkey;

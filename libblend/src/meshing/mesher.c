@@ -272,6 +272,10 @@ typedef struct run {
     size_t err_block;
     lb_error err;
     lb__bctx **ctx; /* one extraction state per thread (index 0: the calling thread) */
+    /* node data of the two layers alive at a time, one slab per layer
+     * parity, NODE_BYTES per block slot: reused from layer to layer, so
+     * the heap neither grows nor gives pages back between layers */
+    unsigned char *slab[2];
     size_t nctx;
     /* the worker pool, started once per run: each phase wakes it (gen) and
      * waits until every worker is done with it (active) */
@@ -357,6 +361,12 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
             }
 }
 
+/* One block's node data in its slab: values, gradients, node and cell
+ * marks for the largest block (LB__MB^3 cells). */
+#define SLAB_NODES ((LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1))
+#define NODE_BYTES                                                                                 \
+    ((SLAB_NODES * 4 * sizeof(double) + SLAB_NODES + LB__MB * LB__MB * LB__MB + 63) / 64 * 64)
+
 /* The node values of a block: its plan (one interval pass over the block's
  * box), mark() with sub-box passes under that plan, then the marked nodes
  * evaluated under the same plan (the point evaluator's culling for that
@@ -366,12 +376,13 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     const lb_evaluator *ev = R->ev;
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
     const size_t n = (size_t)D0 * D1 * D2;
-    B->nmask = calloc(n, 1);
-    B->cmask = calloc((size_t)B->nc[0] * B->nc[1] * B->nc[2], 1);
-    B->vals = malloc(n * sizeof *B->vals);
-    B->grads = malloc(3 * n * sizeof *B->grads);
-    if (!B->nmask || !B->cmask || !B->vals || !B->grads)
-        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    unsigned char *base = R->slab[B->half] + (size_t)B->slot * NODE_BYTES;
+    B->vals = (double *)(void *)base;
+    B->grads = B->vals + SLAB_NODES;
+    B->nmask = (uint8_t *)(B->grads + 3 * SLAB_NODES);
+    B->cmask = B->nmask + SLAB_NODES;
+    memset(B->nmask, 0, n);
+    memset(B->cmask, 0, (size_t)B->nc[0] * B->nc[1] * B->nc[2]);
     lb__boxeval E;
     lb_status s = lb__boxeval_init_plan(ev, &B->plan, &E, err);
     if (s) return s;
@@ -508,11 +519,8 @@ static void do_block(run *R, size_t i, size_t t) {
         block_share(R, B);
     else {
         s = lb__mesh_block(R->ev, R->g, B, R->ctx[t], &e);
-        /* the node data is not needed any more (the share phase is over) */
-        free(B->vals);
-        free(B->grads);
-        free(B->nmask);
-        free(B->cmask);
+        /* the node data is not needed any more (the share phase is over):
+         * its slab slot goes to the layer after next */
         B->vals = B->grads = NULL;
         B->nmask = B->cmask = NULL;
         lb__cplan_free(&B->plan);
@@ -645,6 +653,22 @@ static lb_status layers(run *R, size_t nt, progress *P) {
     pthread_t tid[256];
     wctx W[256];
     if (nt > R->nctx) nt = R->nctx;
+    /* the slabs: slots by place in the layer, halves by layer parity */
+    size_t widest = 0;
+    for (size_t i = 0, start = 0, layer = 0; i < R->nblocks; ++i) {
+        if (R->blocks[i].b[2] != R->blocks[start].b[2]) {
+            start = i;
+            ++layer;
+        }
+        R->blocks[i].slot = (uint32_t)(i - start);
+        R->blocks[i].half = (uint8_t)(layer & 1);
+        if (i - start + 1 > widest) widest = i - start + 1;
+    }
+    for (int h = 0; h < 2; ++h)
+        if (widest && !(R->slab[h] = malloc(widest * NODE_BYTES))) {
+            R->err_block = 0;
+            return lb__fail(&R->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        }
     pool_start(R, W, tid, nt);
     lb_status s = LB_OK;
     size_t cur = 0;
@@ -672,18 +696,24 @@ static lb_status layers(run *R, size_t nt, progress *P) {
 /* ---- merge ---- */
 
 static lb_status merge(run *R, lb_mesh *M, lb_error *err) {
-    size_t tv = 0, tt = 0;
+    /* only vertices on block faces (key bit 63, extract.c) can be cut by
+     * two blocks: they alone go through the hash table */
+    size_t tv = 0, tt = 0, ts = 0;
     for (size_t i = 0; i < R->nblocks; ++i) {
         tv += R->blocks[i].nv;
         tt += R->blocks[i].nt;
+        for (size_t v = 0; v < R->blocks[i].nv; ++v) ts += R->blocks[i].vkey[v] >> 63;
     }
     if (tv > UINT32_MAX)
         return lb__fail(err, LB_ERR_NO_MEMORY,
                         "%s: more than %u vertices; allowed: fewer (a coarser resolution)", FN,
                         UINT32_MAX);
     size_t cap = 64;
-    while (cap < 2 * tv) cap *= 2;
-    uint64_t *keys = calloc(cap, sizeof *keys);
+    while (cap < 2 * ts) cap *= 2;
+    /* written once here, not calloc'ed: a zero page read first and written
+     * later faults twice */
+    uint64_t *keys = malloc(cap * sizeof *keys);
+    if (keys) memset(keys, 0, cap * sizeof *keys);
     uint32_t *vals = malloc(cap * sizeof *vals);
     uint32_t *local = malloc((LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1) * 8 * sizeof *local);
     M->positions = malloc(3 * (tv ? tv : 1) * sizeof *M->positions);
@@ -699,6 +729,12 @@ static lb_status merge(run *R, lb_mesh *M, lb_error *err) {
         lb__block *B = &R->blocks[b];
         for (size_t i = 0; i < B->nv; ++i) {
             const uint64_t key = B->vkey[i];
+            if (!(key >> 63)) { /* inside the block: new */
+                memcpy(M->positions + 3 * nv, B->vpos + 3 * i, 3 * sizeof(double));
+                memcpy(M->normals + 3 * nv, B->vnrm + 3 * i, 3 * sizeof(double));
+                local[i] = (uint32_t)nv++;
+                continue;
+            }
             size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
             while (keys[h] && keys[h] != key) h = (h + 1) & (cap - 1);
             if (!keys[h]) {
@@ -851,10 +887,6 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     }
     for (size_t i = 0; i < R.nblocks; ++i) {
         lb__block *B = &R.blocks[i];
-        free(B->vals);
-        free(B->grads);
-        free(B->nmask);
-        free(B->cmask);
         free(B->vkey);
         free(B->vpos);
         free(B->vnrm);
@@ -864,6 +896,8 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     free(R.blocks);
     for (size_t t = 0; t < R.nctx; ++t) lb__bctx_free(R.ctx[t]);
     free(R.ctx);
+    free(R.slab[0]);
+    free(R.slab[1]);
     pthread_mutex_destroy(&R.lock);
     if (s) {
         lb_mesh_free(M);
