@@ -15,8 +15,12 @@
 
 /* ---- primitives ---- */
 
-static void run_ellipsoid(const lb__instr *in, size_t n, const double *x, const double *y,
-                          const double *z, double *v, double *gx, double *gy, double *gz) {
+/* The coordinates and the four output columns never overlap (points and
+ * registers are separate arrays): restrict lets the loop be vectorised
+ * without a run-time check per pair. */
+static void run_ellipsoid(const lb__instr *in, size_t n, const double *restrict x,
+                          const double *restrict y, const double *restrict z, double *restrict v,
+                          double *restrict gx, double *restrict gy, double *restrict gz) {
     const double c0 = in->prim.c[0], c1 = in->prim.c[1], c2 = in->prim.c[2];
     /* reciprocals once per chunk: one division per point (1/f), and a
      * branch-free body the compiler vectorises */
@@ -24,7 +28,11 @@ static void run_ellipsoid(const lb__instr *in, size_t n, const double *x, const 
     for (size_t j = 0; j < n; ++j) {
         const double u0 = (x[j] - c0) * i0, u1 = (y[j] - c1) * i1, u2 = (z[j] - c2) * i2;
         const double f = sqrt(u0 * u0 + u1 * u1 + u2 * u2);
-        const double inv = f > 0.0 ? 1.0 / f : 0.0;
+        /* at the centre u = 0, so any finite 1/f gives the gradient 0 there;
+         * f + (f == 0) is f elsewhere, bit for bit, and a quiet comparison
+         * added in keeps the loop branch-free (GCC vectorises it; a select
+         * on f > 0, a signalling comparison, it does not) */
+        const double inv = 1.0 / (f + (double)(f == 0.0));
         v[j] = f - 1.0;
         gx[j] = u0 * i0 * inv;
         gy[j] = u1 * i1 * inv;
@@ -73,8 +81,9 @@ LB__INLINE void prim_loop(lb_primitive_kind kind, const lb__instr *in, size_t n,
 /* Zero-convention slab or half-space: |n . (M X + t - c)| / w - 1 is one
  * affine function of X, a . X + b, so the map and 1/w fold into a and b once
  * per chunk and the loop is branch-free (the compiler vectorises it). */
-static void run_plane(const lb__instr *in, size_t n, const double *x, const double *y,
-                      const double *z, double *v, double *gx, double *gy, double *gz) {
+static void run_plane(const lb__instr *in, size_t n, const double *restrict x,
+                      const double *restrict y, const double *restrict z, double *restrict v,
+                      double *restrict gx, double *restrict gy, double *restrict gz) {
     const lb_primitive *P = &in->prim;
     const double iw = 1.0 / P->s0, *M = in->A.M, *t = in->A.t;
     double a[3], b = 0.0;
@@ -82,14 +91,30 @@ static void run_plane(const lb__instr *in, size_t n, const double *x, const doub
         a[j] = in->identity ? P->n[j] * iw
                             : (P->n[0] * M[j] + P->n[1] * M[3 + j] + P->n[2] * M[6 + j]) * iw;
     for (int i = 0; i < 3; ++i) b += P->n[i] * ((in->identity ? 0.0 : t[i]) - P->c[i]) * iw;
-    const double neg = P->kind == LB_PRIM_SLAB ? -1.0 : 0.0;
-    for (size_t j = 0; j < n; ++j) {
-        const double d = a[0] * x[j] + a[1] * y[j] + a[2] * z[j] + b;
-        const double sg = d < 0.0 ? neg : 1.0;
-        v[j] = sg * d - 1.0;
-        gx[j] = sg * a[0];
-        gy[j] = sg * a[1];
-        gz[j] = sg * a[2];
+    const double a0 = a[0], a1 = a[1], a2 = a[2];
+    /* one loop per kind, the sign as arithmetic on the comparison: GCC
+     * vectorises these, not a select (d < 0 ? neg : 1) */
+    if (P->kind == LB_PRIM_SLAB) {
+        for (size_t j = 0; j < n; ++j) {
+            const double d = a0 * x[j] + a1 * y[j] + a2 * z[j] + b;
+            const double sg = 1.0 - 2.0 * (double)(d < 0.0); /* -1 below, 1 above */
+            v[j] = sg * d - 1.0;
+            gx[j] = sg * a0;
+            gy[j] = sg * a1;
+            gz[j] = sg * a2;
+        }
+    } else {
+        for (size_t j = 0; j < n; ++j) {
+            const double d = a0 * x[j] + a1 * y[j] + a2 * z[j] + b;
+            /* 1 above, 0 below (the field is -1 there) from the sign bit: GCC
+             * vectorises this, not 1 - (d < 0) (at d = -0 the value is the
+             * same -1, the gradient that of the flat side) */
+            const double sg = 0.5 + 0.5 * copysign(1.0, d);
+            v[j] = sg * d - 1.0;
+            gx[j] = sg * a0;
+            gy[j] = sg * a1;
+            gz[j] = sg * a2;
+        }
     }
 }
 
