@@ -272,10 +272,13 @@ typedef struct run {
     size_t err_block;
     lb_error err;
     lb__bctx **ctx; /* one extraction state per thread (index 0: the calling thread) */
-    /* node data of the two layers alive at a time, one slab per layer
-     * parity, NODE_BYTES per block slot: reused from layer to layer, so
-     * the heap neither grows nor gives pages back between layers */
-    unsigned char *slab[2];
+    /* node data of the two layers alive at a time: a slot (NODE_BYTES) per
+     * place in a layer and layer parity, allocated on first use and reused
+     * from layer to layer, so the heap neither grows nor gives pages back
+     * between layers; each slot is its own heap block (not one large
+     * mapping that a small mesh would fault in afresh every run) */
+    unsigned char **slots[2];
+    size_t nslots;
     size_t nctx;
     /* the worker pool, started once per run: each phase wakes it (gen) and
      * waits until every worker is done with it (active) */
@@ -361,7 +364,7 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
             }
 }
 
-/* One block's node data in its slab: values, gradients, node and cell
+/* One block's node data in its slot: values, gradients, node and cell
  * marks for the largest block (LB__MB^3 cells). */
 #define SLAB_NODES ((LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1))
 #define NODE_BYTES                                                                                 \
@@ -376,7 +379,12 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
     const lb_evaluator *ev = R->ev;
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
     const size_t n = (size_t)D0 * D1 * D2;
-    unsigned char *base = R->slab[B->half] + (size_t)B->slot * NODE_BYTES;
+    /* only this block uses its slot now (one block per place in a layer,
+     * layers of one parity never overlap in time): no lock */
+    unsigned char **slot = &R->slots[B->half][B->slot];
+    if (!*slot && !(*slot = malloc(NODE_BYTES)))
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    unsigned char *base = *slot;
     B->vals = (double *)(void *)base;
     B->grads = B->vals + SLAB_NODES;
     B->nmask = (uint8_t *)(B->grads + 3 * SLAB_NODES);
@@ -520,7 +528,7 @@ static void do_block(run *R, size_t i, size_t t) {
     else {
         s = lb__mesh_block(R->ev, R->g, B, R->ctx[t], &e);
         /* the node data is not needed any more (the share phase is over):
-         * its slab slot goes to the layer after next */
+         * its slot goes to the layer after next */
         B->vals = B->grads = NULL;
         B->nmask = B->cmask = NULL;
         lb__cplan_free(&B->plan);
@@ -653,7 +661,7 @@ static lb_status layers(run *R, size_t nt, progress *P) {
     pthread_t tid[256];
     wctx W[256];
     if (nt > R->nctx) nt = R->nctx;
-    /* the slabs: slots by place in the layer, halves by layer parity */
+    /* the slots: by place in the layer, halves by layer parity */
     size_t widest = 0;
     for (size_t i = 0, start = 0, layer = 0; i < R->nblocks; ++i) {
         if (R->blocks[i].b[2] != R->blocks[start].b[2]) {
@@ -664,8 +672,9 @@ static lb_status layers(run *R, size_t nt, progress *P) {
         R->blocks[i].half = (uint8_t)(layer & 1);
         if (i - start + 1 > widest) widest = i - start + 1;
     }
+    R->nslots = widest;
     for (int h = 0; h < 2; ++h)
-        if (widest && !(R->slab[h] = malloc(widest * NODE_BYTES))) {
+        if (widest && !(R->slots[h] = calloc(widest, sizeof *R->slots[h]))) {
             R->err_block = 0;
             return lb__fail(&R->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
         }
@@ -896,8 +905,10 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     free(R.blocks);
     for (size_t t = 0; t < R.nctx; ++t) lb__bctx_free(R.ctx[t]);
     free(R.ctx);
-    free(R.slab[0]);
-    free(R.slab[1]);
+    for (int h = 0; h < 2; ++h) {
+        for (size_t i = 0; R.slots[h] && i < R.nslots; ++i) free(R.slots[h][i]);
+        free(R.slots[h]);
+    }
     pthread_mutex_destroy(&R.lock);
     if (s) {
         lb_mesh_free(M);
