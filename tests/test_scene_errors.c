@@ -445,21 +445,28 @@ static void test_limits(void **state) {
     free(many);
     /* arity: 257 arguments of a family capped at LB_MAX_ARITY name the wide
      * families; 65536 of a wide one are refused */
-    char *scale257 = repeat(HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"scale\", "
-                                 "\"op\": \"union\", \"r\": 0.1, \"args\": [" SPH,
-                            ", " SPH, 256, "]}}");
-    expect(scale257, strlen(scale257), LB_ERR_INVALID_ARGUMENT,
-           (const char *const[3]){"$.root.args: scale \"args\" has 257 arguments",
-                                  "allowed: an array of 1 to 256 nodes",
-                                  "displacement, min, max, soft_sum and ricci take up to 65535"});
-    free(scale257);
-    char *min65536 = repeat(HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"min\", "
-                                 "\"args\": [" SPH,
-                            ", " SPH, 65535, "]}}");
-    expect(min65536, strlen(min65536), LB_ERR_INVALID_ARGUMENT,
-           (const char *const[3]){"$.root.args: min \"args\" has 65536 arguments",
-                                  "allowed: an array of 1 to 65535 nodes"});
-    free(min65536);
+    static const struct {
+        const char *head;
+        size_t more; /* arguments after the first */
+        const char *want[3];
+    } wide[] = {
+        {"{\"type\": \"scale\", \"op\": \"union\", \"r\": 0.1, \"args\": [",
+         256,
+         {"$.root.args: scale \"args\" has 257 arguments", "allowed: an array of 1 to 256 nodes",
+          "displacement, min, max, soft_sum and ricci take up to 65535"}},
+        {"{\"type\": \"min\", \"args\": [",
+         65535,
+         {"$.root.args: min \"args\" has 65536 arguments",
+          "allowed: an array of 1 to 65535 nodes"}},
+    };
+    for (size_t w = 0; w < sizeof wide / sizeof wide[0]; ++w) {
+        char head[256];
+        snprintf(head, sizeof head, HEAD "\"convention\": \"zero\", \"root\": %s" SPH,
+                 wide[w].head);
+        char *text = repeat(head, ", " SPH, wide[w].more, "]}}");
+        expect(text, strlen(text), LB_ERR_INVALID_ARGUMENT, wide[w].want);
+        free(text);
+    }
     /* text larger than LB_SCENE_MAX_BYTES: refused before it is read */
     static const char small[] = "{}";
     expect(
