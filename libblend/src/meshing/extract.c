@@ -5,8 +5,8 @@
  *
  * A cell method adds polygons (up to LB__MAXPOLY vertices, oriented
  * counter-clockwise seen from outside the solid) through lb__cell_edge and
- * lb__cell_polygon. A polygon is cut into triangles along diagonals of
- * least total length, among the diagonals it allows: a cube polygon never
+ * lb__cell_polygon. A polygon is cut into the triangles whose smallest
+ * angle is largest, among the diagonals it allows: a cube polygon never
  * uses a diagonal that lies in a face of its cell (where the neighbouring
  * cell might place one too), a tetrahedron's quadrilateral may use either. */
 #include "mesh_internal.h"
@@ -22,9 +22,13 @@ typedef struct face {
 } face;
 
 /* One thread's extraction state, reused block after block (lb__bctx_new):
- * the arrays keep their capacity, and the edge map is reset by a stamp
- * instead of a clear. */
+ * the arrays are sized once for the largest block, and the edge map is
+ * reset by a stamp instead of a clear. A block has at most EMAP_SIZE
+ * crossing edges (one per node and axis mask: every local edge id is
+ * distinct) and FACE_MAX polygons (six tetrahedra per cell, or at most
+ * four cube loops), so nothing grows in the cell loop. */
 #define EMAP_SIZE ((size_t)(LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1) * 8)
+#define FACE_MAX ((size_t)6 * LB__MB * LB__MB * LB__MB)
 
 struct lb__bctx {
     const lb__grid *g;
@@ -32,25 +36,14 @@ struct lb__bctx {
     int32_t *emap;    /* local edge id -> crossing edge index, valid where stamp matches */
     uint32_t *estamp; /* the block stamp each emap entry was written for */
     uint32_t stamp;
-    size_t ne, cap;
+    size_t ne;                 /* crossing edges so far (< EMAP_SIZE) */
     double *ea, *eb, *pa, *pb; /* inside end, outside end, their phi */
     double *ga, *gb;           /* and their gradients */
     uint64_t *key;
     face *faces;
-    size_t nf, fcap;
+    size_t nf; /* polygons so far (< FACE_MAX) */
 };
 typedef lb__bctx bctx;
-
-static int grow(void **p, size_t *cap, size_t need, size_t elem) {
-    if (need <= *cap) return 1;
-    size_t nc = *cap ? 2 * *cap : 64;
-    while (nc < need) nc *= 2;
-    void *q = realloc(*p, nc * elem);
-    if (!q) return 0;
-    *p = q;
-    *cap = nc;
-    return 1;
-}
 
 static inline int corner_in(const double *c, int o) {
     return c[o] < 0.0;
@@ -64,26 +57,6 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
     const int mask = op ^ oq;
     const size_t lid = ((size_t)(lk * D1 + lj) * D0 + li) * 8 + (size_t)mask;
     if (C->estamp[lid] == C->stamp) return C->emap[lid];
-    size_t cap = C->cap;
-    if (C->ne + 1 > cap) {
-        size_t nc = cap ? 2 * cap : 256;
-        double *ea = realloc(C->ea, 3 * nc * sizeof *ea);
-        if (ea) C->ea = ea;
-        double *eb = realloc(C->eb, 3 * nc * sizeof *eb);
-        if (eb) C->eb = eb;
-        double *pa = realloc(C->pa, nc * sizeof *pa);
-        if (pa) C->pa = pa;
-        double *pb = realloc(C->pb, nc * sizeof *pb);
-        if (pb) C->pb = pb;
-        uint64_t *key = realloc(C->key, nc * sizeof *key);
-        if (key) C->key = key;
-        double *ga = realloc(C->ga, 3 * nc * sizeof *ga);
-        if (ga) C->ga = ga;
-        double *gb = realloc(C->gb, 3 * nc * sizeof *gb);
-        if (gb) C->gb = gb;
-        if (!ea || !eb || !pa || !pb || !key || !ga || !gb) return -1;
-        C->cap = nc;
-    }
     const lb__grid *g = C->g;
     const uint64_t gx = (uint64_t)B->b[0] * LB__MB + li, gy = (uint64_t)B->b[1] * LB__MB + lj,
                    gz = (uint64_t)B->b[2] * LB__MB + lk;
@@ -118,7 +91,7 @@ const lb__grid *lb__cell_grid(const lb__bctx *C) {
 }
 
 int lb__cell_polygon(lb__bctx *C, const uint32_t *e, const uint8_t *ce, uint32_t n) {
-    if (!grow((void **)&C->faces, &C->fcap, C->nf + 1, sizeof *C->faces)) return 0;
+    if (C->nf >= FACE_MAX) return 0; /* cannot happen (FACE_MAX above) */
     face *f = &C->faces[C->nf++];
     f->n = n;
     memcpy(f->e, e, n * sizeof *e);
@@ -218,7 +191,16 @@ lb__bctx *lb__bctx_new(void) {
     if (!C) return NULL;
     C->emap = malloc(EMAP_SIZE * sizeof *C->emap);
     C->estamp = calloc(EMAP_SIZE, sizeof *C->estamp);
-    if (!C->emap || !C->estamp) {
+    C->ea = malloc(3 * EMAP_SIZE * sizeof *C->ea);
+    C->eb = malloc(3 * EMAP_SIZE * sizeof *C->eb);
+    C->ga = malloc(3 * EMAP_SIZE * sizeof *C->ga);
+    C->gb = malloc(3 * EMAP_SIZE * sizeof *C->gb);
+    C->pa = malloc(EMAP_SIZE * sizeof *C->pa);
+    C->pb = malloc(EMAP_SIZE * sizeof *C->pb);
+    C->key = malloc(EMAP_SIZE * sizeof *C->key);
+    C->faces = malloc(FACE_MAX * sizeof *C->faces);
+    if (!C->emap || !C->estamp || !C->ea || !C->eb || !C->ga || !C->gb || !C->pa || !C->pb ||
+        !C->key || !C->faces) {
         lb__bctx_free(C);
         return NULL;
     }
