@@ -349,6 +349,23 @@ V3, F3 = blender_mesh(out)
 check(not np.array_equal(V3, V2), "the live update changed the mesh")
 check(st.normals is None, "analytic normals set once the field was idle")
 check(normals_cos(out, V3, F3).min() > 0.999, "live update: split normals are the analytic ones")
+# a field whose last run was short is meshed in the timer itself (one tick,
+# no thread); a long one on a worker thread, its mesh moved in when done
+key0 = st.applied_key
+b1.libblend.r = 0.26
+st.expect = 0.001
+live.tick()
+check(st.job is None and not st.dirty and st.applied_key != key0 and not st.error,
+      "a short field is remeshed within one tick, without a thread")
+key1 = st.applied_key
+b1.libblend.r = 0.25
+st.expect = 1.0
+live.tick()
+check(st.job is not None and st.applied_key == key1, "a long field is meshed on a worker thread")
+while live.tick() is not None:
+    time.sleep(0.002)
+check(st.applied_key != key1 and not st.error and st.job is None, "and its mesh moves in when done")
+V3, F3 = blender_mesh(out)
 
 # a primitive's transform (what G / R / S in the viewport do): the depsgraph handler sees it
 st.status = ""
