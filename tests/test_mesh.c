@@ -808,7 +808,8 @@ static void test_min_feature(void **state) {
 /* A flat union of 4096 spheres (one BT_4096 node: 16^3 lattice, spacing
  * 0.5, radius 0.3, range 0.1, p = 2): its values satisfy the operator's
  * defining equation sum_i [(r - x_i + h)/r]+^2 = 1 at random points, with
- * the spheres' fields x_i = |X - c_i| / radius - 1 computed here; the mesh is closed, oriented and
+ * the spheres' fields x_i = |X - c_i| / radius - 1 computed here, and agree
+ * with the reference walk; a min of the same 4096 is their smallest x_i; the mesh is closed, oriented and
  * manifold, every vertex on the surface, the same for 1 and 2 threads. */
 static void test_wide_union(void **state) {
     (void)state;
@@ -839,6 +840,39 @@ static void test_wide_union(void **state) {
     o.threads = 1;
     built A;
     build_text(text, &o, &A);
+    /* the same spheres in one min node: the sharp union, point by point */
+    {
+        const char *args = strstr(text, "\"args\": [");
+        assert_non_null(args);
+        char *mtext = malloc(strlen(args) + 256);
+        assert_non_null(mtext);
+        snprintf(mtext, strlen(args) + 256,
+                 HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"min\", %s", args);
+        lb_scene *ms = NULL;
+        lb_evaluator *me = NULL;
+        lb_error e = {LB_OK, ""};
+        if (lb_scene_parse(mtext, strlen(mtext), "min4096.json", &ms, &e) ||
+            lb_evaluator_create(ms, &me, &e))
+            fail_msg("%s", e.message);
+        free(mtext);
+        rng_t q = {64};
+        for (int j = 0; j < 200; ++j) {
+            const double X[3] = {rng_range(&q, -0.5, 8.0), rng_range(&q, -0.5, 8.0),
+                                 rng_range(&q, -0.5, 8.0)};
+            double v, gx, gy, gz, xmin = INFINITY;
+            assert_int_equal(lb_evaluator_eval(me, 1, X, X + 1, X + 2, &v, &gx, &gy, &gz, 1, &e),
+                             LB_OK);
+            for (int i = 0; i < K; ++i) {
+                const double dx = X[0] - sp * (i % N), dy = X[1] - sp * (i / N % N),
+                             dz = X[2] - sp * (i / (N * N));
+                const double xi = sqrt(dx * dx + dy * dy + dz * dz) / rad - 1.0;
+                if (xi < xmin) xmin = xi;
+            }
+            if (!(fabs(v - xmin) <= 1e-12)) fail_msg("min of 4096: %.17g, want %.17g", v, xmin);
+        }
+        lb_evaluator_free(me);
+        lb_scene_free(ms);
+    }
     free(text);
     /* values against the defining equation */
     rng_t g = {4096};
@@ -877,6 +911,17 @@ static void test_wide_union(void **state) {
     }
     if (!(worst < 1e-9)) fail_msg("defining equation off by %g", worst);
     assert_true(blended > 50); /* the sample reaches the blends */
+    /* the reference walk (lb_displacement of all 4096 arguments, its heap
+     * scratch) agrees with the compiled evaluator (culled per chunk) */
+    for (int j = 0; j < P; j += 20) {
+        double rv, rg[3];
+        assert_int_equal(lb_scene_eval_reference(A.sc, (double[3]){X[j], Y[j], Z[j]}, &rv, rg, &e),
+                         LB_OK);
+        if (!(fabs(rv - V[j]) <= 1e-12 * (1.0 + fabs(rv))) || !(fabs(rg[0] - GX[j]) <= 1e-9) ||
+            !(fabs(rg[1] - GY[j]) <= 1e-9) || !(fabs(rg[2] - GZ[j]) <= 1e-9))
+            fail_msg("point %d: reference %.17g (%g, %g, %g), evaluator %.17g (%g, %g, %g)", j, rv,
+                     rg[0], rg[1], rg[2], V[j], GX[j], GY[j], GZ[j]);
+    }
     free(X);
     expect_closed_manifold("4096 spheres", A.m);
     assert_true(A.m->ntriangles > 100000);
