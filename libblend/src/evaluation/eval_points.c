@@ -561,17 +561,37 @@ static uint32_t *morton_order(size_t n, const double *x, const double *y, const 
     return idx;
 }
 
+/* The box of n points (centre, half-size): branch-free min / max (the
+ * coordinates were checked finite), which the compiler turns into minsd /
+ * maxsd. */
+static void point_box(const double *x, const double *y, const double *z, size_t n, double bc[3],
+                      double br[3]) {
+    double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
+    const double *C[3] = {x, y, z};
+    for (int d = 0; d < 3; ++d)
+        for (size_t j = 1; j < n; ++j) {
+            const double q = C[d][j];
+            lo[d] = q < lo[d] ? q : lo[d];
+            hi[d] = q > hi[d] ? q : hi[d];
+        }
+    lb__box_centre(lo, hi, bc, br);
+}
+
 static void run_blocks(job *J) {
     const lb_evaluator *ev = J->ev;
     double *regs = malloc(lb__regs_len(ev) * sizeof *regs);
     lb__iv *R = malloc(lb__ivs_len(ev) * sizeof *R);
-    lb__plan plan;
+    /* the block's plan (one pass over the whole tape), then each chunk's
+     * under it: a chunk looks only at what reaches its block, so a blend
+     * of thousands of arguments is scanned once per block, not per chunk */
+    lb__plan plan, bplan;
     lb__plan_alloc(ev, &plan, NULL);
+    lb__plan_alloc(ev, &bplan, NULL);
     /* a block's points gathered into visiting order, and its results: the
      * random reads and writes of a Morton order happen in two tight loops
      * (many loads in flight) instead of between chunks */
     double *buf = J->order ? malloc(7 * BLOCK_CHUNKS * LB__CHUNK * sizeof *buf) : NULL;
-    const int ok = regs && R && plan.need && (buf || !J->order);
+    const int ok = regs && R && plan.need && bplan.need && (buf || !J->order);
     const size_t nblocks = (J->n + BLOCK_CHUNKS * LB__CHUNK - 1) / (BLOCK_CHUNKS * LB__CHUNK);
     for (;;) {
         const size_t b = atomic_fetch_add(&J->next, 1);
@@ -601,22 +621,20 @@ static void run_blocks(job *J) {
             ogy = J->gy ? buf + 5 * nb : NULL;
             ogz = J->gz ? buf + 6 * nb : NULL;
         }
+        if (ok && nb > LB__CHUNK) {
+            double bc[3], br[3];
+            point_box(bx, by, bz, nb, bc, br);
+            lb__bounds_pass(ev, bc, br, R, &bplan);
+        }
         for (size_t o = 0; o < nb && !s; o += LB__CHUNK) {
             const size_t m = nb - o < LB__CHUNK ? nb - o : LB__CHUNK;
             const double *cx = bx + o, *cy = by + o, *cz = bz + o;
-            /* the chunk's box: branch-free min / max (the coordinates were
-             * checked finite), which the compiler turns into minsd / maxsd */
-            double lo[3] = {cx[0], cy[0], cz[0]}, hi[3] = {cx[0], cy[0], cz[0]};
-            const double *C[3] = {cx, cy, cz};
-            for (int d = 0; d < 3; ++d)
-                for (size_t j = 1; j < m; ++j) {
-                    const double q = C[d][j];
-                    lo[d] = q < lo[d] ? q : lo[d];
-                    hi[d] = q > hi[d] ? q : hi[d];
-                }
             double bc[3], br[3];
-            lb__box_centre(lo, hi, bc, br);
-            lb__bounds_pass(ev, bc, br, R, &plan);
+            point_box(cx, cy, cz, m, bc, br);
+            if (nb > LB__CHUNK)
+                lb__bounds_pass_sub(ev, &bplan, bc, br, R, &plan);
+            else
+                lb__bounds_pass(ev, bc, br, R, &plan);
             s = lb__tape_run_plan(ev, &plan, m, cx, cy, cz, regs, &e);
             if (s) break;
             const double *rv = lb__reg(regs, ev->out, 0), *rx = lb__reg(regs, ev->out, 1),
@@ -660,6 +678,7 @@ static void run_blocks(job *J) {
     free(R);
     free(buf);
     lb__plan_free(&plan);
+    lb__plan_free(&bplan);
 }
 
 static void *worker(void *arg) {
