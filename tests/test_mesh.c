@@ -809,8 +809,8 @@ static void test_min_feature(void **state) {
  * 0.5, radius 0.3, range 0.1, p = 2): its values satisfy the operator's
  * defining equation sum_i [(r - x_i + h)/r]+^2 = 1 at random points, with
  * the spheres' fields x_i = |X - c_i| / radius - 1 computed here, and agree
- * with the reference walk; a min of the same 4096 is their smallest x_i; the mesh is closed, oriented and
- * manifold, every vertex on the surface, the same for 1 and 2 threads. */
+ * with the reference walk; a min of the same 4096 is their smallest x_i; the mesh is closed,
+ * oriented and manifold, every vertex on the surface, the same for 1 and 2 threads. */
 static void test_wide_union(void **state) {
     (void)state;
     enum { N = 16, K = N * N * N };
