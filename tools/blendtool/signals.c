@@ -42,13 +42,22 @@ static void on_signal(int sig) {
     _exit(128 + sig);
 }
 
-static void hold(int how) {
+/* Hold the three signals; *old (may be NULL) receives the mask before.
+ * Registry changes restore that mask afterwards, not an unblocked one: once
+ * bt_signals_commit has held the signals for good (the output is being put
+ * in place), a registry change must not let a pending signal in, or the
+ * handler would exit 128 + signal with the output already there. */
+static void hold(sigset_t *old) {
     sigset_t set;
     sigemptyset(&set);
     sigaddset(&set, SIGINT);
     sigaddset(&set, SIGTERM);
     sigaddset(&set, SIGHUP);
-    sigprocmask(how, &set, NULL);
+    sigprocmask(SIG_BLOCK, &set, old);
+}
+
+static void restore(const sigset_t *old) {
+    sigprocmask(SIG_SETMASK, old, NULL);
 }
 
 void bt_signals_install(void) {
@@ -69,7 +78,8 @@ void bt_signals_install(void) {
  * a half-written name. */
 int bt_signals_temp(const char *path) {
     if (!path) return -1;
-    hold(SIG_BLOCK);
+    sigset_t old;
+    hold(&old);
     int slot = -1;
     for (int i = 0; i < MAX_TEMPS && slot < 0; ++i)
         if (!temp_used[i] && strlen(path) < sizeof temps[i]) slot = i;
@@ -77,25 +87,27 @@ int bt_signals_temp(const char *path) {
         strcpy(temps[slot], path);
         temp_used[slot] = 1;
     }
-    hold(SIG_UNBLOCK);
+    restore(&old);
     return slot;
 }
 
 void bt_signals_untemp(int slot) {
     if (slot < 0 || slot >= MAX_TEMPS) return;
-    hold(SIG_BLOCK);
+    sigset_t old;
+    hold(&old);
     temp_used[slot] = 0;
-    hold(SIG_UNBLOCK);
+    restore(&old);
 }
 
 void bt_signals_temp_dir(const char *dir) {
-    hold(SIG_BLOCK);
+    sigset_t old;
+    hold(&old);
     temp_dir_used = 0;
     if (dir && strlen(dir) < sizeof temp_dir) {
         strcpy(temp_dir, dir);
         temp_dir_used = 1;
     }
-    hold(SIG_UNBLOCK);
+    restore(&old);
 }
 
 void bt_signals_child(pid_t pid) {
@@ -103,5 +115,5 @@ void bt_signals_child(pid_t pid) {
 }
 
 void bt_signals_commit(void) {
-    hold(SIG_BLOCK);
+    hold(NULL);
 }
