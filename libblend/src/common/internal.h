@@ -133,10 +133,6 @@ static inline int lb__fast_mode_n(size_t kmax, size_t k, const double *x, const 
     if (!p || !lb__fast_ok_n(kmax, k, x, r, p, m, rmax)) return -1;
     return lb__exponent_mode(k, p);
 }
-static inline int lb__fast_mode(size_t k, const double *x, const double *r, const double *p,
-                                const double *m, double rmax) {
-    return lb__fast_mode_n(LB_MAX_ARITY, k, x, r, p, m, rmax);
-}
 
 /* |v| of a 3-vector without overflow or underflow of the squares. */
 static inline double lb__norm3(const double v[3]) {

@@ -756,19 +756,6 @@ static lb_status boxeval_alloc(const lb_evaluator *ev, lb__boxeval *E, lb_error 
     return LB_OK;
 }
 
-/* Points known to lie in one box (a mesher's block): one interval pass for
- * the box decides the culling for every chunk; no reordering, no threads.
- * The caller guarantees every point is inside [bmin, bmax]. */
-lb_status lb__boxeval_init(const lb_evaluator *ev, const double bmin[3], const double bmax[3],
-                           lb__boxeval *E, lb_error *err) {
-    lb_status s = boxeval_alloc(ev, E, err);
-    if (s) return s;
-    double bc[3], br[3];
-    lb__box_centre(bmin, bmax, bc, br);
-    lb__bounds_pass(ev, bc, br, E->iv, &E->plan);
-    return LB_OK;
-}
-
 lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E,
                                 lb_error *err) {
     lb_status s = boxeval_alloc(ev, E, err);
@@ -896,15 +883,4 @@ void lb__boxeval_free(lb__boxeval *E) {
     free(E->iv);
     lb__plan_free(&E->plan);
     memset(E, 0, sizeof *E);
-}
-
-lb_status lb__eval_in_box(const lb_evaluator *ev, const double bmin[3], const double bmax[3],
-                          size_t n, const double *x, const double *y, const double *z, double *v,
-                          double *gx, double *gy, double *gz, lb_error *err) {
-    lb__boxeval E;
-    lb_status s = lb__boxeval_init(ev, bmin, bmax, &E, err);
-    if (s) return s;
-    s = lb__boxeval_run(ev, &E, n, x, y, z, v, gx, gy, gz, err);
-    lb__boxeval_free(&E);
-    return s;
 }

@@ -191,17 +191,15 @@ LB_INTERNAL lb_status lb__tape_run_plan(const lb_evaluator *ev, const lb__plan *
                                         const double *x, const double *y, const double *z,
                                         double *regs, lb_error *err);
 
-/* Evaluation of many batches of points inside one box under one plan: the
- * interval pass over the box once (init), then any number of runs (the
- * mesher's node values and refinement rounds of one block). */
+/* Evaluation of many batches of points inside one box under one plan, the
+ * box's plan made beforehand (the mesher's block selection): any number of
+ * runs (the mesher's node values and refinement rounds of one block). */
 typedef struct lb__boxeval {
     lb__plan plan;
     double *regs;
     lb__iv *iv; /* the box's interval registers (scratch for sub-box passes afterwards) */
 } lb__boxeval;
-LB_INTERNAL lb_status lb__boxeval_init(const lb_evaluator *ev, const double bmin[3],
-                                       const double bmax[3], lb__boxeval *E, lb_error *err);
-/* The same with the box's plan already made (lb__cplan_make), no pass. */
+/* E for the box whose plan C is (lb__cplan_make); no interval pass. */
 LB_INTERNAL lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C,
                                             lb__boxeval *E, lb_error *err);
 LB_INTERNAL lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n,
@@ -220,14 +218,6 @@ LB_INTERNAL lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from
 LB_INTERNAL void lb__plan_free(lb__plan *P);
 /* How many primitives the plan runs per point. */
 LB_INTERNAL size_t lb__plan_prims(const lb_evaluator *ev, const lb__plan *P);
-
-/* Values and gradients of n points that all lie in [bmin, bmax], with the
- * culling of one interval pass over that box (single-threaded; the
- * mesher's blocks). */
-LB_INTERNAL lb_status lb__eval_in_box(const lb_evaluator *ev, const double bmin[3],
-                                      const double bmax[3], size_t n, const double *x,
-                                      const double *y, const double *z, double *v, double *gx,
-                                      double *gy, double *gz, lb_error *err);
 
 static inline double *lb__reg(double *regs, uint32_t r, int comp) {
     return regs + ((size_t)r * 4u + (size_t)comp) * LB__CHUNK;

@@ -91,9 +91,6 @@ LB_INTERNAL void lb__octant_narrow(const lb_evaluator *ev, const lb__grid *g, co
 /* The box of the block's local nodes [l0, l1] (padded by 1e-9 of a cell). */
 LB_INTERNAL void lb__node_box(const lb__grid *g, const lb__block *B, const uint32_t l0[3],
                               const uint32_t l1[3], double bmin[3], double bmax[3]);
-/* The world box of a block's nodes, widened by a hair for rounding. */
-LB_INTERNAL void lb__block_box(const lb__grid *g, const lb__block *B, double bmin[3],
-                               double bmax[3]);
 
 /* phi_c and its gradient from the field's value and gradient at X. */
 LB_INTERNAL double lb__mesh_phi(const lb__grid *g, const double X[3], double f, const double gf[3],

@@ -94,11 +94,6 @@ void lb__octant_narrow(const lb_evaluator *ev, const lb__grid *g, const lb__bloc
     lb__boxeval_narrow(ev, E, outer, omin, omax);
 }
 
-void lb__block_box(const lb__grid *g, const lb__block *B, double bmin[3], double bmax[3]) {
-    const uint32_t zero[3] = {0, 0, 0};
-    lb__node_box(g, B, zero, B->nc, bmin, bmax);
-}
-
 static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxeval *E, size_t *act,
                              size_t na, const double *a, const double *b, const double *ga,
                              const double *gb, double tol, double *t, double *lo, double *hi,
