@@ -28,7 +28,9 @@ static double clampd(double v) {
     return v < -BIG ? -BIG : v > BIG ? BIG : v;
 }
 
-static void prim_bounds(const lb__instr *in, const double bc[3], const double br[3], iv *out) {
+/* returned by value: in registers, not through memory that the caller
+ * would read back as one wide load (a stalled store forward) */
+static iv prim_bounds(const lb__instr *in, const double bc[3], const double br[3]) {
     const lb_primitive *P = &in->prim;
     if (in->code == LB__I_ELLIPSOID) {
         /* zero-convention ellipsoid in world axes: nearest and farthest
@@ -40,9 +42,8 @@ static void prim_bounds(const lb__instr *in, const double bc[3], const double br
             sn += dn * dn;
             sf += df * df;
         }
-        out->lo = sqrt(sn) * (1.0 - 1e-12) - 1.0;
-        out->hi = sqrt(sf) * (1.0 + 1e-12) - 1.0;
-        return;
+        const iv o = {sqrt(sn) * (1.0 - 1e-12) - 1.0, sqrt(sf) * (1.0 + 1e-12) - 1.0};
+        return o;
     }
     double lc[3], lr[3];
     lb__affine_apply(&in->A, bc, lc);
@@ -95,13 +96,15 @@ static void prim_bounds(const lb__instr *in, const double bc[3], const double br
     }
     }
     /* the kernel is increasing (zero) or decreasing (soft) in rho */
+    iv o;
     if (P->kernel == LB_KERNEL_NONE) {
-        out->lo = lo - 1.0;
-        out->hi = hi - 1.0;
+        o.lo = lo - 1.0;
+        o.hi = hi - 1.0;
     } else {
-        out->lo = lb__kernel(P->kernel, hi, NULL);
-        out->hi = lb__kernel(P->kernel, lo, NULL);
+        o.lo = lb__kernel(P->kernel, hi, NULL);
+        o.hi = lb__kernel(P->kernel, lo, NULL);
     }
+    return o;
 }
 
 /* dual (union-form) argument interval: intersection -x, difference -x_0 */
@@ -409,7 +412,7 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
         const lb__instr *in = &ev->ins[i];
         iv o;
         if (in->code != LB__I_OP) {
-            prim_bounds(in, bc, br, &o);
+            o = prim_bounds(in, bc, br);
         } else {
             const size_t k = in->op.k;
             for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
@@ -428,9 +431,10 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
                 if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
             }
         }
-        o.lo = clampd(o.lo);
-        o.hi = clampd(o.hi);
-        R[in->dst] = o;
+        /* two scalar stores: a struct copy here went through the stack as
+         * two narrow stores and one wide load (a stalled store forward) */
+        R[in->dst].lo = clampd(o.lo);
+        R[in->dst].hi = clampd(o.hi);
     }
     if (plan) plan_needs(ev, plan, NULL);
 }
@@ -466,7 +470,7 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
         const lb__instr *in = &ev->ins[i];
         iv o;
         if (in->code != LB__I_OP) {
-            prim_bounds(in, bc, br, &o);
+            o = prim_bounds(in, bc, br);
         } else if (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC ||
                    in->fast == LB__FAST_MINMAX) {
             const uint16_t *pa = parent->act + in->aoff;
@@ -515,9 +519,10 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                 child->nact[i] = parent->nact[i];
             }
         }
-        o.lo = clampd(o.lo);
-        o.hi = clampd(o.hi);
-        R[in->dst] = o;
+        /* two scalar stores: a struct copy here went through the stack as
+         * two narrow stores and one wide load (a stalled store forward) */
+        R[in->dst].lo = clampd(o.lo);
+        R[in->dst].hi = clampd(o.hi);
     }
     if (child) plan_needs(ev, child, parent);
 }
@@ -528,12 +533,13 @@ void lb__bounds_pass_list(const lb_evaluator *ev, const uint32_t *list, size_t n
         const lb__instr *in = &ev->ins[list[q]];
         iv o;
         if (in->code != LB__I_OP)
-            prim_bounds(in, bc, br, &o);
+            o = prim_bounds(in, bc, br);
         else
             all_args_bounds(ev, in, bc, br, R, &o);
-        o.lo = clampd(o.lo);
-        o.hi = clampd(o.hi);
-        R[in->dst] = o;
+        /* two scalar stores: a struct copy here went through the stack as
+         * two narrow stores and one wide load (a stalled store forward) */
+        R[in->dst].lo = clampd(o.lo);
+        R[in->dst].hi = clampd(o.hi);
     }
 }
 
