@@ -745,7 +745,7 @@ lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const double *x, c
     return LB_OK;
 }
 
-static lb_status boxeval_alloc(const lb_evaluator *ev, lb__boxeval *E, lb_error *err) {
+lb_status lb__boxeval_alloc(const lb_evaluator *ev, lb__boxeval *E, lb_error *err) {
     memset(E, 0, sizeof *E);
     E->regs = malloc(lb__regs_len(ev) * sizeof *E->regs);
     E->iv = malloc(lb__ivs_len(ev) * sizeof *E->iv);
@@ -756,10 +756,15 @@ static lb_status boxeval_alloc(const lb_evaluator *ev, lb__boxeval *E, lb_error 
     return LB_OK;
 }
 
-lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E,
-                                lb_error *err) {
-    lb_status s = boxeval_alloc(ev, E, err);
-    if (s) return s;
+/* Forget P's list (need marks exactly the listed instructions: clearing
+ * those clears it). */
+static void plan_clear(lb__plan *P) {
+    for (uint32_t q = 0; q < P->nlist; ++q) P->need[P->list[q]] = 0;
+    P->nlist = 0;
+}
+
+void lb__boxeval_load(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E) {
+    plan_clear(&E->plan);
     const uint16_t *a = C->act;
     for (uint32_t q = 0; q < C->nlist; ++q) {
         const uint32_t i = C->list[q];
@@ -772,7 +777,13 @@ lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C, lb__
         a += na;
     }
     E->plan.nlist = C->nlist;
-    return LB_OK;
+}
+
+lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E,
+                                lb_error *err) {
+    lb_status s = lb__boxeval_alloc(ev, E, err);
+    if (!s) lb__boxeval_load(ev, C, E);
+    return s;
 }
 
 lb_status lb__cplan_make(const lb_evaluator *ev, const lb__plan *P, lb__cplan *C, lb_error *err) {
@@ -850,9 +861,8 @@ lb_status lb__plan_alloc(const lb_evaluator *ev, lb__plan *P, lb_error *err) {
     return LB_OK;
 }
 
-lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P, lb_error *err) {
-    lb_status s = lb__plan_alloc(ev, P, err);
-    if (s) return s;
+void lb__plan_load(const lb_evaluator *ev, const lb__plan *from, lb__plan *P) {
+    plan_clear(P);
     /* only what the plan lists: its cost, not the tape's */
     for (uint32_t q = 0; q < from->nlist; ++q) {
         const uint32_t i = from->list[q];
@@ -864,7 +874,12 @@ lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *
                from->nact[i] * sizeof *P->act);
     }
     P->nlist = from->nlist;
-    return LB_OK;
+}
+
+lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P, lb_error *err) {
+    lb_status s = lb__plan_alloc(ev, P, err);
+    if (!s) lb__plan_load(ev, from, P);
+    return s;
 }
 
 void lb__plan_free(lb__plan *P) {

@@ -202,6 +202,12 @@ typedef struct lb__boxeval {
 /* E for the box whose plan C is (lb__cplan_make); no interval pass. */
 LB_INTERNAL lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C,
                                             lb__boxeval *E, lb_error *err);
+/* The same in two steps, for a state reused from box to box: E allocated
+ * for ev with an empty plan (NULL members and LB_ERR_NO_MEMORY when memory
+ * is short), then loaded with C's plan (no allocation; any earlier plan of
+ * E's is replaced). */
+LB_INTERNAL lb_status lb__boxeval_alloc(const lb_evaluator *ev, lb__boxeval *E, lb_error *err);
+LB_INTERNAL void lb__boxeval_load(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E);
 LB_INTERNAL lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n,
                                       const double *x, const double *y, const double *z, double *v,
                                       double *gx, double *gy, double *gz, lb_error *err);
@@ -215,6 +221,8 @@ LB_INTERNAL void lb__boxeval_narrow(const lb_evaluator *ev, lb__boxeval *E, cons
  * short), so that E can be narrowed again from the same outer plan. */
 LB_INTERNAL lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P,
                                     lb_error *err);
+/* P (allocated for ev) becomes a copy of from, without allocating. */
+LB_INTERNAL void lb__plan_load(const lb_evaluator *ev, const lb__plan *from, lb__plan *P);
 LB_INTERNAL void lb__plan_free(lb__plan *P);
 /* How many primitives the plan runs per point. */
 LB_INTERNAL size_t lb__plan_prims(const lb_evaluator *ev, const lb__plan *P);
