@@ -27,7 +27,7 @@ typedef struct face {
  * crossing edges (one per node and axis mask: every local edge id is
  * distinct) and FACE_MAX polygons (six tetrahedra per cell, or at most
  * four cube loops), so nothing grows in the cell loop. */
-#define EMAP_SIZE ((size_t)(LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1) * 8)
+#define EMAP_SIZE LB__EMAP_SIZE
 #define FACE_MAX ((size_t)6 * LB__MB * LB__MB * LB__MB)
 
 struct lb__bctx {
@@ -42,6 +42,7 @@ struct lb__bctx {
     uint64_t *key;
     face *faces;
     size_t nf; /* polygons so far (< FACE_MAX) */
+    lb__mscratch S;
 };
 typedef lb__bctx bctx;
 
@@ -216,7 +217,7 @@ static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g
     return T;
 }
 
-lb__bctx *lb__bctx_new(void) {
+lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     lb__bctx *C = calloc(1, sizeof *C);
     if (!C) return NULL;
     C->emap = malloc(EMAP_SIZE * sizeof *C->emap);
@@ -229,8 +230,17 @@ lb__bctx *lb__bctx_new(void) {
     C->pb = malloc(EMAP_SIZE * sizeof *C->pb);
     C->key = malloc(EMAP_SIZE * sizeof *C->key);
     C->faces = malloc(FACE_MAX * sizeof *C->faces);
-    if (!C->emap || !C->estamp || !C->ea || !C->eb || !C->ga || !C->gb || !C->pa || !C->pb ||
-        !C->key || !C->faces) {
+    lb__mscratch *S = &C->S;
+    int ok =
+        lb__boxeval_alloc(ev, &S->E, NULL) == LB_OK && lb__plan_alloc(ev, &S->outer, NULL) == LB_OK;
+    for (int d = 0; d < LB__MARK_DEPTH; ++d)
+        ok = ok && lb__plan_alloc(ev, &S->pool[d], NULL) == LB_OK;
+    S->nodes = malloc(7 * LB__SLAB_NODES * sizeof *S->nodes);
+    S->nidx = malloc(LB__SLAB_NODES * sizeof *S->nidx);
+    S->edges = malloc(10 * EMAP_SIZE * sizeof *S->edges);
+    S->eact = malloc(EMAP_SIZE * sizeof *S->eact);
+    if (!ok || !C->emap || !C->estamp || !C->ea || !C->eb || !C->ga || !C->gb || !C->pa || !C->pb ||
+        !C->key || !C->faces || !S->nodes || !S->nidx || !S->edges || !S->eact) {
         lb__bctx_free(C);
         return NULL;
     }
@@ -249,7 +259,19 @@ void lb__bctx_free(lb__bctx *C) {
     free(C->gb);
     free(C->key);
     free(C->faces);
+    lb__mscratch *S = &C->S;
+    lb__boxeval_free(&S->E);
+    lb__plan_free(&S->outer);
+    for (int d = 0; d < LB__MARK_DEPTH; ++d) lb__plan_free(&S->pool[d]);
+    free(S->nodes);
+    free(S->nidx);
+    free(S->edges);
+    free(S->eact);
     free(C);
+}
+
+lb__mscratch *lb__bctx_scratch(lb__bctx *C) {
+    return &C->S;
 }
 
 lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B, lb__bctx *C,
@@ -296,7 +318,7 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
         }
         memcpy(B->vkey, C->key, C->ne * sizeof *B->vkey);
         s = lb__refine_edges(ev, g, B, C->ne, C->ea, C->eb, C->pa, C->pb, C->ga, C->gb, B->vpos,
-                             B->vnrm, err);
+                             B->vnrm, &C->S, err);
         if (s) goto done;
         uint32_t *T = B->tri;
         for (size_t f = 0; f < C->nf; ++f) T = triangulate(&C->faces[f], B->vpos, g, T);

@@ -19,6 +19,13 @@
 
 #define LB__MB 8      /* cells per block side */
 #define LB__MAXPOLY 7 /* most vertices of one cell polygon (cubes: 7, tetrahedra: 4) */
+/* nodes of the largest block */
+#define LB__SLAB_NODES ((size_t)(LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1))
+/* crossing edges a block can have: one per node and axis mask (every
+ * local edge id is distinct) */
+#define LB__EMAP_SIZE (LB__SLAB_NODES * 8)
+/* splits from a block down to 2^3 cells: one per halving of a side of 8 */
+#define LB__MARK_DEPTH 6
 
 /* The cube cases (cubes.c): for each of the 256 inside/outside patterns of
  * a cell's corners (bit o set: corner o inside; corner bits 1 = +x, 2 = +y,
@@ -57,8 +64,6 @@ typedef struct lb__block {
     uint8_t *nmask; /* nodes evaluated (corners of cells that may cross) */
     uint8_t *cmask; /* cells that may cross the surface, nc[0] * nc[1] * nc[2] */
     lb__cplan plan; /* the block box's plan, from the block selection's descent */
-    uint32_t slot;  /* its place in its layer's slab of node data (mesher.c) */
-    uint8_t half;   /* which of the two slabs: its layer's parity */
     /* output: vertices keyed by grid edge, triangles by local vertex index */
     size_t nv, nt;
     uint64_t *vkey;
@@ -96,6 +101,37 @@ LB_INTERNAL void lb__node_box(const lb__grid *g, const lb__block *B, const uint3
 LB_INTERNAL double lb__mesh_phi(const lb__grid *g, const double X[3], double f, const double gf[3],
                                 double gphi[3]);
 
+/* The largest region-box term of phi_c over block B's nodes (-inf for an
+ * open mesh): wherever phi is at least this, phi_c = phi. */
+LB_INTERNAL double lb__block_boxmax(const lb__grid *g, const lb__block *B);
+
+/* lb__mesh_phi at a point of a block whose lb__block_boxmax is boxmax,
+ * without the per-axis tests where they cannot change phi (the same bits). */
+static inline double lb__mesh_phi_in(const lb__grid *g, double boxmax, const double X[3], double f,
+                                     const double gf[3], double gphi[3]) {
+    const double ph = g->soft ? 0.5 - f : f;
+    if (!(ph >= boxmax)) return lb__mesh_phi(g, X, f, gf, gphi);
+    const double s = g->soft ? -1.0 : 1.0;
+    for (int d = 0; d < 3; ++d) gphi[d] = s * gf[d];
+    return ph;
+}
+
+/* A thread's evaluation scratch, made once per run and reused block after
+ * block (so a block allocates only what it outputs): the evaluator state a
+ * block's runs share, the block's plan kept while that state's is narrowed
+ * octant by octant, mark()'s plans by depth, and the batches of node
+ * values (7 doubles per node) and of refinement (10 doubles and an index
+ * per edge). */
+typedef struct lb__mscratch {
+    lb__boxeval E;
+    lb__plan outer;
+    lb__plan pool[LB__MARK_DEPTH];
+    double *nodes;
+    size_t *nidx;
+    double *edges;
+    size_t *eact;
+} lb__mscratch;
+
 /* Surface extraction over one block whose node values are final (extract.c):
  * finds the crossing edges cell by cell (cubes.c, or tetra.c with
  * g->tetrahedra), refines a vertex on each (lb__refine_edges), triangulates
@@ -104,10 +140,12 @@ typedef struct lb__bctx lb__bctx;
 LB_INTERNAL lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B,
                                      lb__bctx *C, lb_error *err);
 
-/* A thread's extraction state for lb__mesh_block, reused across blocks
- * (NULL when out of memory); freed by lb__bctx_free (NULL is fine). */
-LB_INTERNAL lb__bctx *lb__bctx_new(void);
+/* A thread's extraction state for lb__mesh_block, with its evaluation
+ * scratch, reused across blocks (NULL when out of memory); freed by
+ * lb__bctx_free (NULL is fine). */
+LB_INTERNAL lb__bctx *lb__bctx_new(const lb_evaluator *ev);
 LB_INTERNAL void lb__bctx_free(lb__bctx *C);
+LB_INTERNAL lb__mscratch *lb__bctx_scratch(lb__bctx *C);
 
 /* Safeguarded, batched root solve of phi_c along n grid edges: a[i] inside
  * (phi < 0), b[i] outside, pa/pb their values and ga/gb their gradients
@@ -117,7 +155,7 @@ LB_INTERNAL lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g
                                        const lb__block *B, size_t n, const double *a,
                                        const double *b, const double *pa, const double *pb,
                                        const double *ga, const double *gb, double *pos, double *nrm,
-                                       lb_error *err);
+                                       lb__mscratch *S, lb_error *err);
 
 /* ---- the cell methods' side of extract.c */
 

@@ -12,10 +12,13 @@
  *    (fewer arguments survive culling over a smaller box).
  * 4. Nodes on a block's far faces are also nodes of the next block: they
  *    take that block's value and gradient, so both sides see the same signs
- *    (the evaluator's per-batch culling may differ in the last bit).
- * 5. In parallel, per block: the crossing edges' vertices (refine.c, octant
- *    by octant as in 3) and the cells' polygons (extract.c with cubes.c, or
- *    tetra.c with LB_MESH_TETRAHEDRA).
+ *    (the evaluator's per-batch culling may differ in the last bit). Blocks
+ *    are taken from the last to the first, so a block's next blocks have
+ *    their node values first (one still at work on another thread keeps
+ *    the block waiting in its thread's short list: work()).
+ * 5. Right after, while its node data is in cache: the block's crossing
+ *    edges' vertices (refine.c, octant by octant as in 3) and its cells'
+ *    polygons (extract.c with cubes.c, or tetra.c with LB_MESH_TETRAHEDRA).
  * 6. One thread merges the blocks in block order, sharing the vertex of an
  *    edge two blocks both cut (the first block's copy), so the output is the
  *    same for every thread count.
@@ -253,9 +256,13 @@ static int cmp_block(const void *a, const void *b) {
     return x < y ? -1 : x > y;
 }
 
-/* ---- parallel phases ---- */
-
-enum { PH_NODES, PH_SHARE, PH_MESH };
+/* ---- the blocks' work, in parallel ----
+ * Blocks are taken from the last to the first. A block's node values come
+ * first; then, once the next blocks (+x, +y, +z and their combinations:
+ * taken earlier) have theirs, its far-face nodes take their values
+ * (block_share) and its surface is extracted at once, while its own node
+ * data is still in cache. A block's node data lives in a slot until the
+ * last block that reads it is done (refs), and the slot is reused. */
 
 typedef struct run {
     const lb_evaluator *ev;
@@ -263,30 +270,27 @@ typedef struct run {
     lb__block *blocks;
     size_t nblocks;
     uint32_t nb[3];
-    int phase;
-    size_t hi; /* the current phase runs blocks [next's start, hi) */
     atomic_size_t next, done;
     atomic_int stop;
     const volatile int *cancel;
-    pthread_mutex_t lock;
+    pthread_mutex_t lock; /* the first error and the free slots */
     size_t err_block;
     lb_error err;
     lb__bctx **ctx; /* one extraction state per thread (index 0: the calling thread) */
-    /* node data of the two layers alive at a time: a slot (NODE_BYTES) per
-     * place in a layer and layer parity, allocated on first use and reused
-     * from layer to layer, so the heap neither grows nor gives pages back
-     * between layers; each slot is its own heap block (not one large
-     * mapping that a small mesh would fault in afresh every run) */
-    unsigned char **slots[2];
-    size_t nslots;
     size_t nctx;
-    /* the worker pool, started once per run: each phase wakes it (gen) and
-     * waits until every worker is done with it (active) */
-    pthread_mutex_t pm;
-    pthread_cond_t go, fin;
-    unsigned gen;
-    size_t active, nworkers;
-    int quit;
+    /* per block: its next blocks by offset c (bit d: +1 along axis d), as
+     * index + 1 (0: none kept); whether its node values are done; how many
+     * of itself and the blocks before it still read its node data */
+    uint32_t (*nbr)[8];
+    atomic_int *ready;
+    atomic_uint *refs;
+    /* node data slots (NODE_BYTES each, their own heap blocks): all made so
+     * far, and the free ones (at most one per block) */
+    unsigned char **all, **free;
+    size_t nall, nfree;
+    /* waiting for a next block's node values */
+    pthread_mutex_t wm;
+    pthread_cond_t wc;
 } run;
 
 static lb__block *find_block(run *R, const uint32_t b[3]) {
@@ -316,9 +320,6 @@ static void sub_phi(const lb_evaluator *ev, const lb__grid *g, const lb__plan *p
     phi_interval(g, bl, bh, R[ev->out].lo, R[ev->out].hi, lo, hi);
 }
 
-/* Splits from a block down to 2^3 cells: one per halving of a side of 8. */
-#define MARK_DEPTH 6
-
 /* Inside a kept block, the sub-boxes of at most 2^3 cells whose interval
  * may contain 0: their cells and corner nodes are marked; nothing else of
  * the block is evaluated (no cell outside them can cross the surface). A box
@@ -340,7 +341,7 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
             span = s1[d] - s0[d];
             axis = d;
         }
-    lb__plan *own = pool && axis >= 0 && depth < MARK_DEPTH ? &pool[depth] : NULL;
+    lb__plan *own = pool && axis >= 0 && depth < LB__MARK_DEPTH ? &pool[depth] : NULL;
     double lo, hi;
     sub_phi(R->ev, g, plan, IV, n0, n1, own, &lo, &hi);
     if (lo >= 0.0 || hi < 0.0) return;
@@ -366,59 +367,69 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
 
 /* One block's node data in its slot: values, gradients, node and cell
  * marks for the largest block (LB__MB^3 cells). */
-#define SLAB_NODES ((LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1))
+#define SLAB_NODES LB__SLAB_NODES
 #define NODE_BYTES                                                                                 \
     ((SLAB_NODES * 4 * sizeof(double) + SLAB_NODES + LB__MB * LB__MB * LB__MB + 63) / 64 * 64)
+
+/* A free slot (the most recently freed: still warm), or a new one; NULL
+ * when out of memory. */
+static unsigned char *slot_get(run *R) {
+    unsigned char *p = NULL;
+    pthread_mutex_lock(&R->lock);
+    if (R->nfree) p = R->free[--R->nfree];
+    pthread_mutex_unlock(&R->lock);
+    if (p || !(p = malloc(NODE_BYTES))) return p;
+    pthread_mutex_lock(&R->lock);
+    R->all[R->nall++] = p; /* at most one slot per block was ever made */
+    pthread_mutex_unlock(&R->lock);
+    return p;
+}
+
+/* One reader of block i's node data is done; the last one frees its slot. */
+static void slot_release(run *R, size_t i) {
+    if (atomic_fetch_sub(&R->refs[i], 1) != 1) return;
+    lb__block *B = &R->blocks[i];
+    unsigned char *p = (unsigned char *)(void *)B->vals;
+    B->vals = B->grads = NULL;
+    B->nmask = B->cmask = NULL;
+    if (!p) return;
+    pthread_mutex_lock(&R->lock);
+    R->free[R->nfree++] = p;
+    pthread_mutex_unlock(&R->lock);
+}
 
 /* The node values of a block: its plan (one interval pass over the block's
  * box), mark() with sub-box passes under that plan, then the marked nodes
  * evaluated under the same plan (the point evaluator's culling for that
  * box, computed once). */
-static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
+static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *err) {
     const lb__grid *g = R->g;
     const lb_evaluator *ev = R->ev;
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
     const size_t n = (size_t)D0 * D1 * D2;
-    /* only this block uses its slot now (one block per place in a layer,
-     * layers of one parity never overlap in time): no lock */
-    unsigned char **slot = &R->slots[B->half][B->slot];
-    if (!*slot && !(*slot = malloc(NODE_BYTES)))
-        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    unsigned char *base = *slot;
+    unsigned char *base = slot_get(R);
+    if (!base) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     B->vals = (double *)(void *)base;
     B->grads = B->vals + SLAB_NODES;
     B->nmask = (uint8_t *)(B->grads + 3 * SLAB_NODES);
     B->cmask = B->nmask + SLAB_NODES;
     memset(B->nmask, 0, n);
     memset(B->cmask, 0, (size_t)B->nc[0] * B->nc[1] * B->nc[2]);
-    lb__boxeval E;
-    lb_status s = lb__boxeval_init_plan(ev, &B->plan, &E, err);
-    if (s) return s;
+    lb__boxeval *E = &S->E;
+    lb__boxeval_load(ev, &B->plan, E);
     const uint32_t zero[3] = {0, 0, 0};
-    /* few primitives: no narrower plans (LB__NARROW_MIN_PRIMS), here or below */
-    const int narrow = lb__plan_prims(ev, &E.plan) >= LB__NARROW_MIN_PRIMS;
-    lb__plan pool[MARK_DEPTH];
-    int npool = 0;
-    for (; narrow && npool < MARK_DEPTH && !s; ++npool)
-        s = lb__plan_copy(ev, &E.plan, &pool[npool], err);
-    if (!s) mark(R, B, &E.plan, E.iv, zero, B->nc, narrow ? pool : NULL, 0);
-    for (int i = 0; i < npool; ++i) lb__plan_free(&pool[i]);
-    if (s) {
-        lb__boxeval_free(&E);
-        return s;
-    }
+    /* few primitives: no narrower plans (LB__NARROW_MIN_PRIMS), here or below;
+     * each split box's pass fills its depth's plan whole (no copy needed) */
+    const int narrow = lb__plan_prims(ev, &E->plan) >= LB__NARROW_MIN_PRIMS;
+    mark(R, B, &E->plan, E->iv, zero, B->nc, narrow ? S->pool : NULL, 0);
     size_t m = 0;
     for (size_t q = 0; q < n; ++q) m += B->nmask[q];
-    double *mem = NULL;
-    size_t *idx = NULL;
-    if (m == 0) goto done;
-    mem = malloc(7 * m * sizeof *mem);
-    idx = malloc(m * sizeof *idx);
-    if (!mem || !idx) {
-        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-        goto done;
-    }
-    double *x = mem, *y = x + m, *z = y + m, *v = z + m, *gx = v + m, *gy = gx + m, *gz = gy + m;
+    if (m == 0) return LB_OK;
+    /* m <= LB__SLAB_NODES: the thread's scratch holds the batch */
+    double *x = S->nodes, *y = x + m, *z = y + m, *v = z + m, *gx = v + m, *gy = gx + m,
+           *gz = gy + m;
+    size_t *idx = S->nidx;
+    lb_status s = LB_OK;
     /* the nodes by octant (nodes up to the middle one in the low half), each
      * octant evaluated under its own, tighter plan: a block's interval pass
      * keeps every argument that may matter somewhere in the block, an
@@ -450,41 +461,31 @@ static lb_status block_nodes(run *R, lb__block *B, lb_error *err) {
                 }
     }
     start[ngroups] = w;
-    lb__plan outer = {0};
-    if (narrow) s = lb__plan_copy(ev, &E.plan, &outer, err);
+    if (narrow) lb__plan_load(ev, &E->plan, &S->outer);
     for (int o = 0; o < ngroups && !s; ++o) {
         const size_t c = start[o + 1] - start[o];
         if (!c) continue;
-        if (narrow) lb__octant_narrow(ev, g, B, o, &outer, &E);
+        if (narrow) lb__octant_narrow(ev, g, B, o, &S->outer, E);
         const size_t a = start[o];
-        s = lb__boxeval_run(ev, &E, c, x + a, y + a, z + a, v + a, gx + a, gy + a, gz + a, err);
+        s = lb__boxeval_run(ev, E, c, x + a, y + a, z + a, v + a, gx + a, gy + a, gz + a, err);
     }
-    lb__plan_free(&outer);
+    const double boxmax = lb__block_boxmax(g, B);
     for (size_t i = 0; i < m && !s; ++i) {
         const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
-        B->vals[idx[i]] = lb__mesh_phi(g, X, v[i], gf, B->grads + 3 * idx[i]);
+        B->vals[idx[i]] = lb__mesh_phi_in(g, boxmax, X, v[i], gf, B->grads + 3 * idx[i]);
     }
-done:
-    lb__boxeval_free(&E);
-    free(mem);
-    free(idx);
     return s;
 }
 
-/* Far-face nodes take the value and gradient of the block that owns them. */
-static void block_share(run *R, lb__block *B) {
+/* Far-face nodes take the value and gradient of the block that owns them
+ * (block i's next blocks, whose node values are done). They read only
+ * nodes that their owner never overwrites: every axis on which such a node
+ * is on the owner's far face is one without a next block. */
+static void block_share(run *R, size_t bi) {
+    lb__block *B = &R->blocks[bi];
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
-    /* the (up to 7) next blocks, looked up once */
     const lb__block *next[8] = {NULL};
-    for (int c = 1; c < 8; ++c) {
-        uint32_t ob[3];
-        int ok = 1;
-        for (int d = 0; d < 3; ++d) {
-            ob[d] = B->b[d] + ((c >> d) & 1);
-            if (ob[d] >= R->nb[d]) ok = 0;
-        }
-        next[c] = ok ? find_block(R, ob) : NULL;
-    }
+    for (int c = 1; c < 8; ++c) next[c] = R->nbr[bi][c] ? &R->blocks[R->nbr[bi][c] - 1] : NULL;
     for (uint32_t k = 0; k < D2; ++k)
         for (uint32_t j = 0; j < D1; ++j) {
             /* only far-face nodes take another block's values: off the far
@@ -515,33 +516,65 @@ static void block_share(run *R, lb__block *B) {
         }
 }
 
-/* One block of the current phase on thread t; failures keep the first
- * block's error. */
-static void do_block(run *R, size_t i, size_t t) {
+static int stopped(run *R);
+
+/* Wake the blocks waiting for a next block's node values (or for stop). */
+static void wake(run *R) {
+    pthread_mutex_lock(&R->wm);
+    pthread_cond_broadcast(&R->wc);
+    pthread_mutex_unlock(&R->wm);
+}
+
+/* Wait until block j's node values are done; 0 when the run stopped. */
+static int wait_ready(run *R, size_t j) {
+    if (!atomic_load(&R->ready[j])) {
+        pthread_mutex_lock(&R->wm);
+        while (!atomic_load(&R->ready[j]) && !atomic_load(&R->stop))
+            pthread_cond_wait(&R->wc, &R->wm);
+        pthread_mutex_unlock(&R->wm);
+    }
+    return !stopped(R);
+}
+
+static void fail_block(run *R, size_t i, const lb_error *e) {
+    pthread_mutex_lock(&R->lock);
+    if (i < R->err_block) {
+        R->err_block = i;
+        R->err = *e;
+    }
+    pthread_mutex_unlock(&R->lock);
+    atomic_store(&R->stop, 1);
+    wake(R);
+}
+
+/* Block i's node values; 0 when they failed (the run stops). Its next
+ * blocks' values may not be done yet: finish_block waits for them. */
+static int start_block(run *R, size_t i, size_t t) {
     lb_error e = {LB_OK, ""};
-    lb_status s = LB_OK;
+    const lb_status s = block_nodes(R, &R->blocks[i], lb__bctx_scratch(R->ctx[t]), &e);
+    if (s) fail_block(R, i, &e); /* stop is set before ready: a waiter sees both */
+    atomic_store(&R->ready[i], 1);
+    wake(R);
+    return !s;
+}
+
+static int next_ready(run *R, size_t i) {
+    for (int c = 1; c < 8; ++c)
+        if (R->nbr[i][c] && !atomic_load(&R->ready[R->nbr[i][c] - 1])) return 0;
+    return 1;
+}
+
+/* Block i on thread t, once its next blocks' node values are done: its
+ * far-face nodes, then its extraction while its node data is in cache. */
+static void finish_block(run *R, size_t i, size_t t) {
+    lb_error e = {LB_OK, ""};
     lb__block *B = &R->blocks[i];
-    if (R->phase == PH_NODES)
-        s = block_nodes(R, B, &e);
-    else if (R->phase == PH_SHARE)
-        block_share(R, B);
-    else {
-        s = lb__mesh_block(R->ev, R->g, B, R->ctx[t], &e);
-        /* the node data is not needed any more (the share phase is over):
-         * its slot goes to the layer after next */
-        B->vals = B->grads = NULL;
-        B->nmask = B->cmask = NULL;
-        lb__cplan_free(&B->plan);
-    }
-    if (s) {
-        pthread_mutex_lock(&R->lock);
-        if (i < R->err_block) {
-            R->err_block = i;
-            R->err = e;
-        }
-        pthread_mutex_unlock(&R->lock);
-        atomic_store(&R->stop, 1);
-    }
+    block_share(R, i);
+    for (int c = 1; c < 8; ++c)
+        if (R->nbr[i][c]) slot_release(R, R->nbr[i][c] - 1);
+    if (lb__mesh_block(R->ev, R->g, B, R->ctx[t], &e)) fail_block(R, i, &e);
+    slot_release(R, i);
+    lb__cplan_free(&B->plan);
     atomic_fetch_add(&R->done, 1);
 }
 
@@ -549,62 +582,10 @@ static int stopped(run *R) {
     if (atomic_load(&R->stop)) return 1;
     if (R->cancel && *R->cancel) {
         atomic_store(&R->stop, 1);
+        wake(R);
         return 1;
     }
     return 0;
-}
-
-typedef struct wctx {
-    run *R;
-    size_t t;
-} wctx;
-
-static void *worker(void *arg) {
-    const wctx *W = arg;
-    run *R = W->R;
-    unsigned seen = 0;
-    pthread_mutex_lock(&R->pm);
-    for (;;) {
-        while (R->gen == seen && !R->quit) pthread_cond_wait(&R->go, &R->pm);
-        if (R->quit) break;
-        seen = R->gen;
-        pthread_mutex_unlock(&R->pm);
-        while (!stopped(R)) {
-            const size_t i = atomic_fetch_add(&R->next, 1);
-            if (i >= R->hi) break;
-            do_block(R, i, W->t);
-        }
-        pthread_mutex_lock(&R->pm);
-        if (--R->active == 0) pthread_cond_signal(&R->fin);
-    }
-    pthread_mutex_unlock(&R->pm);
-    return NULL;
-}
-
-/* Start up to nt - 1 workers (fewer if the system refuses threads: the
- * calling thread still does every phase). */
-static void pool_start(run *R, wctx *W, pthread_t *tid, size_t nt) {
-    pthread_mutex_init(&R->pm, NULL);
-    pthread_cond_init(&R->go, NULL);
-    pthread_cond_init(&R->fin, NULL);
-    R->nworkers = 0;
-    for (size_t t = 1; t < nt && t < 256; ++t) {
-        W[R->nworkers].R = R;
-        W[R->nworkers].t = t;
-        if (pthread_create(&tid[R->nworkers], NULL, worker, &W[R->nworkers]) != 0) break;
-        ++R->nworkers;
-    }
-}
-
-static void pool_stop(run *R, pthread_t *tid) {
-    pthread_mutex_lock(&R->pm);
-    R->quit = 1;
-    pthread_cond_broadcast(&R->go);
-    pthread_mutex_unlock(&R->pm);
-    for (size_t t = 0; t < R->nworkers; ++t) pthread_join(tid[t], NULL);
-    pthread_cond_destroy(&R->go);
-    pthread_cond_destroy(&R->fin);
-    pthread_mutex_destroy(&R->pm);
 }
 
 typedef struct progress {
@@ -614,92 +595,123 @@ typedef struct progress {
     int cancelled;
 } progress;
 
-/* One phase over blocks [lo, hi) on nt threads; the calling thread works too
- * and is the only one that reports progress (between its own blocks).
- * P->weight is the phase's share of the run over all blocks. */
-static lb_status phase(run *R, int ph, size_t lo, size_t hi, progress *P) {
-    if (lo >= hi) return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
-    R->phase = ph;
-    R->hi = hi;
-    atomic_store(&R->next, lo);
-    atomic_store(&R->done, 0);
-    pthread_mutex_lock(&R->pm);
-    R->active = R->nworkers;
-    ++R->gen;
-    pthread_cond_broadcast(&R->go);
-    pthread_mutex_unlock(&R->pm);
+/* The next block to take, from the last to the first; SIZE_MAX when none. */
+static size_t take(run *R) {
+    const size_t k = atomic_fetch_add(&R->next, 1);
+    return k < R->nblocks ? R->nblocks - 1 - k : SIZE_MAX;
+}
+
+/* Blocks whose node values are done, waiting for their next blocks' (at
+ * most this many per thread: each holds a slot). */
+#define PENDING_MAX 4
+
+/* One thread's share of the blocks: take a block and compute its node
+ * values; finish every taken block whose next blocks are ready. A thread
+ * waits only when PENDING_MAX blocks (or, at the end, all it has left)
+ * wait for other threads' node values; every block taken has its node
+ * values done before its thread waits, so nothing waits in a cycle. P
+ * (the calling thread's only) reports progress and may cancel. */
+static void work(run *R, size_t t, progress *P) {
+    size_t pend[PENDING_MAX];
+    size_t np = 0;
+    int more = 1;
     const double all = (double)(R->nblocks ? R->nblocks : 1);
     while (!stopped(R)) {
-        if (P->fn) {
+        if (P && P->fn) {
             const double f = P->base + P->weight * (double)atomic_load(&R->done) / all;
             if (P->fn(f, P->user)) {
                 P->cancelled = 1;
                 atomic_store(&R->stop, 1);
+                wake(R);
                 break;
             }
         }
-        const size_t i = atomic_fetch_add(&R->next, 1);
-        if (i >= hi) break;
-        do_block(R, i, 0);
+        size_t k = 0;
+        for (size_t q = 0; q < np; ++q) {
+            if (next_ready(R, pend[q]))
+                finish_block(R, pend[q], t);
+            else
+                pend[k++] = pend[q];
+        }
+        np = k;
+        if (more && np < PENDING_MAX) {
+            const size_t i = take(R);
+            if (i == SIZE_MAX)
+                more = 0;
+            else if (start_block(R, i, t))
+                pend[np++] = i;
+            continue;
+        }
+        if (!np) break;
+        /* every pending block waits on another thread: wait for the oldest */
+        for (int c = 1; c < 8; ++c)
+            if (R->nbr[pend[0]][c]) wait_ready(R, R->nbr[pend[0]][c] - 1);
     }
-    pthread_mutex_lock(&R->pm);
-    while (R->active) pthread_cond_wait(&R->fin, &R->pm);
-    pthread_mutex_unlock(&R->pm);
-    P->base += P->weight * (double)(hi - lo) / all;
-    if (R->cancel && *R->cancel) P->cancelled = 1;
-    return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
 }
 
-/* The phases, one layer of blocks (one block z) at a time: the node values
- * of a layer and of the next one (whose near faces the layer's far faces
- * take), then the layer's sharing and extraction, which frees its node
- * data. So node data is held for two layers at once, never for the whole
- * surface (the peak memory of a fine mesh is its output). The values are
- * the same as computing every layer's nodes first: a block only reads nodes
- * of the next blocks that those blocks never overwrite (block_share). */
-static lb_status layers(run *R, size_t nt, progress *P) {
+typedef struct wctx {
+    run *R;
+    size_t t;
+} wctx;
+
+static void *worker(void *arg) {
+    const wctx *W = arg;
+    work(W->R, W->t, NULL);
+    return NULL;
+}
+
+/* Every block on nt threads (nt - 1 workers, fewer if the system refuses
+ * threads: the calling thread works too and is the only one that reports
+ * progress, between its own blocks). Nothing waits on a block taken later,
+ * so the order of taking cannot deadlock. */
+static lb_status blocks_run(run *R, size_t nt, progress *P) {
+    if (nt > R->nctx) nt = R->nctx;
+    const size_t nbk = R->nblocks;
+    R->nbr = calloc(nbk ? nbk : 1, sizeof *R->nbr);
+    R->ready = calloc(nbk ? nbk : 1, sizeof *R->ready);
+    R->refs = calloc(nbk ? nbk : 1, sizeof *R->refs);
+    R->all = malloc((nbk ? nbk : 1) * sizeof *R->all);
+    R->free = malloc((nbk ? nbk : 1) * sizeof *R->free);
+    if (!R->nbr || !R->ready || !R->refs || !R->all || !R->free) {
+        R->err_block = 0;
+        return lb__fail(&R->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    }
+    for (size_t i = 0; i < nbk; ++i) {
+        atomic_init(&R->ready[i], 0);
+        atomic_init(&R->refs[i], 1);
+    }
+    for (size_t i = 0; i < nbk; ++i)
+        for (int c = 1; c < 8; ++c) {
+            uint32_t ob[3];
+            int ok = 1;
+            for (int d = 0; d < 3; ++d) {
+                ob[d] = R->blocks[i].b[d] + ((c >> d) & 1);
+                if (ob[d] >= R->nb[d]) ok = 0;
+            }
+            const lb__block *O = ok ? find_block(R, ob) : NULL;
+            if (!O) continue;
+            const size_t j = (size_t)(O - R->blocks);
+            R->nbr[i][c] = (uint32_t)(j + 1);
+            atomic_fetch_add(&R->refs[j], 1);
+        }
+    pthread_mutex_init(&R->wm, NULL);
+    pthread_cond_init(&R->wc, NULL);
     pthread_t tid[256];
     wctx W[256];
-    if (nt > R->nctx) nt = R->nctx;
-    /* the slots: by place in the layer, halves by layer parity */
-    size_t widest = 0;
-    for (size_t i = 0, start = 0, layer = 0; i < R->nblocks; ++i) {
-        if (R->blocks[i].b[2] != R->blocks[start].b[2]) {
-            start = i;
-            ++layer;
-        }
-        R->blocks[i].slot = (uint32_t)(i - start);
-        R->blocks[i].half = (uint8_t)(layer & 1);
-        if (i - start + 1 > widest) widest = i - start + 1;
+    size_t nw = 0;
+    for (size_t t = 1; t < nt && t < 256; ++t) {
+        W[nw].R = R;
+        W[nw].t = t;
+        if (pthread_create(&tid[nw], NULL, worker, &W[nw]) != 0) break;
+        ++nw;
     }
-    R->nslots = widest;
-    for (int h = 0; h < 2; ++h)
-        if (widest && !(R->slots[h] = calloc(widest, sizeof *R->slots[h]))) {
-            R->err_block = 0;
-            return lb__fail(&R->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-        }
-    pool_start(R, W, tid, nt);
-    lb_status s = LB_OK;
-    size_t cur = 0;
-    size_t next = 0; /* the first block of the layer after cur's */
-    while (next < R->nblocks && R->blocks[next].b[2] == R->blocks[0].b[2]) ++next;
-    const double wn = 0.45, ws = 0.05, wm = 0.40;
-    P->weight = wn;
-    s = phase(R, PH_NODES, 0, next, P);
-    while (!s && !P->cancelled && cur < R->nblocks) {
-        size_t after = next;
-        while (after < R->nblocks && R->blocks[after].b[2] == R->blocks[next].b[2]) ++after;
-        P->weight = wn;
-        if (!s && !P->cancelled) s = phase(R, PH_NODES, next, after, P);
-        P->weight = ws;
-        if (!s && !P->cancelled) s = phase(R, PH_SHARE, cur, next, P);
-        P->weight = wm;
-        if (!s && !P->cancelled) s = phase(R, PH_MESH, cur, next, P);
-        cur = next;
-        next = after;
-    }
-    pool_stop(R, tid);
-    return s;
+    work(R, 0, P);
+    for (size_t t = 0; t < nw; ++t) pthread_join(tid[t], NULL);
+    pthread_cond_destroy(&R->wc);
+    pthread_mutex_destroy(&R->wm);
+    P->base += P->weight;
+    if (R->cancel && *R->cancel) P->cancelled = 1;
+    return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
 }
 
 /* ---- merge ---- */
@@ -885,9 +897,10 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     R.ctx = calloc(nt, sizeof *R.ctx);
     if (R.ctx)
         for (R.nctx = 0; R.nctx < nt; ++R.nctx)
-            if (!(R.ctx[R.nctx] = lb__bctx_new())) break;
+            if (!(R.ctx[R.nctx] = lb__bctx_new(ev))) break;
     if (!M || !R.ctx || R.nctx < nt) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    if (!s && !P.cancelled) s = layers(&R, nt, &P);
+    P.weight = 0.90;
+    if (!s && !P.cancelled) s = blocks_run(&R, nt, &P);
     if (s && R.err_block != SIZE_MAX && err) *err = R.err;
     if (!s && !P.cancelled) s = merge(&R, M, err);
     if (!s && P.cancelled) s = lb__fail(err, LB_ERR_CANCELLED, "%s: cancelled by the caller", FN);
@@ -905,10 +918,12 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     free(R.blocks);
     for (size_t t = 0; t < R.nctx; ++t) lb__bctx_free(R.ctx[t]);
     free(R.ctx);
-    for (int h = 0; h < 2; ++h) {
-        for (size_t i = 0; R.slots[h] && i < R.nslots; ++i) free(R.slots[h][i]);
-        free(R.slots[h]);
-    }
+    for (size_t i = 0; i < R.nall; ++i) free(R.all[i]);
+    free(R.all);
+    free(R.free);
+    free(R.nbr);
+    free(R.ready);
+    free(R.refs);
     pthread_mutex_destroy(&R.lock);
     if (s) {
         lb_mesh_free(M);

@@ -43,6 +43,19 @@ double lb__mesh_phi(const lb__grid *g, const double X[3], double f, const double
     return phi;
 }
 
+double lb__block_boxmax(const lb__grid *g, const lb__block *B) {
+    double boxmax = -INFINITY;
+    if (!g->closed) return boxmax;
+    const uint32_t zero[3] = {0, 0, 0};
+    double bl[3], bh[3];
+    lb__node_box(g, B, zero, B->nc, bl, bh);
+    for (int d = 0; d < 3; ++d) {
+        boxmax = fmax(boxmax, g->bmin[d] - bl[d]);
+        boxmax = fmax(boxmax, bh[d] - g->bmax[d]);
+    }
+    return boxmax;
+}
+
 #define MAX_ITER 64
 
 /* The root in (0, 1) of the cubic Hermite interpolant of phi along an edge
@@ -98,22 +111,21 @@ static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxe
                              size_t na, const double *a, const double *b, const double *ga,
                              const double *gb, double tol, double *t, double *lo, double *hi,
                              double *x, double *y, double *z, double *v, double *gx, double *gy,
-                             double *gz, double *pos, double *nrm, lb_error *err);
+                             double *gz, double *pos, double *nrm, double boxmax, lb_error *err);
 
 lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, size_t n,
                            const double *a, const double *b, const double *pa, const double *pb,
                            const double *ga, const double *gb, double *pos, double *nrm,
-                           lb_error *err) {
+                           lb__mscratch *S, lb_error *err) {
     if (n == 0) return LB_OK;
     double hmin = g->h[0];
     if (g->h[1] < hmin) hmin = g->h[1];
     if (g->h[2] < hmin) hmin = g->h[2];
     const double tol = 1e-7 * hmin;
-    double *mem = malloc(n * (10 * sizeof(double) + sizeof(size_t)));
-    if (!mem) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
-    double *t = mem, *lo = t + n, *hi = lo + n, *x = hi + n, *y = x + n, *z = y + n, *v = z + n,
-           *gx = v + n, *gy = gx + n, *gz = gy + n;
-    size_t *act = (size_t *)(mem + 10 * n);
+    /* n <= LB__EMAP_SIZE: the thread's scratch holds every batch */
+    double *t = S->edges, *lo = t + n, *hi = lo + n, *x = hi + n, *y = x + n, *z = y + n,
+           *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
+    size_t *act = S->eact;
     for (size_t i = 0; i < n; ++i) {
         lo[i] = 0.0;
         hi[i] = 1.0;
@@ -126,26 +138,22 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
         if (!(t0 < 1.0 - 1e-9)) t0 = 1.0 - 1e-9;
         t[i] = t0;
     }
-    lb__boxeval E;
-    lb_status s = lb__boxeval_init_plan(ev, &B->plan, &E, err);
-    if (s) {
-        free(mem);
-        return s;
-    }
+    lb__boxeval *E = &S->E;
+    lb__boxeval_load(ev, &B->plan, E);
+    lb_status s = LB_OK;
     /* the edges by octant of the block (as the node values, mesher.c), each
      * octant refined under its own plan: the edge's midpoint decides. A plan
      * with few primitives keeps all the edges in one group. */
-    const int narrow = lb__plan_prims(ev, &E.plan) >= LB__NARROW_MIN_PRIMS;
+    const int narrow = lb__plan_prims(ev, &E->plan) >= LB__NARROW_MIN_PRIMS;
     const int ngroups = narrow ? 8 : 1;
-    lb__plan outer = {0};
     size_t start[9] = {0};
     const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
     if (narrow) {
-        s = lb__plan_copy(ev, &E.plan, &outer, err);
+        lb__plan_load(ev, &E->plan, &S->outer);
         double mid[3];
         lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + half[0], (uint64_t)B->b[1] * LB__MB + half[1],
                      (uint64_t)B->b[2] * LB__MB + half[2], mid);
-        for (int pass = 0; pass < 2 && !s; ++pass) {
+        for (int pass = 0; pass < 2; ++pass) {
             size_t fill[8];
             for (int o = 0; o < 8; ++o) fill[o] = start[o];
             for (size_t i = 0; i < n; ++i) {
@@ -164,16 +172,14 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
         for (size_t i = 0; i < n; ++i) act[i] = i;
         start[1] = n;
     }
+    const double boxmax = lb__block_boxmax(g, B);
     for (int o = 0; o < ngroups && !s; ++o) {
         const size_t na = start[o + 1] - start[o];
         if (!na) continue;
-        if (narrow) lb__octant_narrow(ev, g, B, o, &outer, &E);
-        s = refine_some(ev, g, &E, act + start[o], na, a, b, ga, gb, tol, t, lo, hi, x, y, z, v, gx,
-                        gy, gz, pos, nrm, err);
+        if (narrow) lb__octant_narrow(ev, g, B, o, &S->outer, E);
+        s = refine_some(ev, g, E, act + start[o], na, a, b, ga, gb, tol, t, lo, hi, x, y, z, v, gx,
+                        gy, gz, pos, nrm, boxmax, err);
     }
-    lb__plan_free(&outer);
-    lb__boxeval_free(&E);
-    free(mem);
     return s;
 }
 
@@ -183,7 +189,7 @@ static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxe
                              size_t na, const double *a, const double *b, const double *ga,
                              const double *gb, double tol, double *t, double *lo, double *hi,
                              double *x, double *y, double *z, double *v, double *gx, double *gy,
-                             double *gz, double *pos, double *nrm, lb_error *err) {
+                             double *gz, double *pos, double *nrm, double boxmax, lb_error *err) {
     lb_status s = LB_OK;
     for (int it = 0; it < MAX_ITER && na > 0 && !s; ++it) {
         for (size_t j = 0; j < na; ++j) {
@@ -202,7 +208,7 @@ static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxe
             const double *A = a + 3 * i, *Bp = b + 3 * i;
             const double X[3] = {x[j], y[j], z[j]}, gf[3] = {gx[j], gy[j], gz[j]};
             double gp[3];
-            const double ph = lb__mesh_phi(g, X, v[j], gf, gp);
+            const double ph = lb__mesh_phi_in(g, boxmax, X, v[j], gf, gp);
             const double e[3] = {Bp[0] - A[0], Bp[1] - A[1], Bp[2] - A[2]};
             const double L = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
             const double gl = sqrt(gp[0] * gp[0] + gp[1] * gp[1] + gp[2] * gp[2]);
@@ -228,31 +234,33 @@ static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxe
                  * is below tol / 100 and the normal here is within 1e-6 rad
                  * of the one at the new point; kinks (normals that jump)
                  * never qualify. */
-                double kap = 0.0;
+                double kap2 = 0.0; /* the largest squared normal change */
                 const double *G[2] = {ga + 3 * i, gb + 3 * i};
+                const double igl = 1.0 / gl, iL = 1.0 / L;
                 for (int q = 0; q < 2; ++q) {
                     const double l =
                         sqrt(G[q][0] * G[q][0] + G[q][1] * G[q][1] + G[q][2] * G[q][2]);
                     if (!(l > 0.0)) {
-                        kap = INFINITY;
+                        kap2 = INFINITY;
                         break;
                     }
+                    const double il = 1.0 / l;
                     double dn = 0.0;
                     for (int d = 0; d < 3; ++d) {
-                        const double u = G[q][d] / l - gp[d] / gl;
+                        const double u = G[q][d] * il - gp[d] * igl;
                         dn += u * u;
                     }
-                    if (sqrt(dn) > kap) kap = sqrt(dn);
+                    if (dn > kap2) kap2 = dn;
                 }
-                kap = 4.0 * kap / L;
+                const double kap = 4.0 * sqrt(kap2) * iL;
                 /* the slope along the edge may change too (fields whose
                  * gradient length varies, as blends' do): phi'' from the
                  * end slopes and this one, with the same safety factor */
-                const double s0 = (G[0][0] * e[0] + G[0][1] * e[1] + G[0][2] * e[2]) / L,
-                             s1 = (G[1][0] * e[0] + G[1][1] * e[1] + G[1][2] * e[2]) / L,
-                             sh = dt / L;
+                const double s0 = (G[0][0] * e[0] + G[0][1] * e[1] + G[0][2] * e[2]) * iL,
+                             s1 = (G[1][0] * e[0] + G[1][1] * e[1] + G[1][2] * e[2]) * iL,
+                             sh = dt * iL;
                 const double M =
-                    4.0 * fmax(fabs(sh - s0) / (t[i] * L), fabs(s1 - sh) / ((1.0 - t[i]) * L));
+                    4.0 * iL * fmax(fabs(sh - s0) / t[i], fabs(s1 - sh) / (1.0 - t[i]));
                 const double step = fabs(tn - t[i]) * L;
                 if (0.5 * kap * step * step <= 0.01 * tol && kap * step <= 1e-6 &&
                     0.5 * M * step * step <= 0.01 * tol * fabs(sh)) {
