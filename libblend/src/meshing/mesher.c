@@ -409,6 +409,10 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
     const size_t n = (size_t)D0 * D1 * D2;
     unsigned char *base = slot_get(R);
     if (!base) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    /* a reused slot was last written about a layer of blocks ago (out of
+     * the core's cache): fetch it for writing while mark() runs, instead of
+     * stalling on the scattered stores of the node values below */
+    for (size_t off = 0; off < NODE_BYTES; off += 64) __builtin_prefetch(base + off, 1, 3);
     B->vals = (double *)(void *)base;
     B->grads = B->vals + SLAB_NODES;
     B->nmask = (uint8_t *)(B->grads + 3 * SLAB_NODES);
@@ -483,37 +487,37 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
  * is on the owner's far face is one without a next block. */
 static void block_share(run *R, size_t bi) {
     lb__block *B = &R->blocks[bi];
-    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
     const lb__block *next[8] = {NULL};
     for (int c = 1; c < 8; ++c) next[c] = R->nbr[bi][c] ? &R->blocks[R->nbr[bi][c] - 1] : NULL;
-    for (uint32_t k = 0; k < D2; ++k)
-        for (uint32_t j = 0; j < D1; ++j) {
-            /* only far-face nodes take another block's values: off the far
-             * faces in y and z, only the far x node of the row */
-            const uint32_t i0 = (k == LB__MB || j == LB__MB) ? 0 : LB__MB;
-            for (uint32_t i = i0; i < D0; ++i) {
-                const uint32_t l[3] = {i, j, k};
-                int c = 0;
-                uint32_t ol[3];
-                for (int d = 0; d < 3; ++d) {
-                    ol[d] = l[d];
-                    if (l[d] == LB__MB && B->b[d] + 1 < R->nb[d]) {
-                        c |= 1 << d;
-                        ol[d] = 0;
-                    }
-                }
-                if (!c || !next[c]) continue;
-                const lb__block *O = next[c];
-                const uint32_t E0 = O->nc[0] + 1, E1 = O->nc[1] + 1;
-                const size_t mine = ((size_t)k * D1 + j) * D0 + i,
-                             theirs = ((size_t)ol[2] * E1 + ol[1]) * E0 + ol[0];
-                /* a node only one side evaluated is used only by that side:
-                 * the other side's interval proved its cells there do not cross */
-                if (!B->nmask[mine] || !O->nmask[theirs]) continue;
-                B->vals[mine] = O->vals[theirs];
-                memcpy(B->grads + 3 * mine, O->grads + 3 * theirs, 3 * sizeof(double));
-            }
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    /* node l takes next[c]'s node where c holds the axes on which l is on the
+     * far face and a next block exists in the grid: the region of c is
+     * l[d] = LB__MB on c's axes and below it (or up to nc where the grid
+     * ends) on the others */
+    for (int c = 1; c < 8; ++c) {
+        const lb__block *O = next[c];
+        if (!O) continue;
+        uint32_t lo[3], hi[3];
+        for (int d = 0; d < 3; ++d) {
+            const int far = B->b[d] + 1 < R->nb[d];
+            lo[d] = (c >> d) & 1 ? LB__MB : 0;
+            hi[d] = (c >> d) & 1 ? LB__MB : far ? LB__MB - 1 : B->nc[d];
         }
+        const uint32_t E0 = O->nc[0] + 1, E1 = O->nc[1] + 1;
+        for (uint32_t k = lo[2]; k <= hi[2]; ++k)
+            for (uint32_t j = lo[1]; j <= hi[1]; ++j)
+                for (uint32_t i = lo[0]; i <= hi[0]; ++i) {
+                    const uint32_t oi = c & 1 ? 0 : i, oj = c & 2 ? 0 : j, ok = c & 4 ? 0 : k;
+                    const size_t mine = ((size_t)k * D1 + j) * D0 + i,
+                                 theirs = ((size_t)ok * E1 + oj) * E0 + oi;
+                    /* a node only one side evaluated is used only by that
+                     * side: the other side's interval proved its cells there
+                     * do not cross */
+                    if (!B->nmask[mine] || !O->nmask[theirs]) continue;
+                    B->vals[mine] = O->vals[theirs];
+                    memcpy(B->grads + 3 * mine, O->grads + 3 * theirs, 3 * sizeof(double));
+                }
+    }
 }
 
 static int stopped(run *R);
@@ -551,6 +555,21 @@ static void fail_block(run *R, size_t i, const lb_error *e) {
  * blocks' values may not be done yet: finish_block waits for them. */
 static int start_block(run *R, size_t i, size_t t) {
     lb_error e = {LB_OK, ""};
+    /* the +z block's near face, read by block_share right after this block's
+     * node values, was computed about a layer of blocks ago: fetch it now
+     * (its node data is readable once it is ready) */
+    const uint32_t up = R->nbr[i][4];
+    if (up && atomic_load(&R->ready[up - 1])) {
+        const lb__block *O = &R->blocks[up - 1];
+        const size_t face = (size_t)(O->nc[0] + 1) * (O->nc[1] + 1);
+        if (O->vals) {
+            for (size_t off = 0; off < face * sizeof(double); off += 64)
+                __builtin_prefetch((const char *)O->vals + off, 0, 3);
+            for (size_t off = 0; off < 3 * face * sizeof(double); off += 64)
+                __builtin_prefetch((const char *)O->grads + off, 0, 3);
+            for (size_t off = 0; off < face; off += 64) __builtin_prefetch(O->nmask + off, 0, 3);
+        }
+    }
     const lb_status s = block_nodes(R, &R->blocks[i], lb__bctx_scratch(R->ctx[t]), &e);
     if (s) fail_block(R, i, &e); /* stop is set before ready: a waiter sees both */
     atomic_store(&R->ready[i], 1);
@@ -731,17 +750,19 @@ static lb_status merge(run *R, lb_mesh *M, lb_error *err) {
                         UINT32_MAX);
     size_t cap = 64;
     while (cap < 2 * ts) cap *= 2;
-    /* written once here, not calloc'ed: a zero page read first and written
-     * later faults twice */
-    uint64_t *keys = malloc(cap * sizeof *keys);
-    if (keys) memset(keys, 0, cap * sizeof *keys);
-    uint32_t *vals = malloc(cap * sizeof *vals);
+    /* key and vertex side by side (one cache line per probe); written once
+     * here, not calloc'ed: a zero page read first and written later faults
+     * twice */
+    struct kv {
+        uint64_t key, v;
+    } *tab = malloc(cap * sizeof *tab);
+    if (tab) memset(tab, 0, cap * sizeof *tab);
     uint32_t *local = malloc((LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1) * 8 * sizeof *local);
     M->positions = malloc(3 * (tv ? tv : 1) * sizeof *M->positions);
     M->normals = malloc(3 * (tv ? tv : 1) * sizeof *M->normals);
     M->triangles = malloc(3 * (tt ? tt : 1) * sizeof *M->triangles);
     lb_status s = LB_OK;
-    if (!keys || !vals || !local || !M->positions || !M->normals || !M->triangles) {
+    if (!tab || !local || !M->positions || !M->normals || !M->triangles) {
         s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
         goto done;
     }
@@ -757,15 +778,15 @@ static lb_status merge(run *R, lb_mesh *M, lb_error *err) {
                 continue;
             }
             size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
-            while (keys[h] && keys[h] != key) h = (h + 1) & (cap - 1);
-            if (!keys[h]) {
-                keys[h] = key;
-                vals[h] = (uint32_t)nv;
+            while (tab[h].key && tab[h].key != key) h = (h + 1) & (cap - 1);
+            if (!tab[h].key) {
+                tab[h].key = key;
+                tab[h].v = nv;
                 memcpy(M->positions + 3 * nv, B->vpos + 3 * i, 3 * sizeof(double));
                 memcpy(M->normals + 3 * nv, B->vnrm + 3 * i, 3 * sizeof(double));
                 ++nv;
             }
-            local[i] = vals[h];
+            local[i] = (uint32_t)tab[h].v;
         }
         for (size_t t = 0; t < 3 * B->nt; ++t) M->triangles[3 * nt + t] = local[B->tri[t]];
         nt += B->nt;
@@ -787,8 +808,7 @@ static lb_status merge(run *R, lb_mesh *M, lb_error *err) {
         if (q) M->normals = q;
     }
 done:
-    free(keys);
-    free(vals);
+    free(tab);
     free(local);
     return s;
 }
