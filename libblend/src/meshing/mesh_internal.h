@@ -24,8 +24,9 @@
 /* crossing edges a block can have: one per node and axis mask (every
  * local edge id is distinct) */
 #define LB__EMAP_SIZE (LB__SLAB_NODES * 8)
-/* splits from a block down to 2^3 cells: one per halving of a side of 8 */
-#define LB__MARK_DEPTH 6
+/* mark()'s levels that cut boxes: a block, then its 4^3 boxes (their
+ * children, 2^3, are marked or not) */
+#define LB__MARK_DEPTH 2
 
 /* The cube cases (cubes.c): for each of the 256 inside/outside patterns of
  * a cell's corners (bit o set: corner o inside; corner bits 1 = +x, 2 = +y,
