@@ -225,10 +225,13 @@ LB__INLINE void bt_two_loop(const size_t K, const lb__instr *in, const uint16_t 
     double sg[4];
     for (size_t i = 0; i < K; ++i)
         sg[i] = op == LB_UNION ? 1.0 : op == LB_INTERSECTION || act[i] == 0 ? -1.0 : 1.0;
+    /* the reciprocals of r and m once for the chunk (the same bits) */
+    double ir[4], im[4];
+    lb__bt_recip(K, r, m, ir, im);
     for (size_t j = 0; j < n; ++j) {
-        double u[4], dx[4];
+        double u[4], dx[4], ws[8];
         for (size_t i = 0; i < K; ++i) u[i] = op == LB_UNION ? vs[i][j] : sg[i] * vs[i][j];
-        double v = lb__bt_two_union(K, u, r, m, dx, NULL, NULL);
+        double v = lb__bt_two_union_recip(K, u, r, m, ir, im, dx, ws);
         if (op != LB_UNION) {
             for (size_t i = 0; i < K; ++i) dx[i] *= -sg[i];
             v = -v;
