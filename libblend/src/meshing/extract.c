@@ -33,8 +33,12 @@ typedef struct face {
 struct lb__bctx {
     const lb__grid *g;
     lb__block *B;
-    int32_t *emap;    /* local edge id -> crossing edge index, valid where stamp matches */
-    uint32_t *estamp; /* the block stamp each emap entry was written for */
+    /* local edge id -> crossing edge index (e), valid where the entry's
+     * stamp is the block's: side by side, one cache line per lookup */
+    struct emap {
+        uint32_t stamp;
+        int32_t e;
+    } * emap;
     uint32_t stamp;
     size_t ne;                 /* crossing edges so far (< EMAP_SIZE) */
     double *ea, *eb, *pa, *pb; /* inside end, outside end, their phi */
@@ -57,7 +61,7 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
     const uint32_t li = i + (op & 1), lj = j + ((op >> 1) & 1), lk = k + ((op >> 2) & 1);
     const int mask = op ^ oq;
     const size_t lid = ((size_t)(lk * D1 + lj) * D0 + li) * 8 + (size_t)mask;
-    if (C->estamp[lid] == C->stamp) return C->emap[lid];
+    if (C->emap[lid].stamp == C->stamp) return C->emap[lid].e;
     const lb__grid *g = C->g;
     const uint64_t gx = (uint64_t)B->b[0] * LB__MB + li, gy = (uint64_t)B->b[1] * LB__MB + lj,
                    gz = (uint64_t)B->b[2] * LB__MB + lk;
@@ -82,8 +86,8 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
     int shared = 0;
     for (int d = 0; d < 3; ++d) shared |= !((mask >> d) & 1) && (loc[d] == 0 || loc[d] == B->nc[d]);
     C->key[e] = (lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask) | (uint64_t)shared << 63;
-    C->emap[lid] = (int32_t)e;
-    C->estamp[lid] = C->stamp;
+    C->emap[lid].e = (int32_t)e;
+    C->emap[lid].stamp = C->stamp;
     return (int64_t)e;
 }
 
@@ -220,8 +224,7 @@ static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g
 lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     lb__bctx *C = calloc(1, sizeof *C);
     if (!C) return NULL;
-    C->emap = malloc(EMAP_SIZE * sizeof *C->emap);
-    C->estamp = calloc(EMAP_SIZE, sizeof *C->estamp);
+    C->emap = calloc(EMAP_SIZE, sizeof *C->emap);
     C->ea = malloc(3 * EMAP_SIZE * sizeof *C->ea);
     C->eb = malloc(3 * EMAP_SIZE * sizeof *C->eb);
     C->ga = malloc(3 * EMAP_SIZE * sizeof *C->ga);
@@ -239,8 +242,8 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     S->nidx = malloc(LB__SLAB_NODES * sizeof *S->nidx);
     S->edges = malloc(10 * EMAP_SIZE * sizeof *S->edges);
     S->eact = malloc(EMAP_SIZE * sizeof *S->eact);
-    if (!ok || !C->emap || !C->estamp || !C->ea || !C->eb || !C->ga || !C->gb || !C->pa || !C->pb ||
-        !C->key || !C->faces || !S->nodes || !S->nidx || !S->edges || !S->eact) {
+    if (!ok || !C->emap || !C->ea || !C->eb || !C->ga || !C->gb || !C->pa || !C->pb || !C->key ||
+        !C->faces || !S->nodes || !S->nidx || !S->edges || !S->eact) {
         lb__bctx_free(C);
         return NULL;
     }
@@ -250,7 +253,6 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
 void lb__bctx_free(lb__bctx *C) {
     if (!C) return;
     free(C->emap);
-    free(C->estamp);
     free(C->ea);
     free(C->eb);
     free(C->pa);
@@ -280,7 +282,7 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
     C->B = B;
     C->ne = C->nf = 0;
     if (++C->stamp == 0) { /* wrapped: clear the stamps once */
-        memset(C->estamp, 0, EMAP_SIZE * sizeof *C->estamp);
+        memset(C->emap, 0, EMAP_SIZE * sizeof *C->emap);
         C->stamp = 1;
     }
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
