@@ -789,28 +789,67 @@ lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C, lb__
     return s;
 }
 
-lb_status lb__cplan_make(const lb_evaluator *ev, const lb__plan *P, lb__cplan *C, lb_error *err) {
-    size_t na = 0;
+/* A compact plan's sizes: listed instructions, and argument-list entries
+ * (each operator's count, then its arguments). */
+static void cplan_sizes(const lb_evaluator *ev, const lb__plan *P, size_t *nl, size_t *na) {
+    size_t a = 0;
     for (uint32_t q = 0; q < P->nlist; ++q)
-        if (ev->ins[P->list[q]].code == LB__I_OP) na += 1u + P->nact[P->list[q]];
-    C->nlist = P->nlist;
+        if (ev->ins[P->list[q]].code == LB__I_OP) a += 1u + P->nact[P->list[q]];
+    *nl = P->nlist;
+    *na = a;
+}
+
+/* P written compactly into list and act (sized by cplan_sizes). */
+static void cplan_fill(const lb_evaluator *ev, const lb__plan *P, uint32_t *list, uint16_t *act) {
+    for (uint32_t q = 0; q < P->nlist; ++q) {
+        const uint32_t i = P->list[q];
+        list[q] = i;
+        if (ev->ins[i].code != LB__I_OP) continue;
+        *act++ = P->nact[i];
+        memcpy(act, P->act + ev->ins[i].aoff, P->nact[i] * sizeof *act);
+        act += P->nact[i];
+    }
+}
+
+lb_status lb__cplan_make(const lb_evaluator *ev, const lb__plan *P, lb__cplan *C, lb_error *err) {
+    size_t nl, na;
+    cplan_sizes(ev, P, &nl, &na);
+    C->nlist = (uint32_t)nl;
     C->nact_total = (uint32_t)na;
-    C->list = malloc((P->nlist ? P->nlist : 1) * sizeof *C->list);
+    C->list = malloc((nl ? nl : 1) * sizeof *C->list);
     C->act = malloc((na ? na : 1) * sizeof *C->act);
     if (!C->list || !C->act) {
         lb__cplan_free(C);
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
     }
-    uint16_t *a = C->act;
-    for (uint32_t q = 0; q < P->nlist; ++q) {
-        const uint32_t i = P->list[q];
-        C->list[q] = i;
-        if (ev->ins[i].code != LB__I_OP) continue;
-        *a++ = P->nact[i];
-        memcpy(a, P->act + ev->ins[i].aoff, P->nact[i] * sizeof *a);
-        a += P->nact[i];
-    }
+    cplan_fill(ev, P, C->list, C->act);
     return LB_OK;
+}
+
+void *lb__cplan_pack(const lb_evaluator *ev, const lb__plan *P, size_t n, lb__cplan *C) {
+    size_t tl = 0, ta = 0;
+    for (size_t k = 0; k < n; ++k) {
+        size_t nl, na;
+        cplan_sizes(ev, &P[k], &nl, &na);
+        tl += nl;
+        ta += na;
+    }
+    void *mem = malloc(tl * sizeof(uint32_t) + (ta ? ta : 1) * sizeof(uint16_t));
+    if (!mem) return NULL;
+    uint32_t *list = mem;
+    uint16_t *act = (uint16_t *)(void *)(list + tl);
+    for (size_t k = 0; k < n; ++k) {
+        size_t nl, na;
+        cplan_sizes(ev, &P[k], &nl, &na);
+        C[k].nlist = (uint32_t)nl;
+        C[k].nact_total = (uint32_t)na;
+        C[k].list = list;
+        C[k].act = act;
+        cplan_fill(ev, &P[k], list, act);
+        list += nl;
+        act += na;
+    }
+    return mem;
 }
 
 void lb__cplan_free(lb__cplan *C) {

@@ -98,6 +98,9 @@ typedef struct lb__cplan {
 LB_INTERNAL lb_status lb__cplan_make(const lb_evaluator *ev, const lb__plan *P, lb__cplan *C,
                                      lb_error *err);
 LB_INTERNAL void lb__cplan_free(lb__cplan *C);
+/* n plans made compact into C[0..n) in one allocation, returned (free it
+ * once, not the plans one by one); NULL when out of memory. */
+LB_INTERNAL void *lb__cplan_pack(const lb_evaluator *ev, const lb__plan *P, size_t n, lb__cplan *C);
 
 /* Interval pass over the box centre bc, half-size br: R (nregs entries)
  * receives every register's interval; the root's is R[ev->out]. With a plan,

@@ -238,6 +238,7 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
         lb__boxeval_alloc(ev, &S->E, NULL) == LB_OK && lb__plan_alloc(ev, &S->outer, NULL) == LB_OK;
     for (int d = 0; d < LB__MARK_DEPTH; ++d)
         ok = ok && lb__plan_alloc(ev, &S->pool[d], NULL) == LB_OK;
+    for (int o = 0; o < 8; ++o) ok = ok && lb__plan_alloc(ev, &S->oct[o], NULL) == LB_OK;
     S->nodes = malloc(7 * LB__SLAB_NODES * sizeof *S->nodes);
     S->nidx = malloc(LB__SLAB_NODES * sizeof *S->nidx);
     S->edges = malloc(10 * EMAP_SIZE * sizeof *S->edges);
@@ -265,6 +266,7 @@ void lb__bctx_free(lb__bctx *C) {
     lb__boxeval_free(&S->E);
     lb__plan_free(&S->outer);
     for (int d = 0; d < LB__MARK_DEPTH; ++d) lb__plan_free(&S->pool[d]);
+    for (int o = 0; o < 8; ++o) lb__plan_free(&S->oct[o]);
     free(S->nodes);
     free(S->nidx);
     free(S->edges);

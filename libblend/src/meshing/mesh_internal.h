@@ -65,6 +65,11 @@ typedef struct lb__block {
     uint8_t *nmask; /* nodes evaluated (corners of cells that may cross) */
     uint8_t *cmask; /* cells that may cross the surface, nc[0] * nc[1] * nc[2] */
     lb__cplan plan; /* the block box's plan, from the block selection's descent */
+    /* its octants' plans (octant o: bit d set, the upper half along axis d),
+     * from mark()'s passes, for the refinement; octmem holds them (NULL:
+     * none, the refinement narrows for itself) */
+    lb__cplan oct[8];
+    void *octmem;
     /* output: vertices keyed by grid edge, triangles by local vertex index */
     size_t nv, nt;
     uint64_t *vkey;
@@ -120,13 +125,15 @@ static inline double lb__mesh_phi_in(const lb__grid *g, double boxmax, const dou
 /* A thread's evaluation scratch, made once per run and reused block after
  * block (so a block allocates only what it outputs): the evaluator state a
  * block's runs share, the block's plan kept while that state's is narrowed
- * octant by octant, mark()'s plans by depth, and the batches of node
+ * octant by octant, mark()'s plans by depth and its octant plans, and the
+ * batches of node
  * values (7 doubles per node) and of refinement (10 doubles and an index
  * per edge). */
 typedef struct lb__mscratch {
     lb__boxeval E;
     lb__plan outer;
     lb__plan pool[LB__MARK_DEPTH];
+    lb__plan oct[8]; /* the block's octant plans, from mark()'s passes */
     double *nodes;
     size_t *nidx;
     double *edges;

@@ -331,7 +331,7 @@ static void sub_phi(const lb_evaluator *ev, const lb__grid *g, const lb__plan *p
  * arguments that survived above them (pool NULL: every box under the
  * block's plan). */
 static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const uint32_t s0[3],
-                 const uint32_t s1[3], lb__plan *pool, int depth) {
+                 const uint32_t s1[3], lb__plan *pool, int depth, lb__plan *given) {
     const lb__grid *g = R->g;
     uint64_t n0[3], n1[3];
     for (int d = 0; d < 3; ++d) {
@@ -345,7 +345,11 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
         mid[d] = s0[d] + (s1[d] - s0[d]) / 2;
         if (s1[d] - s0[d] > 2) split |= 1 << d;
     }
-    lb__plan *own = pool && split && depth < LB__MARK_DEPTH ? &pool[depth] : NULL;
+    /* given: this box's plan is kept by the caller (an octant's) */
+    lb__plan *own = !split                           ? NULL
+                    : given                          ? given
+                    : pool && depth < LB__MARK_DEPTH ? &pool[depth]
+                                                     : NULL;
     double lo, hi;
     sub_phi(R->ev, g, plan, IV, n0, n1, own, &lo, &hi);
     if (lo >= 0.0 || hi < 0.0) return;
@@ -359,7 +363,7 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
                 c0[d] = cut && up ? mid[d] : s0[d];
                 c1[d] = cut && !up ? mid[d] : s1[d];
             }
-            mark(R, B, next, IV, c0, c1, pool, depth + 1);
+            mark(R, B, next, IV, c0, c1, pool, depth + 1, NULL);
         }
         return;
     }
@@ -433,7 +437,26 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
     /* few primitives: no narrower plans (LB__NARROW_MIN_PRIMS), here or below;
      * each split box's pass fills its depth's plan whole (no copy needed) */
     const int narrow = lb__plan_prims(ev, &E->plan) >= LB__NARROW_MIN_PRIMS;
-    mark(R, B, &E->plan, E->iv, zero, B->nc, narrow ? S->pool : NULL, 0);
+    /* a block of at least 6 cells a side starts at its octants (the block
+     * passed its interval test in the selection): their passes' plans are
+     * the octant plans of the node values and the refinement, so no octant
+     * is passed twice */
+    const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
+    const int octs = narrow && B->nc[0] >= 6 && B->nc[1] >= 6 && B->nc[2] >= 6;
+    if (octs) {
+        for (int o = 0; o < 8; ++o) {
+            uint32_t l0[3], l1[3];
+            for (int d = 0; d < 3; ++d) {
+                l0[d] = (o >> d) & 1 ? half[d] : 0;
+                l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
+            }
+            mark(R, B, &E->plan, E->iv, l0, l1, S->pool, 1, &S->oct[o]);
+        }
+        if (!(B->octmem = lb__cplan_pack(ev, S->oct, 8, B->oct)))
+            return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    } else {
+        mark(R, B, &E->plan, E->iv, zero, B->nc, narrow ? S->pool : NULL, 0, NULL);
+    }
     size_t m = 0;
     for (size_t q = 0; q < n; ++q) m += B->nmask[q];
     if (m == 0) return LB_OK;
@@ -449,7 +472,6 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
      * few primitives gains too little to pay for eight more passes: then
      * the block is one group under its own plan. */
     const int ngroups = narrow ? 8 : 1;
-    const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
     size_t start[9] = {0}, w = 0;
     for (int o = 0; o < ngroups; ++o) {
         uint32_t r0[3], r1[3]; /* the group's node range, inclusive */
@@ -473,11 +495,14 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
                 }
     }
     start[ngroups] = w;
-    if (narrow) lb__plan_load(ev, &E->plan, &S->outer);
+    if (narrow && !octs) lb__plan_load(ev, &E->plan, &S->outer);
     for (int o = 0; o < ngroups && !s; ++o) {
         const size_t c = start[o + 1] - start[o];
         if (!c) continue;
-        if (narrow) lb__octant_narrow(ev, g, B, o, &S->outer, E);
+        if (octs)
+            lb__plan_load(ev, &S->oct[o], &E->plan);
+        else if (narrow)
+            lb__octant_narrow(ev, g, B, o, &S->outer, E);
         const size_t a = start[o];
         s = lb__boxeval_run(ev, E, c, x + a, y + a, z + a, v + a, gx + a, gy + a, gz + a, err);
     }
@@ -602,6 +627,8 @@ static void finish_block(run *R, size_t i, size_t t) {
     if (lb__mesh_block(R->ev, R->g, B, R->ctx[t], &e)) fail_block(R, i, &e);
     slot_release(R, i);
     lb__cplan_free(&B->plan);
+    free(B->octmem);
+    B->octmem = NULL;
     atomic_fetch_add(&R->done, 1);
 }
 
@@ -941,6 +968,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         free(B->vpos);
         free(B->vnrm);
         free(B->tri);
+        free(B->octmem);
         lb__cplan_free(&B->plan);
     }
     free(R.blocks);

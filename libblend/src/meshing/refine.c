@@ -149,7 +149,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
     size_t start[9] = {0};
     const uint32_t half[3] = {B->nc[0] / 2, B->nc[1] / 2, B->nc[2] / 2};
     if (narrow) {
-        lb__plan_load(ev, &E->plan, &S->outer);
+        if (!B->octmem) lb__plan_load(ev, &E->plan, &S->outer);
         double mid[3];
         lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + half[0], (uint64_t)B->b[1] * LB__MB + half[1],
                      (uint64_t)B->b[2] * LB__MB + half[2], mid);
@@ -176,7 +176,10 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
     for (int o = 0; o < ngroups && !s; ++o) {
         const size_t na = start[o + 1] - start[o];
         if (!na) continue;
-        if (narrow) lb__octant_narrow(ev, g, B, o, &S->outer, E);
+        if (narrow && B->octmem) /* mark()'s plan of this octant */
+            lb__boxeval_load(ev, &B->oct[o], E);
+        else if (narrow)
+            lb__octant_narrow(ev, g, B, o, &S->outer, E);
         s = refine_some(ev, g, E, act + start[o], na, a, b, ga, gb, tol, t, lo, hi, x, y, z, v, gx,
                         gy, gz, pos, nrm, boxmax, err);
     }
