@@ -179,8 +179,17 @@ LB_INTERNAL lb_status lb__bounds_box(const lb_evaluator *ev, const double bmin[3
                                      const double bmax[3], double *lo, double *hi, lb_error *err);
 
 /* Centre and half-size of a box, the half-size rounded up to cover it. */
-LB_INTERNAL void lb__box_centre(const double bmin[3], const double bmax[3], double bc[3],
-                                double br[3]);
+static inline void lb__box_centre(const double bmin[3], const double bmax[3], double bc[3],
+                                  double br[3]) {
+    for (int d = 0; d < 3; ++d) {
+        bc[d] = 0.5 * (bmin[d] + bmax[d]);
+        br[d] = 0.5 * (bmax[d] - bmin[d]);
+        /* the centre is rounded: cover both ends exactly */
+        const double a = fabs(bc[d] - bmin[d]), b = fabs(bmax[d] - bc[d]);
+        const double e = (a > b ? a : b) * (1.0 + 1e-15);
+        if (e > br[d]) br[d] = e;
+    }
+}
 
 /* Run the whole tape, without culling, on n <= LB__CHUNK points into regs
  * (nregs * 4 * LB__CHUNK doubles), adding to *count (may be NULL) one per

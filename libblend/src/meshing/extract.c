@@ -290,9 +290,15 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
     lb_status s = LB_OK;
     for (uint32_t k = 0; k < B->nc[2]; ++k)
-        for (uint32_t j = 0; j < B->nc[1]; ++j)
+        for (uint32_t j = 0; j < B->nc[1]; ++j) {
+            const uint8_t *row = B->cmask + ((size_t)k * B->nc[1] + j) * B->nc[0];
+            if (B->nc[0] == sizeof(uint64_t)) { /* most rows of most blocks: no marked cell */
+                uint64_t w;
+                memcpy(&w, row, sizeof w);
+                if (!w) continue;
+            }
             for (uint32_t i = 0; i < B->nc[0]; ++i) {
-                if (!B->cmask[((size_t)k * B->nc[1] + j) * B->nc[0] + i]) continue;
+                if (!row[i]) continue;
                 double c[8];
                 int nin = 0;
                 for (int o = 0; o < 8; ++o) {
@@ -308,6 +314,7 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
                     goto done;
                 }
             }
+        }
     B->nv = C->ne;
     if (C->ne) {
         B->vkey = malloc(C->ne * sizeof *B->vkey);
