@@ -461,6 +461,13 @@ static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const d
  * root's interval is R[ev->out]. With child (may be NULL), also the plan of
  * the smaller box: each blend keeps what the sub-box culling kept (a subset
  * of the parent's), every other operator the parent's list. */
+/* Operator i (in) keeps the parent's argument list in the child plan: the
+ * operators whose bounds do not cull. */
+static void inherit_args(lb__plan *child, const lb__plan *parent, const lb__instr *in, uint32_t i) {
+    memcpy(child->act + in->aoff, parent->act + in->aoff, parent->nact[i] * sizeof *parent->act);
+    child->nact[i] = parent->nact[i];
+}
+
 void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const double bc[3],
                          const double br[3], iv *R, lb__plan *child) {
     const bscr S = scratch(ev, R);
@@ -506,18 +513,10 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                     child->nact[i] = na;
                 }
             }
-            if (child && in->fast == LB__FAST_MINMAX) {
-                memcpy(child->act + in->aoff, parent->act + in->aoff,
-                       parent->nact[i] * sizeof *parent->act);
-                child->nact[i] = parent->nact[i];
-            }
+            if (child && in->fast == LB__FAST_MINMAX) inherit_args(child, parent, in, i);
         } else {
             all_args_bounds(ev, in, bc, br, R, &o);
-            if (child) {
-                memcpy(child->act + in->aoff, parent->act + in->aoff,
-                       parent->nact[i] * sizeof *parent->act);
-                child->nact[i] = parent->nact[i];
-            }
+            if (child) inherit_args(child, parent, in, i);
         }
         /* two scalar stores: a struct copy here went through the stack as
          * two narrow stores and one wide load (a stalled store forward) */
