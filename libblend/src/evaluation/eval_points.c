@@ -782,13 +782,6 @@ void lb__boxeval_load(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E
     E->plan.nlist = C->nlist;
 }
 
-lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E,
-                                lb_error *err) {
-    lb_status s = lb__boxeval_alloc(ev, E, err);
-    if (!s) lb__boxeval_load(ev, C, E);
-    return s;
-}
-
 /* A compact plan's sizes: listed instructions, and argument-list entries
  * (each operator's count, then its arguments). */
 static void cplan_sizes(const lb_evaluator *ev, const lb__plan *P, size_t *nl, size_t *na) {
@@ -916,12 +909,6 @@ void lb__plan_load(const lb_evaluator *ev, const lb__plan *from, lb__plan *P) {
                from->nact[i] * sizeof *P->act);
     }
     P->nlist = from->nlist;
-}
-
-lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P, lb_error *err) {
-    lb_status s = lb__plan_alloc(ev, P, err);
-    if (!s) lb__plan_load(ev, from, P);
-    return s;
 }
 
 void lb__plan_free(lb__plan *P) {

@@ -211,13 +211,10 @@ typedef struct lb__boxeval {
     double *regs;
     lb__iv *iv; /* the box's interval registers (scratch for sub-box passes afterwards) */
 } lb__boxeval;
-/* E for the box whose plan C is (lb__cplan_make); no interval pass. */
-LB_INTERNAL lb_status lb__boxeval_init_plan(const lb_evaluator *ev, const lb__cplan *C,
-                                            lb__boxeval *E, lb_error *err);
-/* The same in two steps, for a state reused from box to box: E allocated
- * for ev with an empty plan (NULL members and LB_ERR_NO_MEMORY when memory
- * is short), then loaded with C's plan (no allocation; any earlier plan of
- * E's is replaced). */
+/* E for boxes whose plans were made beforehand (lb__cplan_make), reused
+ * from box to box: allocated for ev with an empty plan (NULL members and
+ * LB_ERR_NO_MEMORY when memory is short), then loaded with a box's plan C
+ * (no allocation, no interval pass; any earlier plan of E's is replaced). */
 LB_INTERNAL lb_status lb__boxeval_alloc(const lb_evaluator *ev, lb__boxeval *E, lb_error *err);
 LB_INTERNAL void lb__boxeval_load(const lb_evaluator *ev, const lb__cplan *C, lb__boxeval *E);
 LB_INTERNAL lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, size_t n,
@@ -229,11 +226,8 @@ LB_INTERNAL void lb__boxeval_free(lb__boxeval *E);
  * Every later point must lie in [bmin, bmax]. */
 LB_INTERNAL void lb__boxeval_narrow(const lb_evaluator *ev, lb__boxeval *E, const lb__plan *outer,
                                     const double bmin[3], const double bmax[3]);
-/* A copy of E's plan into P (allocated like E's; NULL members when memory is
- * short), so that E can be narrowed again from the same outer plan. */
-LB_INTERNAL lb_status lb__plan_copy(const lb_evaluator *ev, const lb__plan *from, lb__plan *P,
-                                    lb_error *err);
-/* P (allocated for ev) becomes a copy of from, without allocating. */
+/* P (allocated for ev, lb__plan_alloc) becomes a copy of from, without
+ * allocating: E's plan kept so that E can be narrowed again from it. */
 LB_INTERNAL void lb__plan_load(const lb_evaluator *ev, const lb__plan *from, lb__plan *P);
 LB_INTERNAL void lb__plan_free(lb__plan *P);
 /* How many primitives the plan runs per point. */
