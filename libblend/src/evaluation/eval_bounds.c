@@ -107,6 +107,14 @@ static iv prim_bounds(const lb__instr *in, const double bc[3], const double br[3
     return o;
 }
 
+/* An instruction's interval into its register, clamped: two scalar stores
+ * (a struct copy went through the stack as two narrow stores and one wide
+ * load, a stalled store forward on every instruction of every pass). */
+static inline void store_iv(iv *r, iv o) {
+    r->lo = clampd(o.lo);
+    r->hi = clampd(o.hi);
+}
+
 /* dual (union-form) argument interval: intersection -x, difference -x_0 */
 static iv dual_iv(lb_setop op, size_t i, iv x) {
     const int neg = op == LB_INTERSECTION || (op == LB_DIFFERENCE && i == 0);
@@ -431,10 +439,7 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
                 if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
             }
         }
-        /* two scalar stores: a struct copy here went through the stack as
-         * two narrow stores and one wide load (a stalled store forward) */
-        R[in->dst].lo = clampd(o.lo);
-        R[in->dst].hi = clampd(o.hi);
+        store_iv(&R[in->dst], o);
     }
     if (plan) plan_needs(ev, plan, NULL);
 }
@@ -454,13 +459,6 @@ static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const d
         op_bounds(ev->conv, &in->op, x, c, o, S.xl);
 }
 
-/* The same pass over a box inside the box of `parent` (a plan made by
- * lb__bounds_pass): instructions the parent does not need are skipped, and
- * blends consider only the arguments the parent kept, which are the only
- * ones that can matter inside. Fills R for the needed instructions; the
- * root's interval is R[ev->out]. With child (may be NULL), also the plan of
- * the smaller box: each blend keeps what the sub-box culling kept (a subset
- * of the parent's), every other operator the parent's list. */
 /* Operator i (in) keeps the parent's argument list in the child plan: the
  * operators whose bounds do not cull. */
 static void inherit_args(lb__plan *child, const lb__plan *parent, const lb__instr *in, uint32_t i) {
@@ -468,6 +466,13 @@ static void inherit_args(lb__plan *child, const lb__plan *parent, const lb__inst
     child->nact[i] = parent->nact[i];
 }
 
+/* The same pass over a box inside the box of `parent` (a plan made by
+ * lb__bounds_pass): instructions the parent does not need are skipped, and
+ * blends consider only the arguments the parent kept, which are the only
+ * ones that can matter inside. Fills R for the needed instructions; the
+ * root's interval is R[ev->out]. With child (may be NULL), also the plan of
+ * the smaller box: each blend keeps what the sub-box culling kept (a subset
+ * of the parent's), every other operator the parent's list. */
 void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const double bc[3],
                          const double br[3], iv *R, lb__plan *child) {
     const bscr S = scratch(ev, R);
@@ -518,10 +523,7 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
             all_args_bounds(ev, in, bc, br, R, &o);
             if (child) inherit_args(child, parent, in, i);
         }
-        /* two scalar stores: a struct copy here went through the stack as
-         * two narrow stores and one wide load (a stalled store forward) */
-        R[in->dst].lo = clampd(o.lo);
-        R[in->dst].hi = clampd(o.hi);
+        store_iv(&R[in->dst], o);
     }
     if (child) plan_needs(ev, child, parent);
 }
@@ -535,10 +537,7 @@ void lb__bounds_pass_list(const lb_evaluator *ev, const uint32_t *list, size_t n
             o = prim_bounds(in, bc, br);
         else
             all_args_bounds(ev, in, bc, br, R, &o);
-        /* two scalar stores: a struct copy here went through the stack as
-         * two narrow stores and one wide load (a stalled store forward) */
-        R[in->dst].lo = clampd(o.lo);
-        R[in->dst].hi = clampd(o.hi);
+        store_iv(&R[in->dst], o);
     }
 }
 
