@@ -94,9 +94,18 @@ static inline void lb__node_pos(const lb__grid *g, uint64_t x, uint64_t y, uint6
  * three spheres and pay off from four (bench scenes S1, S2, 2026-12-01). */
 #define LB__NARROW_MIN_PRIMS 4
 
+/* Octant o of block B as local nodes [l0, l1] (bit d of o set: the upper
+ * half along axis d, from the middle node nc / 2 on). */
+static inline void lb__octant_nodes(const lb__block *B, int o, uint32_t l0[3], uint32_t l1[3]) {
+    for (int d = 0; d < 3; ++d) {
+        const uint32_t half = B->nc[d] / 2;
+        l0[d] = (o >> d) & 1 ? half : 0;
+        l1[d] = (o >> d) & 1 ? B->nc[d] : half;
+    }
+}
+
 /* E's plan narrowed (lb__boxeval_narrow) from outer, the block's plan, to
- * octant o of B (bit d set: the upper half along axis d, from the middle
- * node on). */
+ * octant o of B (lb__octant_nodes). */
 LB_INTERNAL void lb__octant_narrow(const lb_evaluator *ev, const lb__grid *g, const lb__block *B,
                                    int o, const lb__plan *outer, lb__boxeval *E);
 /* The box of the block's local nodes [l0, l1] (padded by 1e-9 of a cell). */

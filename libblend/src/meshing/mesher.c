@@ -446,10 +446,7 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
     if (octs) {
         for (int o = 0; o < 8; ++o) {
             uint32_t l0[3], l1[3];
-            for (int d = 0; d < 3; ++d) {
-                l0[d] = (o >> d) & 1 ? half[d] : 0;
-                l1[d] = (o >> d) & 1 ? B->nc[d] : half[d];
-            }
+            lb__octant_nodes(B, o, l0, l1);
             mark(R, B, &E->plan, E->iv, l0, l1, S->pool, 1, &S->oct[o]);
         }
         if (!(B->octmem = lb__cplan_pack(ev, S->oct, 8, B->oct)))

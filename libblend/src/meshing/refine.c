@@ -97,11 +97,7 @@ void lb__node_box(const lb__grid *g, const lb__block *B, const uint32_t l0[3], c
 void lb__octant_narrow(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, int o,
                        const lb__plan *outer, lb__boxeval *E) {
     uint32_t l0[3], l1[3];
-    for (int d = 0; d < 3; ++d) {
-        const uint32_t half = B->nc[d] / 2;
-        l0[d] = (o >> d) & 1 ? half : 0;
-        l1[d] = (o >> d) & 1 ? B->nc[d] : half;
-    }
+    lb__octant_nodes(B, o, l0, l1);
     double omin[3], omax[3];
     lb__node_box(g, B, l0, l1, omin, omax);
     lb__boxeval_narrow(ev, E, outer, omin, omax);
