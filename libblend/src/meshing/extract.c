@@ -144,36 +144,6 @@ static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g
         T[2] = f->e[2];
         return T + 3;
     }
-    if (n == 4) { /* the dynamic programme below, written out: two diagonals */
-        const int ok02 = f->ce[0] == 0xff || !lb__cube_edges_share_face(g, f->ce[0], f->ce[2]);
-        const int ok13 = f->ce[1] == 0xff || !lb__cube_edges_share_face(g, f->ce[1], f->ce[3]);
-        const double *P[4] = {pos + 3 * f->e[0], pos + 3 * f->e[1], pos + 3 * f->e[2],
-                              pos + 3 * f->e[3]};
-        double best = INFINITY;
-        int k = 1;
-        if (ok02) {
-            double w = worst_cos(P[0], P[2], P[3]);
-            const double w0 = worst_cos(P[0], P[1], P[2]);
-            const double W0 = w0 < INFINITY ? w0 : INFINITY; /* as the programme keeps it */
-            if (W0 > w) w = W0;
-            if (w < best) {
-                best = w;
-                k = 2;
-            }
-        }
-        if (ok13) {
-            double w = worst_cos(P[0], P[1], P[3]);
-            const double w1 = worst_cos(P[1], P[2], P[3]);
-            const double W1 = w1 < INFINITY ? w1 : INFINITY;
-            if (W1 > w) w = W1;
-            if (w < best) k = 1;
-        }
-        const uint32_t *e = f->e;
-        const uint32_t t2[6] = {e[0], e[2], e[3], e[0], e[1], e[2]},
-                       t1[6] = {e[0], e[1], e[3], e[1], e[2], e[3]};
-        memcpy(T, k == 2 ? t2 : t1, sizeof t1);
-        return T + 6;
-    }
     double W[LB__MAXPOLY][LB__MAXPOLY];
     uint8_t ok[LB__MAXPOLY][LB__MAXPOLY], K[LB__MAXPOLY][LB__MAXPOLY];
     for (uint32_t a = 0; a < n; ++a)
