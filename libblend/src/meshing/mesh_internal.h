@@ -135,9 +135,8 @@ static inline double lb__mesh_phi_in(const lb__grid *g, double boxmax, const dou
  * block (so a block allocates only what it outputs): the evaluator state a
  * block's runs share, the block's plan kept while that state's is narrowed
  * octant by octant, mark()'s plans by depth and its octant plans, and the
- * batches of node
- * values (7 doubles per node) and of refinement (10 doubles and an index
- * per edge). */
+ * batches of node values (7 doubles per node) and of refinement (10
+ * doubles and an index per edge). */
 typedef struct lb__mscratch {
     lb__boxeval E;
     lb__plan outer;

@@ -410,10 +410,10 @@ static void slot_release(run *R, size_t i) {
     pthread_mutex_unlock(&R->lock);
 }
 
-/* The node values of a block: its plan (one interval pass over the block's
- * box), mark() with sub-box passes under that plan, then the marked nodes
- * evaluated under the same plan (the point evaluator's culling for that
- * box, computed once). */
+/* The node values of a block: its plan (from the block selection's
+ * descent), mark() with sub-box passes under that plan, then the marked
+ * nodes evaluated octant by octant under the octants' plans (or the block's
+ * own, for few primitives). */
 static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *err) {
     const lb__grid *g = R->g;
     const lb_evaluator *ev = R->ev;
@@ -550,8 +550,6 @@ static void block_share(run *R, size_t bi) {
     }
 }
 
-static int stopped(run *R);
-
 /* Wake the blocks waiting for a next block's node values (or for stop). */
 static void wake(run *R) {
     pthread_mutex_lock(&R->wm);
@@ -559,15 +557,12 @@ static void wake(run *R) {
     pthread_mutex_unlock(&R->wm);
 }
 
-/* Wait until block j's node values are done; 0 when the run stopped. */
-static int wait_ready(run *R, size_t j) {
-    if (!atomic_load(&R->ready[j])) {
-        pthread_mutex_lock(&R->wm);
-        while (!atomic_load(&R->ready[j]) && !atomic_load(&R->stop))
-            pthread_cond_wait(&R->wc, &R->wm);
-        pthread_mutex_unlock(&R->wm);
-    }
-    return !stopped(R);
+/* Wait until block j's node values are done, or the run stops. */
+static void wait_ready(run *R, size_t j) {
+    if (atomic_load(&R->ready[j])) return;
+    pthread_mutex_lock(&R->wm);
+    while (!atomic_load(&R->ready[j]) && !atomic_load(&R->stop)) pthread_cond_wait(&R->wc, &R->wm);
+    pthread_mutex_unlock(&R->wm);
 }
 
 static void fail_block(run *R, size_t i, const lb_error *e) {
