@@ -107,27 +107,21 @@ int lb__cell_polygon(lb__bctx *C, const uint32_t *e, const uint8_t *ce, uint32_t
     return 1;
 }
 
-/* The cosine of a triangle's smallest angle (1 for a degenerate one): the
- * largest of its three corner cosines. */
-static double worst_cos(const double *A, const double *B, const double *C) {
-    /* the smallest angle is the one opposite the shortest side */
-    const double e0[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]}; /* AB, opposite C */
-    const double e1[3] = {C[0] - B[0], C[1] - B[1], C[2] - B[2]}; /* BC, opposite A */
-    const double e2[3] = {A[0] - C[0], A[1] - C[1], A[2] - C[2]}; /* CA, opposite B */
-    const double l0 = e0[0] * e0[0] + e0[1] * e0[1] + e0[2] * e0[2];
-    const double l1 = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2];
-    const double l2 = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2];
-    const double *u, *v;
-    double lu, lv;
-    if (l0 <= l1 && l0 <= l2) { /* at C, between CA and CB = -BC */
-        u = e2, v = e1, lu = l2, lv = l1;
-    } else if (l1 <= l2) { /* at A, between AB and AC = -CA */
-        u = e0, v = e2, lu = l0, lv = l2;
-    } else { /* at B, between BC and BA = -AB */
-        u = e1, v = e0, lu = l1, lv = l0;
+/* The cosine of a triangle's smallest angle (1 for a degenerate one), from
+ * its squared side lengths: the smallest angle is the one opposite the
+ * shortest side s, between the other two sides u and v, and by the law of
+ * cosines its cosine is (u + v - s) / (2 sqrt(u v)). */
+static inline double worst_cos(double l0, double l1, double l2) {
+    double s, u, v;
+    if (l0 <= l1 && l0 <= l2) {
+        s = l0, u = l1, v = l2;
+    } else if (l1 <= l2) {
+        s = l1, u = l0, v = l2;
+    } else {
+        s = l2, u = l0, v = l1;
     }
-    const double den = sqrt(lu * lv);
-    return den > 0.0 ? -(u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / den : 1.0;
+    const double den = sqrt(u * v);
+    return den > 0.0 ? (u + v - s) / (2.0 * den) : 1.0;
 }
 
 /* Cut polygon f (vertices placed in pos) into f->n - 2 triangles along the
@@ -144,13 +138,17 @@ static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g
         T[2] = f->e[2];
         return T + 3;
     }
-    double W[LB__MAXPOLY][LB__MAXPOLY];
+    double W[LB__MAXPOLY][LB__MAXPOLY], L[LB__MAXPOLY][LB__MAXPOLY];
     uint8_t ok[LB__MAXPOLY][LB__MAXPOLY], K[LB__MAXPOLY][LB__MAXPOLY];
     for (uint32_t a = 0; a < n; ++a)
         for (uint32_t b = a + 1; b < n; ++b) {
             const int edge = b == a + 1 || (a == 0 && b == n - 1);
             ok[a][b] = (uint8_t)(edge || f->ce[a] == 0xff ||
                                  !lb__cube_edges_share_face(g, f->ce[a], f->ce[b]));
+            /* squared lengths of the sides and diagonals a triangle may use */
+            const double *A = pos + 3 * f->e[a], *B = pos + 3 * f->e[b];
+            const double d[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
+            L[a][b] = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         }
     for (uint32_t len = 2; len < n; ++len)
         for (uint32_t a = 0; a + len < n; ++a) {
@@ -159,7 +157,7 @@ static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g
             uint8_t bk = (uint8_t)(a + 1);
             for (uint32_t k = b - 1; k > a; --k) {
                 if (!ok[a][k] || !ok[k][b]) continue;
-                double w = worst_cos(pos + 3 * f->e[a], pos + 3 * f->e[k], pos + 3 * f->e[b]);
+                double w = worst_cos(L[a][k], L[k][b], L[a][b]);
                 if (k - a >= 2 && W[a][k] > w) w = W[a][k];
                 if (b - k >= 2 && W[k][b] > w) w = W[k][b];
                 if (w < best) {
