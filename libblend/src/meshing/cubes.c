@@ -134,9 +134,7 @@ int lb__mctable_check(const lb__mctable *t) {
     return 1;
 }
 
-int lb__cube_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c) {
-    int cfg = 0;
-    for (int o = 0; o < 8; ++o) cfg |= (c[o] < 0.0) << o;
+int lb__cube_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c, int cfg) {
     const lb__mccase *cs = &lb__cell_grid(C)->mc.c[cfg];
     int off = 0;
     for (int l = 0; l < cs->nloop; ++l) {

@@ -268,16 +268,16 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
             for (uint32_t i = 0; i < B->nc[0]; ++i) {
                 if (!row[i]) continue;
                 double c[8];
-                int nin = 0;
+                int cfg = 0; /* bit o: corner o inside */
                 for (int o = 0; o < 8; ++o) {
                     const size_t idx =
                         ((size_t)(k + ((o >> 2) & 1)) * D1 + (j + ((o >> 1) & 1))) * D0 +
                         (i + (o & 1));
                     c[o] = B->vals[idx];
-                    nin += c[o] < 0.0;
+                    cfg |= (c[o] < 0.0) << o;
                 }
-                if (nin == 0 || nin == 8) continue;
-                if (!(g->tetrahedra ? lb__tetra_cell : lb__cube_cell)(C, i, j, k, c)) {
+                if (cfg == 0 || cfg == 255) continue;
+                if (!(g->tetrahedra ? lb__tetra_cell : lb__cube_cell)(C, i, j, k, c, cfg)) {
                     s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
                     goto done;
                 }

@@ -187,10 +187,13 @@ LB_INTERNAL int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t 
  * memory. */
 LB_INTERNAL int lb__cell_polygon(lb__bctx *C, const uint32_t *e, const uint8_t *ce, uint32_t n);
 
-/* One cell (i, j, k) with corner values c (some inside, some outside): its
- * polygons, by the cube cases or by the Kuhn split. 0 when out of memory. */
-LB_INTERNAL int lb__cube_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c);
-LB_INTERNAL int lb__tetra_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c);
+/* One cell (i, j, k) with corner values c (some inside, some outside; bit o
+ * of cfg set: corner o inside): its polygons, by the cube cases or by the
+ * Kuhn split. 0 when out of memory. */
+LB_INTERNAL int lb__cube_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c,
+                              int cfg);
+LB_INTERNAL int lb__tetra_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c,
+                               int cfg);
 
 /* The grid of the block being extracted (cell methods read the cube cases). */
 LB_INTERNAL const lb__grid *lb__cell_grid(const lb__bctx *C);

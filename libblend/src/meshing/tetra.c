@@ -22,10 +22,6 @@
 static const uint8_t KUHN[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
                                    {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
 
-static inline int corner_in(const double *c, int o) {
-    return c[o] < 0.0;
-}
-
 /* Doubled lattice midpoint of corners p, q. */
 static void mid2(int p, int q, int m[3]) {
     for (int d = 0; d < 3; ++d) m[d] = ((p >> d) & 1) + ((q >> d) & 1);
@@ -55,11 +51,11 @@ static int reverse(const int ep[], const int eq[], const uint8_t *tv, const int 
     return dot < 0;
 }
 
-int lb__tetra_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c) {
+int lb__tetra_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c, int cfg) {
     for (int t = 0; t < 6; ++t) {
         const uint8_t *tv = KUHN[t];
         int in[4], nin = 0;
-        for (int q = 0; q < 4; ++q) nin += in[q] = corner_in(c, tv[q]);
+        for (int q = 0; q < 4; ++q) nin += in[q] = (cfg >> tv[q]) & 1;
         if (nin == 0 || nin == 4) continue;
         int ep[4], eq[4], ne = 0;
         if (nin == 1 || nin == 3) {
