@@ -3,6 +3,20 @@
  * keyed by node and axis mask), their vertices (lb__refine_edges), and the
  * triangulation of each cell polygon once its vertices are placed.
  *
+ * Every crossing edge has one owner, the only block that refines its
+ * vertex: of the blocks that hold the edge (up to four, when it lies on
+ * block faces), the last, in which the edge is off the far faces. The
+ * blocks are done from the last to the first (mesher.c), so an owner is
+ * done before the blocks that hold its edges on their far faces: it keeps
+ * its vertices on its near faces in a table in its node slot (position and
+ * index), and they take them from there, as references (block, index). A
+ * vertex is the same for every block that uses it, and the mesh needs no
+ * search to share it. An edge whose owner is not kept or did not cut it
+ * (the owner's interval passes proved its cells there do not cross, and a
+ * value near 0 fell the other way in the evaluators' last bit) stays with
+ * each block that cuts it, as an orphan keyed by its edge, and the merge
+ * shares it by key.
+ *
  * A cell method adds polygons (up to LB__MAXPOLY vertices, oriented
  * counter-clockwise seen from outside the solid) through lb__cell_edge and
  * lb__cell_polygon. A polygon is cut into the triangles whose smallest
@@ -30,20 +44,39 @@ typedef struct face {
 #define EMAP_SIZE LB__EMAP_SIZE
 #define FACE_MAX ((size_t)6 * LB__MB * LB__MB * LB__MB)
 
+#ifndef LB__FORCE_ORPHANS
+#define LB__FORCE_ORPHANS 0
+#endif
+
+/* A vertex index in a polygon while the block is extracted: an own edge's
+ * index, or REF | a reference's index. */
+#define REF 0x80000000u
+
 struct lb__bctx {
     const lb__grid *g;
     lb__block *B;
-    /* local edge id -> crossing edge index (e), valid where the entry's
-     * stamp is the block's: side by side, one cache line per lookup */
+    const lb__block *blocks; /* the run's blocks, B's next blocks (index + 1) */
+    const uint32_t *nbr;
+    int gnext; /* bit d: the grid has a block after B along d */
+    /* local edge id -> vertex index (e, REF for a reference), valid where
+     * the entry's stamp is the block's: side by side, one cache line per
+     * lookup */
     struct emap {
         uint32_t stamp;
-        int32_t e;
+        uint32_t e;
     } * emap;
     uint32_t stamp;
-    size_t ne;                 /* crossing edges so far (< EMAP_SIZE) */
+    size_t ne;                 /* own crossing edges so far (< EMAP_SIZE) */
     double *ea, *eb, *pa, *pb; /* inside end, outside end, their phi */
     double *ga, *gb;           /* and their gradients */
-    uint64_t *key;
+    uint32_t *eloc;            /* local node (4 bits per axis) and mask (bits 12-14) */
+    uint8_t *orph;             /* 1: an orphan */
+    uint64_t *key;             /* an orphan's grid edge key */
+    size_t norph;
+    size_t nref;    /* references so far */
+    uint32_t *ref;  /* block and index, 2 per reference */
+    double *rpos;   /* their positions */
+    uint32_t *perm; /* own edge -> vertex index, when there are orphans */
     face *faces;
     size_t nf; /* polygons so far (< FACE_MAX) */
     lb__mscratch S;
@@ -54,6 +87,14 @@ static inline int corner_in(const double *c, int o) {
     return c[o] < 0.0;
 }
 
+/* The near-face table entry of local node l's edge along mask, on the near
+ * face of axis d (l[d] = 0, mask without bit d). */
+static inline size_t face_entry(int d, const uint32_t l[3], int mask) {
+    const int d1 = d == 0 ? 1 : 0, d2 = d == 2 ? 1 : 2;
+    const int m = (((mask >> d1) & 1) | ((mask >> d2) & 1) << 1) - 1;
+    return ((size_t)d * LB__FACE_NODES + l[d1] * (LB__MB + 1) + l[d2]) * 3 + (size_t)m;
+}
+
 int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, int oq,
                       const double *c) {
     const lb__block *B = C->B;
@@ -62,9 +103,43 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
     const int mask = op ^ oq;
     const size_t lid = ((size_t)(lk * D1 + lj) * D0 + li) * 8 + (size_t)mask;
     if (C->emap[lid].stamp == C->stamp) return C->emap[lid].e;
+    C->emap[lid].stamp = C->stamp;
+    /* on B's far face along the axes in far (and a next block exists
+     * there): the next block at offset far owns the edge */
+    const uint32_t loc[3] = {li, lj, lk};
+    int far = 0;
+    for (int d = 0; d < 3; ++d)
+        far |= (!((mask >> d) & 1) && loc[d] == B->nc[d] && ((C->gnext >> d) & 1)) << d;
+    int orphan = 0;
+    if (far) {
+        const uint32_t o = C->nbr[far];
+        if (o) {
+            const lb__block *O = &C->blocks[o - 1];
+            const int d = far & 1 ? 0 : far & 2 ? 1 : 2;
+            const uint32_t ol[3] = {far & 1 ? 0 : li, far & 2 ? 0 : lj, far & 4 ? 0 : lk};
+            const size_t fe = face_entry(d, ol, mask);
+            if ((O->fvalid[fe >> 3] >> (fe & 7)) & 1) {
+                const size_t r = C->nref++;
+                C->ref[2 * r] = o - 1;
+                C->ref[2 * r + 1] = O->ftab[fe].idx;
+                memcpy(C->rpos + 3 * r, O->ftab[fe].pos, 3 * sizeof(double));
+                C->emap[lid].e = REF | (uint32_t)r;
+                return (int64_t)(REF | (uint32_t)r);
+            }
+        }
+        orphan = 1; /* not kept, or it did not cut this edge */
+    }
     const lb__grid *g = C->g;
     const uint64_t gx = (uint64_t)B->b[0] * LB__MB + li, gy = (uint64_t)B->b[1] * LB__MB + lj,
                    gz = (uint64_t)B->b[2] * LB__MB + lk;
+#if LB__FORCE_ORPHANS
+    /* the orphan test's build (tests/mesh/test_mesh_orphans.c): every third
+     * edge on a near face is an orphan of all the blocks that hold it */
+    for (int d = 0; d < 3 && !orphan; ++d)
+        if (!((mask >> d) & 1) && !loc[d] && B->b[d] &&
+            (lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask) % 3 == 0)
+            orphan = 1;
+#endif
     double P[3], Q[3];
     lb__node_pos(g, gx, gy, gz, P);
     lb__node_pos(g, gx + (mask & 1), gy + ((mask >> 1) & 1), gz + ((mask >> 2) & 1), Q);
@@ -74,20 +149,18 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
     memcpy(C->eb + 3 * e, pin ? Q : P, sizeof P);
     C->pa[e] = pin ? c[op] : c[oq];
     C->pb[e] = pin ? c[oq] : c[op];
-    const uint32_t D0n = B->nc[0] + 1, D1n = B->nc[1] + 1;
-    const size_t np = ((size_t)lk * D1n + lj) * D0n + li;
-    const size_t nq = ((size_t)(lk + ((mask >> 2) & 1)) * D1n + (lj + ((mask >> 1) & 1))) * D0n +
-                      (li + (mask & 1));
+    const size_t np = ((size_t)lk * D1 + lj) * D0 + li;
+    const size_t nq =
+        ((size_t)(lk + ((mask >> 2) & 1)) * D1 + (lj + ((mask >> 1) & 1))) * D0 + (li + (mask & 1));
     memcpy(C->ga + 3 * e, B->grads + 3 * (pin ? np : nq), 3 * sizeof(double));
     memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
-    /* on a block face (some axis the edge does not run along at 0 or nc):
-     * other blocks may cut it too, and the merge must find their copies */
-    const uint32_t loc[3] = {li, lj, lk};
-    int shared = 0;
-    for (int d = 0; d < 3; ++d) shared |= !((mask >> d) & 1) && (loc[d] == 0 || loc[d] == B->nc[d]);
-    C->key[e] = (lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask) | (uint64_t)shared << 63;
-    C->emap[lid].e = (int32_t)e;
-    C->emap[lid].stamp = C->stamp;
+    C->eloc[e] = li | lj << 4 | lk << 8 | (uint32_t)mask << 12;
+    C->orph[e] = (uint8_t)orphan;
+    if (orphan) {
+        C->key[e] = lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask;
+        ++C->norph;
+    }
+    C->emap[lid].e = (uint32_t)e;
     return (int64_t)e;
 }
 
@@ -200,6 +273,11 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     C->pa = malloc(EMAP_SIZE * sizeof *C->pa);
     C->pb = malloc(EMAP_SIZE * sizeof *C->pb);
     C->key = malloc(EMAP_SIZE * sizeof *C->key);
+    C->eloc = malloc(EMAP_SIZE * sizeof *C->eloc);
+    C->orph = malloc(EMAP_SIZE * sizeof *C->orph);
+    C->ref = malloc(2 * EMAP_SIZE * sizeof *C->ref);
+    C->rpos = malloc(3 * EMAP_SIZE * sizeof *C->rpos);
+    C->perm = malloc(EMAP_SIZE * sizeof *C->perm);
     C->faces = malloc(FACE_MAX * sizeof *C->faces);
     lb__mscratch *S = &C->S;
     int ok =
@@ -212,7 +290,8 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     S->edges = malloc(10 * EMAP_SIZE * sizeof *S->edges);
     S->eact = malloc(EMAP_SIZE * sizeof *S->eact);
     if (!ok || !C->emap || !C->ea || !C->eb || !C->ga || !C->gb || !C->pa || !C->pb || !C->key ||
-        !C->faces || !S->nodes || !S->nidx || !S->edges || !S->eact) {
+        !C->eloc || !C->orph || !C->ref || !C->rpos || !C->perm || !C->faces || !S->nodes ||
+        !S->nidx || !S->edges || !S->eact) {
         lb__bctx_free(C);
         return NULL;
     }
@@ -229,6 +308,11 @@ void lb__bctx_free(lb__bctx *C) {
     free(C->ga);
     free(C->gb);
     free(C->key);
+    free(C->eloc);
+    free(C->orph);
+    free(C->ref);
+    free(C->rpos);
+    free(C->perm);
     free(C->faces);
     lb__mscratch *S = &C->S;
     lb__boxeval_free(&S->E);
@@ -246,11 +330,62 @@ lb__mscratch *lb__bctx_scratch(lb__bctx *C) {
     return &C->S;
 }
 
-lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B, lb__bctx *C,
+/* Own edges' vertices, in place: those of the block alone first, then the
+ * orphans (both in the order found), so that a next block's reference and
+ * the merge can count on the first np. perm maps old to new indices. */
+static void orphans_last(lb__bctx *C) {
+    const size_t n = C->ne, np = n - C->norph;
+    size_t a = 0, b = np;
+    for (size_t e = 0; e < n; ++e) C->perm[e] = (uint32_t)(C->orph[e] ? b++ : a++);
+    /* apply the permutation through the refinement batch (free until the
+     * refinement) as a copy */
+    double *tmp = C->S.edges;
+    double *arr3[4] = {C->ea, C->eb, C->ga, C->gb};
+    for (int q = 0; q < 4; ++q) {
+        for (size_t e = 0; e < n; ++e) memcpy(tmp + 3 * C->perm[e], arr3[q] + 3 * e, 24);
+        memcpy(arr3[q], tmp, 3 * n * sizeof(double));
+    }
+    double *arr1[2] = {C->pa, C->pb};
+    for (int q = 0; q < 2; ++q) {
+        for (size_t e = 0; e < n; ++e) tmp[C->perm[e]] = arr1[q][e];
+        memcpy(arr1[q], tmp, n * sizeof(double));
+    }
+    uint64_t *kt = (uint64_t *)(void *)tmp;
+    for (size_t e = 0; e < n; ++e) kt[C->perm[e]] = C->key[e];
+    memcpy(C->key, kt, n * sizeof *kt);
+    uint32_t *lt = (uint32_t *)(void *)tmp;
+    for (size_t e = 0; e < n; ++e) lt[C->perm[e]] = C->eloc[e];
+    memcpy(C->eloc, lt, n * sizeof *lt);
+}
+
+/* The block's own vertices on its near faces into its table (for the
+ * blocks before it; only those of the block alone: np). */
+static void publish(lb__bctx *C) {
+    lb__block *B = C->B;
+    const size_t np = C->ne - C->norph;
+    for (size_t e = 0; e < np; ++e) {
+        const uint32_t w = C->eloc[e];
+        const uint32_t l[3] = {w & 15, (w >> 4) & 15, (w >> 8) & 15};
+        const int mask = (int)(w >> 12);
+        for (int d = 0; d < 3; ++d) {
+            if (l[d] || ((mask >> d) & 1) || !B->b[d]) continue;
+            const size_t fe = face_entry(d, l, mask);
+            B->ftab[fe].idx = (uint32_t)e;
+            memcpy(B->ftab[fe].pos, B->vpos + 3 * e, 3 * sizeof(double));
+            B->fvalid[fe >> 3] |= (uint8_t)(1u << (fe & 7));
+        }
+    }
+}
+
+lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B,
+                         const lb__block *blocks, const uint32_t nbr[8], int gnext, lb__bctx *C,
                          lb_error *err) {
     C->g = g;
     C->B = B;
-    C->ne = C->nf = 0;
+    C->blocks = blocks;
+    C->nbr = nbr;
+    C->gnext = gnext;
+    C->ne = C->nf = C->nref = C->norph = 0;
     if (++C->stamp == 0) { /* wrapped: clear the stamps once */
         memset(C->emap, 0, EMAP_SIZE * sizeof *C->emap);
         C->stamp = 1;
@@ -283,22 +418,40 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
                 }
             }
         }
-    B->nv = C->ne;
-    if (C->ne) {
-        B->vkey = malloc(C->ne * sizeof *B->vkey);
-        B->vpos = malloc(3 * C->ne * sizeof *B->vpos);
-        B->vnrm = malloc(3 * C->ne * sizeof *B->vnrm);
+    const size_t ne = C->ne, nref = C->nref;
+    B->nv = ne;
+    B->np = ne - C->norph;
+    B->nref = nref;
+    if (ne + nref) {
         size_t nt = 0;
         for (size_t f = 0; f < C->nf; ++f) nt += C->faces[f].n - 2;
+        B->vpos = malloc(3 * (ne + nref) * sizeof *B->vpos);
+        B->vnrm = malloc(3 * (ne ? ne : 1) * sizeof *B->vnrm);
         B->tri = malloc(3 * (nt ? nt : 1) * sizeof *B->tri);
-        if (!B->vkey || !B->vpos || !B->vnrm || !B->tri) {
+        B->rref = malloc(2 * (nref ? nref : 1) * sizeof *B->rref);
+        B->okey = C->norph ? malloc(C->norph * sizeof *B->okey) : NULL;
+        if (!B->vpos || !B->vnrm || !B->tri || !B->rref || (C->norph && !B->okey)) {
             s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
             goto done;
         }
-        memcpy(B->vkey, C->key, C->ne * sizeof *B->vkey);
-        s = lb__refine_edges(ev, g, B, C->ne, C->ea, C->eb, C->pa, C->pb, C->ga, C->gb, B->vpos,
+        if (C->norph) {
+            orphans_last(C);
+            memcpy(B->okey, C->key + B->np, C->norph * sizeof *B->okey);
+        }
+        s = lb__refine_edges(ev, g, B, ne, C->ea, C->eb, C->pa, C->pb, C->ga, C->gb, B->vpos,
                              B->vnrm, &C->S, err);
         if (s) goto done;
+        publish(C);
+        memcpy(B->vpos + 3 * ne, C->rpos, 3 * nref * sizeof(double));
+        memcpy(B->rref, C->ref, 2 * nref * sizeof *B->rref);
+        /* polygon vertices as local indices: own ones, then references */
+        for (size_t f = 0; f < C->nf; ++f) {
+            face *F = &C->faces[f];
+            for (uint32_t q = 0; q < F->n; ++q) {
+                const uint32_t v = F->e[q];
+                F->e[q] = v & REF ? (uint32_t)ne + (v & ~REF) : C->norph ? C->perm[v] : v;
+            }
+        }
         uint32_t *T = B->tri;
         for (size_t f = 0; f < C->nf; ++f) T = triangulate(&C->faces[f], B->vpos, g, T);
         B->nt = nt;

@@ -55,6 +55,20 @@ typedef struct lb__grid {
     lb__mctable mc;
 } lb__grid;
 
+/* A vertex a block owns on one of its near faces (local coordinate 0 on an
+ * axis its edge does not run along), for the block before it on that axis:
+ * its index in the block and its position. */
+typedef struct lb__fent {
+    uint32_t idx, pad;
+    double pos[3];
+} lb__fent;
+
+/* Entries of a block's near-face table: per near face (axis d), per node of
+ * the face (the other two local coordinates, 0..LB__MB each) and per edge
+ * direction in the face (the three non-zero masks without bit d). */
+#define LB__FACE_NODES ((size_t)(LB__MB + 1) * (LB__MB + 1))
+#define LB__FACE_ENTRIES (3 * LB__FACE_NODES * 3)
+
 /* One block of LB__MB^3 cells (fewer at the far end of the grid). */
 typedef struct lb__block {
     uint32_t b[3];  /* block coordinates */
@@ -70,9 +84,19 @@ typedef struct lb__block {
      * none, the refinement narrows for itself) */
     lb__cplan oct[8];
     void *octmem;
-    /* output: vertices keyed by grid edge, triangles by local vertex index */
-    size_t nv, nt;
-    uint64_t *vkey;
+    /* in the block's node slot: its near-face vertices, for the blocks
+     * before it (extract.c) */
+    lb__fent *ftab;
+    uint8_t *fvalid; /* bit e: ftab[e] is written */
+    /* output (extract.c): nv vertices of its own in vpos and vnrm, of which
+     * the first np are its alone and the rest are orphans (okey: their grid
+     * edge keys, nv - np of them); nref vertices of next blocks (rref: their
+     * block and index there, 2 per vertex), whose positions follow the own
+     * ones in vpos; nt triangles over local vertex indices (own ones, then
+     * the references) */
+    size_t nv, np, nref, nt;
+    uint64_t *okey;
+    uint32_t *rref;
     double *vpos, *vnrm;
     uint32_t *tri;
 } lb__block;
@@ -150,10 +174,15 @@ typedef struct lb__mscratch {
 
 /* Surface extraction over one block whose node values are final (extract.c):
  * finds the crossing edges cell by cell (cubes.c, or tetra.c with
- * g->tetrahedra), refines a vertex on each (lb__refine_edges), triangulates
- * the cell polygons and writes the block's vertices and triangles. */
+ * g->tetrahedra), refines a vertex on each edge the block owns
+ * (lb__refine_edges), takes the others from their owners' near-face tables,
+ * triangulates the cell polygons and writes the block's vertices and
+ * triangles. blocks and nbr (B's next blocks by offset c, as index + 1; 0:
+ * none kept) give the owners, which must be done; bit d of gnext: the grid
+ * has a block after B along axis d. */
 typedef struct lb__bctx lb__bctx;
 LB_INTERNAL lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B,
+                                     const lb__block *blocks, const uint32_t nbr[8], int gnext,
                                      lb__bctx *C, lb_error *err);
 
 /* A thread's extraction state for lb__mesh_block, with its evaluation

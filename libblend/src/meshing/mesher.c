@@ -13,15 +13,16 @@
  * 4. Nodes on a block's far faces are also nodes of the next block: they
  *    take that block's value and gradient, so both sides see the same signs
  *    (the evaluator's per-batch culling may differ in the last bit). Blocks
- *    are taken from the last to the first, so a block's next blocks have
- *    their node values first (one still at work on another thread keeps
- *    the block waiting in its thread's short list: work()).
- * 5. Right after, while its node data is in cache: the block's crossing
- *    edges' vertices (refine.c, octant by octant as in 3) and its cells'
- *    polygons (extract.c with cubes.c, or tetra.c with LB_MESH_TETRAHEDRA).
- * 6. One thread merges the blocks in block order, sharing the vertex of an
- *    edge two blocks both cut (the first block's copy), so the output is the
- *    same for every thread count.
+ *    are taken from the last to the first, so a block's next blocks are
+ *    done first (one still at work on another thread keeps the block
+ *    waiting in its thread's short list: work()).
+ * 5. Right after, while its node data is in cache: the vertices of the
+ *    crossing edges the block owns (refine.c, octant by octant as in 3),
+ *    the vertices on its far faces taken from the next blocks that own
+ *    them, and its cells' polygons (extract.c with cubes.c, or tetra.c with
+ *    LB_MESH_TETRAHEDRA): every vertex is refined once.
+ * 6. The blocks are merged from the last to the first as they are done, so
+ *    the output is the same for every thread count.
  * Threads take blocks from a shared counter; the calling thread works too
  * and is the only one that calls the progress callback. */
 #include "mesh_internal.h"
@@ -259,10 +260,29 @@ static int cmp_block(const void *a, const void *b) {
 /* ---- the blocks' work, in parallel ----
  * Blocks are taken from the last to the first. A block's node values come
  * first; then, once the next blocks (+x, +y, +z and their combinations:
- * taken earlier) have theirs, its far-face nodes take their values
+ * taken earlier) are done, its far-face nodes take their values
  * (block_share) and its surface is extracted at once, while its own node
- * data is still in cache. A block's node data lives in a slot until the
- * last block that reads it is done (refs), and the slot is reused. */
+ * data is still in cache. A block's node data, with its near-face vertex
+ * table, lives in a slot until the last block that reads it is done
+ * (refs), and the slot is reused. */
+
+/* The mesh being merged (merge_block): its arrays' capacities, the table of
+ * orphan vertices (grid edge key, mesh vertex), a block's orphan-to-mesh
+ * map, each merged block's first mesh vertex, and the first failure. */
+typedef struct mkv {
+    uint64_t key, v;
+} mkv;
+
+typedef struct mstate {
+    lb_mesh *M;
+    size_t vcap, tcap;
+    mkv *tab;
+    size_t cap, used;
+    uint32_t *local;
+    uint32_t *base;
+    lb_status s;
+    lb_error err;
+} mstate;
 
 typedef struct run {
     const lb_evaluator *ev;
@@ -288,9 +308,16 @@ typedef struct run {
      * far, and the free ones (at most one per block) */
     unsigned char **all, **free;
     size_t nall, nfree;
-    /* waiting for a next block's node values */
+    /* waiting for a next block to be done: gen counts the blocks done */
     pthread_mutex_t wm;
     pthread_cond_t wc;
+    atomic_ulong gen;
+    /* the merge: blocks whose output is done (fin), how many are merged
+     * (from the last block down), under mlock */
+    atomic_int *fin;
+    pthread_mutex_t mlock;
+    size_t mnext;
+    mstate ms;
 } run;
 
 static lb__block *find_block(run *R, const uint32_t b[3]) {
@@ -377,11 +404,15 @@ static void mark(run *R, lb__block *B, const lb__plan *plan, lb__iv *IV, const u
             }
 }
 
-/* One block's node data in its slot: values, gradients, node and cell
- * marks for the largest block (LB__MB^3 cells). */
+/* One block's node data in its slot: values, gradients, the near-face
+ * table (extract.c), node and cell marks and the table's written bits, for
+ * the largest block (LB__MB^3 cells). */
 #define SLAB_NODES LB__SLAB_NODES
+#define FTAB_OFFSET (SLAB_NODES * 4 * sizeof(double))
+#define MASK_OFFSET (FTAB_OFFSET + LB__FACE_ENTRIES * sizeof(lb__fent))
+#define FVALID_BYTES ((LB__FACE_ENTRIES + 7) / 8)
 #define NODE_BYTES                                                                                 \
-    ((SLAB_NODES * 4 * sizeof(double) + SLAB_NODES + LB__MB * LB__MB * LB__MB + 63) / 64 * 64)
+    ((MASK_OFFSET + SLAB_NODES + LB__MB * LB__MB * LB__MB + FVALID_BYTES + 63) / 64 * 64)
 
 /* A free slot (the most recently freed: still warm), or a new one; NULL
  * when out of memory. */
@@ -403,7 +434,8 @@ static void slot_release(run *R, size_t i) {
     lb__block *B = &R->blocks[i];
     unsigned char *p = (unsigned char *)(void *)B->vals;
     B->vals = B->grads = NULL;
-    B->nmask = B->cmask = NULL;
+    B->nmask = B->cmask = B->fvalid = NULL;
+    B->ftab = NULL;
     if (!p) return;
     pthread_mutex_lock(&R->lock);
     R->free[R->nfree++] = p;
@@ -424,13 +456,16 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
     /* a reused slot was last written about a layer of blocks ago (out of
      * the core's cache): fetch it for writing while mark() runs, instead of
      * stalling on the scattered stores of the node values below */
-    for (size_t off = 0; off < NODE_BYTES; off += 64) __builtin_prefetch(base + off, 1, 3);
+    for (size_t off = 0; off < FTAB_OFFSET; off += 64) __builtin_prefetch(base + off, 1, 3);
     B->vals = (double *)(void *)base;
     B->grads = B->vals + SLAB_NODES;
-    B->nmask = (uint8_t *)(B->grads + 3 * SLAB_NODES);
+    B->ftab = (lb__fent *)(void *)(base + FTAB_OFFSET);
+    B->nmask = base + MASK_OFFSET;
     B->cmask = B->nmask + SLAB_NODES;
+    B->fvalid = B->cmask + LB__MB * LB__MB * LB__MB;
     memset(B->nmask, 0, n);
     memset(B->cmask, 0, (size_t)B->nc[0] * B->nc[1] * B->nc[2]);
+    memset(B->fvalid, 0, FVALID_BYTES);
     lb__boxeval *E = &S->E;
     lb__boxeval_load(ev, &B->plan, E);
     const uint32_t zero[3] = {0, 0, 0};
@@ -557,12 +592,156 @@ static void wake(run *R) {
     pthread_mutex_unlock(&R->wm);
 }
 
-/* Wait until block j's node values are done, or the run stops. */
-static void wait_ready(run *R, size_t j) {
-    if (atomic_load(&R->ready[j])) return;
-    pthread_mutex_lock(&R->wm);
-    while (!atomic_load(&R->ready[j]) && !atomic_load(&R->stop)) pthread_cond_wait(&R->wc, &R->wm);
-    pthread_mutex_unlock(&R->wm);
+/* ---- merge ----
+ * Blocks are merged from the last to the first, each as soon as it and
+ * every block after it is done: its output is still in cache, and its
+ * memory serves the blocks after it instead of fresh pages. A block's own
+ * vertices are appended; a reference (extract.c) names a vertex of a next
+ * block, merged before it, by that block's first mesh vertex plus its
+ * index; orphans are shared by their grid edge key through a hash table
+ * (the first block merged keeps its copy). The order is fixed, so the
+ * output is the same for every thread count. Whoever finishes a block
+ * merges what is ready (try_merge, never waiting for the lock); the calling
+ * thread merges the rest after the workers are joined. */
+
+/* *p (cap elements of size sz) reallocated to c elements when c > cap. */
+static int grow(void **p, size_t cap, size_t c, size_t sz) {
+    if (c <= cap) return 1;
+    void *q = realloc(*p, c * sz);
+    if (!q) return 0;
+    *p = q;
+    return 1;
+}
+
+/* The mesh arrays' first capacity, in bytes: glibc serves an allocation
+ * this large by mmap whatever its dynamic threshold (at most 32 MiB on
+ * 64-bit systems), so the pages not written cost no memory, growing moves
+ * pages (mremap) instead of copying them, and the final shrink is in place.
+ * Growing from small sizes copied (and faulted in) the arrays about twice:
+ * 4.5 % of S2's time at 256 cells. */
+#define FIRST_BYTES ((size_t)32 << 20)
+
+/* A capacity (elements of sz bytes) of at least need, doubling cap. */
+static size_t doubled(size_t cap, size_t need, size_t sz) {
+    size_t c = cap ? cap : FIRST_BYTES / sz;
+    while (c < need) c *= 2;
+    return c;
+}
+
+/* A table of cap (a power of 2) slots for at least n keys, half full at most:
+ * the old entries moved over. */
+static int tab_fit(mstate *S, size_t n) {
+    if (2 * n <= S->cap) return 1;
+    size_t cap = S->cap ? S->cap : 1024;
+    while (cap < 2 * n) cap *= 2;
+    mkv *t = calloc(cap, sizeof *t);
+    if (!t) return 0;
+    for (size_t i = 0; i < S->cap; ++i) {
+        if (!S->tab[i].key) continue;
+        size_t h = (size_t)((S->tab[i].key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
+        while (t[h].key) h = (h + 1) & (cap - 1);
+        t[h] = S->tab[i];
+    }
+    free(S->tab);
+    S->tab = t;
+    S->cap = cap;
+    return 1;
+}
+
+/* Block bi's output appended to the mesh, then freed. 0 on failure (S->s). */
+static int merge_block(mstate *S, lb__block *B, size_t bi) {
+    lb_mesh *M = S->M;
+    const size_t no = B->nv - B->np; /* orphans */
+    if (M->nvertices + B->nv > UINT32_MAX) {
+        S->s = lb__fail(&S->err, LB_ERR_NO_MEMORY,
+                        "%s: more than %u vertices; allowed: fewer (a coarser resolution)", FN,
+                        UINT32_MAX);
+        return 0;
+    }
+    const size_t vc = doubled(S->vcap, M->nvertices + B->nv, 3 * sizeof(double)),
+                 tc = doubled(S->tcap, M->ntriangles + B->nt, 3 * sizeof(uint32_t));
+    const int ok = grow((void **)&M->positions, S->vcap, vc, 3 * sizeof(double)) &&
+                   grow((void **)&M->normals, S->vcap, vc, 3 * sizeof(double)) &&
+                   grow((void **)&M->triangles, S->tcap, tc, 3 * sizeof(uint32_t));
+    if (M->positions && M->normals) S->vcap = vc; /* both grown (or neither needed to) */
+    if (ok) S->tcap = tc;
+    if (!ok || (no && !tab_fit(S, S->used + no))) {
+        S->s = lb__fail(&S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        return 0;
+    }
+    /* the block's own vertices are the mesh's next ones */
+    const size_t base = M->nvertices;
+    S->base[bi] = (uint32_t)base;
+    memcpy(M->positions + 3 * base, B->vpos, 3 * B->np * sizeof(double));
+    memcpy(M->normals + 3 * base, B->vnrm, 3 * B->np * sizeof(double));
+    size_t nv = base + B->np;
+    uint32_t *local = S->local; /* orphan -> mesh vertex */
+    for (size_t i = 0; i < no; ++i) {
+        const uint64_t key = B->okey[i];
+        const size_t cap = S->cap;
+        size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
+        while (S->tab[h].key && S->tab[h].key != key) h = (h + 1) & (cap - 1);
+        if (!S->tab[h].key) {
+            S->tab[h].key = key;
+            S->tab[h].v = nv;
+            ++S->used;
+            memcpy(M->positions + 3 * nv, B->vpos + 3 * (B->np + i), 3 * sizeof(double));
+            memcpy(M->normals + 3 * nv, B->vnrm + 3 * (B->np + i), 3 * sizeof(double));
+            ++nv;
+        }
+        local[i] = (uint32_t)S->tab[h].v;
+    }
+    /* local vertex u: own (u < np), orphan, or a reference to a block merged
+     * before this one */
+    uint32_t *T = M->triangles + 3 * M->ntriangles;
+    const uint32_t np = (uint32_t)B->np, nown = (uint32_t)B->nv;
+    for (size_t t = 0; t < 3 * B->nt; ++t) {
+        const uint32_t u = B->tri[t];
+        if (u < np) {
+            T[t] = (uint32_t)base + u;
+        } else if (u < nown) {
+            T[t] = local[u - np];
+        } else {
+            const uint32_t *r = B->rref + 2 * (u - nown);
+            T[t] = S->base[r[0]] + r[1];
+        }
+    }
+    M->ntriangles += B->nt;
+    M->nvertices = nv;
+    /* merged: the block's copy goes (its memory serves the next blocks) */
+    free(B->okey);
+    free(B->rref);
+    free(B->vpos);
+    free(B->vnrm);
+    free(B->tri);
+    B->okey = NULL;
+    B->rref = NULL;
+    B->vpos = B->vnrm = NULL;
+    B->tri = NULL;
+    return 1;
+}
+
+/* Merge the blocks that are next in order and done, unless another thread
+ * is merging (it will see them, or the final sweep will). */
+static void try_merge(run *R) {
+    mstate *S = &R->ms;
+    for (;;) {
+        if (pthread_mutex_trylock(&R->mlock)) return;
+        while (R->mnext < R->nblocks && !S->s) {
+            const size_t i = R->nblocks - 1 - R->mnext;
+            if (!atomic_load(&R->fin[i])) break;
+            if (!merge_block(S, &R->blocks[i], i)) {
+                atomic_store(&R->stop, 1);
+                wake(R);
+                break;
+            }
+            ++R->mnext;
+        }
+        const int again =
+            !S->s && R->mnext < R->nblocks && atomic_load(&R->fin[R->nblocks - 1 - R->mnext]);
+        pthread_mutex_unlock(&R->mlock);
+        if (!again) return;
+    }
 }
 
 static void fail_block(run *R, size_t i, const lb_error *e) {
@@ -602,26 +781,40 @@ static int start_block(run *R, size_t i, size_t t) {
     return !s;
 }
 
-static int next_ready(run *R, size_t i) {
+/* Are block i's next blocks done (their output and near-face tables)? */
+static int next_done(run *R, size_t i) {
     for (int c = 1; c < 8; ++c)
-        if (R->nbr[i][c] && !atomic_load(&R->ready[R->nbr[i][c] - 1])) return 0;
+        if (R->nbr[i][c] && !atomic_load(&R->fin[R->nbr[i][c] - 1])) return 0;
     return 1;
 }
 
-/* Block i on thread t, once its next blocks' node values are done: its
- * far-face nodes, then its extraction while its node data is in cache. */
+/* Block i on thread t, once its next blocks are done: its far-face nodes,
+ * then its extraction while its node data is in cache (taking the next
+ * blocks' vertices on its far faces from their tables), then the merge of
+ * what is ready. */
 static void finish_block(run *R, size_t i, size_t t) {
     lb_error e = {LB_OK, ""};
     lb__block *B = &R->blocks[i];
     block_share(R, i);
+    int gnext = 0;
+    for (int d = 0; d < 3; ++d) gnext |= (B->b[d] + 1 < R->nb[d]) << d;
+    const int ok = !lb__mesh_block(R->ev, R->g, B, R->blocks, R->nbr[i], gnext, R->ctx[t], &e);
+    if (!ok) fail_block(R, i, &e);
     for (int c = 1; c < 8; ++c)
         if (R->nbr[i][c]) slot_release(R, R->nbr[i][c] - 1);
-    if (lb__mesh_block(R->ev, R->g, B, R->ctx[t], &e)) fail_block(R, i, &e);
     slot_release(R, i);
     lb__cplan_free(&B->plan);
     free(B->octmem);
     B->octmem = NULL;
     atomic_fetch_add(&R->done, 1);
+    if (!ok) return;
+    atomic_store(&R->fin[i], 1);
+    /* a thread waiting for a next block of its own may go on */
+    pthread_mutex_lock(&R->wm);
+    atomic_fetch_add(&R->gen, 1);
+    pthread_cond_broadcast(&R->wc);
+    pthread_mutex_unlock(&R->wm);
+    try_merge(R);
 }
 
 static int stopped(run *R) {
@@ -647,16 +840,19 @@ static size_t take(run *R) {
     return k < R->nblocks ? R->nblocks - 1 - k : SIZE_MAX;
 }
 
-/* Blocks whose node values are done, waiting for their next blocks' (at
- * most this many per thread: each holds a slot). */
+/* Blocks whose node values are done, waiting for their next blocks to be
+ * done (at most this many per thread: each holds a slot). */
 #define PENDING_MAX 4
 
 /* One thread's share of the blocks: take a block and compute its node
- * values; finish every taken block whose next blocks are ready. A thread
+ * values; finish every taken block whose next blocks are done. A thread
  * waits only when PENDING_MAX blocks (or, at the end, all it has left)
- * wait for other threads' node values; every block taken has its node
- * values done before its thread waits, so nothing waits in a cycle. P
- * (the calling thread's only) reports progress and may cancel. */
+ * wait for other threads' blocks. Nothing waits in a cycle: a block waits
+ * only on blocks after it, which were taken before it; the last block not
+ * done has every block after it done, and its thread (which took it, and
+ * computed its node values before waiting) finishes it at its next look,
+ * which the gen count guarantees. P (the calling thread's only) reports
+ * progress and may cancel. */
 static void work(run *R, size_t t, progress *P) {
     size_t pend[PENDING_MAX];
     size_t np = 0;
@@ -672,9 +868,10 @@ static void work(run *R, size_t t, progress *P) {
                 break;
             }
         }
+        const unsigned long gen = atomic_load(&R->gen); /* before looking */
         size_t k = 0;
         for (size_t q = 0; q < np; ++q) {
-            if (next_ready(R, pend[q]))
+            if (next_done(R, pend[q]))
                 finish_block(R, pend[q], t);
             else
                 pend[k++] = pend[q];
@@ -689,9 +886,12 @@ static void work(run *R, size_t t, progress *P) {
             continue;
         }
         if (!np) break;
-        /* every pending block waits on another thread: wait for the oldest */
-        for (int c = 1; c < 8; ++c)
-            if (R->nbr[pend[0]][c]) wait_ready(R, R->nbr[pend[0]][c] - 1);
+        /* every pending block waits on other threads: wait until a block is
+         * done (or the run stops), then look again */
+        pthread_mutex_lock(&R->wm);
+        while (atomic_load(&R->gen) == gen && !atomic_load(&R->stop))
+            pthread_cond_wait(&R->wc, &R->wm);
+        pthread_mutex_unlock(&R->wm);
     }
 }
 
@@ -716,16 +916,20 @@ static lb_status blocks_run(run *R, size_t nt, progress *P) {
     R->nbr = calloc(nbk ? nbk : 1, sizeof *R->nbr);
     R->ready = calloc(nbk ? nbk : 1, sizeof *R->ready);
     R->refs = calloc(nbk ? nbk : 1, sizeof *R->refs);
+    R->fin = calloc(nbk ? nbk : 1, sizeof *R->fin);
+    R->ms.base = malloc((nbk ? nbk : 1) * sizeof *R->ms.base);
     R->all = malloc((nbk ? nbk : 1) * sizeof *R->all);
     R->free = malloc((nbk ? nbk : 1) * sizeof *R->free);
-    if (!R->nbr || !R->ready || !R->refs || !R->all || !R->free) {
+    if (!R->nbr || !R->ready || !R->refs || !R->fin || !R->ms.base || !R->all || !R->free) {
         R->err_block = 0;
         return lb__fail(&R->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     }
     for (size_t i = 0; i < nbk; ++i) {
         atomic_init(&R->ready[i], 0);
         atomic_init(&R->refs[i], 1);
+        atomic_init(&R->fin[i], 0);
     }
+    atomic_init(&R->gen, 0);
     for (size_t i = 0; i < nbk; ++i)
         for (int c = 1; c < 8; ++c) {
             uint32_t ob[3];
@@ -758,86 +962,6 @@ static lb_status blocks_run(run *R, size_t nt, progress *P) {
     P->base += P->weight;
     if (R->cancel && *R->cancel) P->cancelled = 1;
     return R->err_block != SIZE_MAX ? R->err.status : LB_OK;
-}
-
-/* ---- merge ---- */
-
-static lb_status merge(run *R, lb_mesh *M, lb_error *err) {
-    /* only vertices on block faces (key bit 63, extract.c) can be cut by
-     * two blocks: they alone go through the hash table */
-    size_t tv = 0, tt = 0, ts = 0;
-    for (size_t i = 0; i < R->nblocks; ++i) {
-        tv += R->blocks[i].nv;
-        tt += R->blocks[i].nt;
-        for (size_t v = 0; v < R->blocks[i].nv; ++v) ts += R->blocks[i].vkey[v] >> 63;
-    }
-    if (tv > UINT32_MAX)
-        return lb__fail(err, LB_ERR_NO_MEMORY,
-                        "%s: more than %u vertices; allowed: fewer (a coarser resolution)", FN,
-                        UINT32_MAX);
-    size_t cap = 64;
-    while (cap < 2 * ts) cap *= 2;
-    /* key and vertex side by side (one cache line per probe); written once
-     * here, not calloc'ed: a zero page read first and written later faults
-     * twice */
-    struct kv {
-        uint64_t key, v;
-    } *tab = malloc(cap * sizeof *tab);
-    if (tab) memset(tab, 0, cap * sizeof *tab);
-    uint32_t *local = malloc((LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1) * 8 * sizeof *local);
-    M->positions = malloc(3 * (tv ? tv : 1) * sizeof *M->positions);
-    M->normals = malloc(3 * (tv ? tv : 1) * sizeof *M->normals);
-    M->triangles = malloc(3 * (tt ? tt : 1) * sizeof *M->triangles);
-    lb_status s = LB_OK;
-    if (!tab || !local || !M->positions || !M->normals || !M->triangles) {
-        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-        goto done;
-    }
-    size_t nv = 0, nt = 0;
-    for (size_t b = 0; b < R->nblocks; ++b) {
-        lb__block *B = &R->blocks[b];
-        for (size_t i = 0; i < B->nv; ++i) {
-            const uint64_t key = B->vkey[i];
-            if (!(key >> 63)) { /* inside the block: new */
-                memcpy(M->positions + 3 * nv, B->vpos + 3 * i, 3 * sizeof(double));
-                memcpy(M->normals + 3 * nv, B->vnrm + 3 * i, 3 * sizeof(double));
-                local[i] = (uint32_t)nv++;
-                continue;
-            }
-            size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
-            while (tab[h].key && tab[h].key != key) h = (h + 1) & (cap - 1);
-            if (!tab[h].key) {
-                tab[h].key = key;
-                tab[h].v = nv;
-                memcpy(M->positions + 3 * nv, B->vpos + 3 * i, 3 * sizeof(double));
-                memcpy(M->normals + 3 * nv, B->vnrm + 3 * i, 3 * sizeof(double));
-                ++nv;
-            }
-            local[i] = (uint32_t)tab[h].v;
-        }
-        for (size_t t = 0; t < 3 * B->nt; ++t) M->triangles[3 * nt + t] = local[B->tri[t]];
-        nt += B->nt;
-        /* merged: the block's copy goes, so the peak holds one mesh, not two */
-        free(B->vkey);
-        free(B->vpos);
-        free(B->vnrm);
-        free(B->tri);
-        B->vkey = NULL;
-        B->vpos = B->vnrm = NULL;
-        B->tri = NULL;
-    }
-    M->nvertices = nv;
-    M->ntriangles = nt;
-    if (nv) {
-        double *p = realloc(M->positions, 3 * nv * sizeof *p);
-        if (p) M->positions = p;
-        double *q = realloc(M->normals, 3 * nv * sizeof *q);
-        if (q) M->normals = q;
-    }
-done:
-    free(tab);
-    free(local);
-    return s;
 }
 
 /* Estimated bytes per kept block (node values, crossing edges, output). */
@@ -934,29 +1058,56 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     R.blocks = L.b;
     R.nblocks = L.n;
     pthread_mutex_init(&R.lock, NULL);
+    pthread_mutex_init(&R.mlock, NULL);
     size_t nt = opt->threads == 0 ? (size_t)sysconf(_SC_NPROCESSORS_ONLN) : (size_t)opt->threads;
     if (nt < 1) nt = 1;
     if (nt > R.nblocks) nt = R.nblocks ? R.nblocks : 1;
     if (P.fn && P.fn(0.05, P.user)) P.cancelled = 1;
     P.base = 0.05;
     lb_mesh *M = calloc(1, sizeof *M);
+    R.ms.M = M;
+    R.ms.local = malloc(LB__EMAP_SIZE * sizeof *R.ms.local);
     if (nt > 256) nt = 256;
     R.ctx = calloc(nt, sizeof *R.ctx);
     if (R.ctx)
         for (R.nctx = 0; R.nctx < nt; ++R.nctx)
             if (!(R.ctx[R.nctx] = lb__bctx_new(ev))) break;
-    if (!M || !R.ctx || R.nctx < nt) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    if (!M || !R.ms.local || !R.ctx || R.nctx < nt)
+        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     P.weight = 0.90;
     if (!s && !P.cancelled) s = blocks_run(&R, nt, &P);
     if (s && R.err_block != SIZE_MAX && err) *err = R.err;
-    if (!s && !P.cancelled) s = merge(&R, M, err);
+    if (!s && !P.cancelled) {
+        try_merge(&R); /* the blocks no worker merged */
+        s = R.ms.s;
+        if (s && err) *err = R.ms.err;
+        if (!s && R.mnext != R.nblocks) /* cannot happen: every block is done */
+            s = lb__fail(err, LB_ERR_INTERNAL, "%s: %zu blocks not merged", FN,
+                         R.nblocks - R.mnext);
+    }
+    if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
+        M->positions = malloc(3 * sizeof *M->positions);
+        M->normals = malloc(3 * sizeof *M->normals);
+        M->triangles = malloc(3 * sizeof *M->triangles);
+        if (!M->positions || !M->normals || !M->triangles)
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    }
+    if (!s && M->nvertices) { /* the arrays' spare capacity goes */
+        double *p = realloc(M->positions, 3 * M->nvertices * sizeof *p);
+        if (p) M->positions = p;
+        double *q = realloc(M->normals, 3 * M->nvertices * sizeof *q);
+        if (q) M->normals = q;
+        uint32_t *r = realloc(M->triangles, 3 * M->ntriangles * sizeof *r);
+        if (r && M->ntriangles) M->triangles = r;
+    }
     if (!s && P.cancelled) s = lb__fail(err, LB_ERR_CANCELLED, "%s: cancelled by the caller", FN);
     if (!s && P.fn && P.fn(1.0, P.user)) {
         /* cancelling at 100 % is too late to matter: the mesh is done */
     }
     for (size_t i = 0; i < R.nblocks; ++i) {
         lb__block *B = &R.blocks[i];
-        free(B->vkey);
+        free(B->okey);
+        free(B->rref);
         free(B->vpos);
         free(B->vnrm);
         free(B->tri);
@@ -972,7 +1123,12 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     free(R.nbr);
     free(R.ready);
     free(R.refs);
+    free(R.fin);
+    free(R.ms.tab);
+    free(R.ms.base);
+    free(R.ms.local);
     pthread_mutex_destroy(&R.lock);
+    pthread_mutex_destroy(&R.mlock);
     if (s) {
         lb_mesh_free(M);
         return s;
