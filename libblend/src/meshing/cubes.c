@@ -114,6 +114,15 @@ void lb__mctable_init(lb__mctable *t) {
             if (c->nloop < 4) c->len[c->nloop++] = (uint8_t)len; /* at most 4: checked */
             nv += len;
         }
+        for (int l = 0, off = 0; l < c->nloop; off += c->len[l++]) {
+            const int n = c->len[l];
+            for (int a = 0; a < n && n <= LB__MAXPOLY; ++a)
+                for (int b = a + 1; b < n; ++b) {
+                    const int side = b == a + 1 || (a == 0 && b == n - 1);
+                    if (side || !((t->share[c->e[off + a]] >> c->e[off + b]) & 1))
+                        c->ok[l] |= (uint64_t)1 << LB__PAIR(a, b);
+                }
+        }
     }
 }
 
@@ -146,7 +155,7 @@ int lb__cube_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double 
             if (id < 0) return 0;
             v[q] = (uint32_t)id;
         }
-        if (!lb__cell_polygon(C, v, cs->e + off, (uint32_t)n)) return 0;
+        if (!lb__cell_polygon(C, v, cs->ok[l], (uint32_t)n)) return 0;
         off += n;
     }
     return 1;

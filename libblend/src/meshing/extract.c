@@ -31,7 +31,7 @@
 
 typedef struct face {
     uint32_t e[LB__MAXPOLY];
-    uint8_t ce[LB__MAXPOLY]; /* cube edge of each vertex (cubes.c), 0xff: any diagonal */
+    uint64_t ok; /* the vertex pairs a triangle may join (LB__PAIR bits) */
     uint32_t n;
 } face;
 
@@ -168,15 +168,12 @@ const lb__grid *lb__cell_grid(const lb__bctx *C) {
     return C->g;
 }
 
-int lb__cell_polygon(lb__bctx *C, const uint32_t *e, const uint8_t *ce, uint32_t n) {
+int lb__cell_polygon(lb__bctx *C, const uint32_t *e, uint64_t ok, uint32_t n) {
     if (C->nf >= FACE_MAX) return 0; /* cannot happen (FACE_MAX above) */
     face *f = &C->faces[C->nf++];
     f->n = n;
+    f->ok = ok;
     memcpy(f->e, e, n * sizeof *e);
-    if (ce)
-        memcpy(f->ce, ce, n);
-    else
-        memset(f->ce, 0xff, n);
     return 1;
 }
 
@@ -203,7 +200,7 @@ static inline double worst_cos(double l0, double l1, double l2) {
  * smallest angle; ties keep the later split). Every polygon a cell method
  * emits has an allowed triangulation (cubes.c checks its table); a
  * tetrahedron's quadrilateral allows both diagonals. */
-static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g, uint32_t *T) {
+static uint32_t *triangulate(const face *f, const double *pos, uint32_t *T) {
     const uint32_t n = f->n;
     if (n == 3) {
         T[0] = f->e[0];
@@ -211,22 +208,46 @@ static uint32_t *triangulate(const face *f, const double *pos, const lb__grid *g
         T[2] = f->e[2];
         return T + 3;
     }
+    /* squared lengths of the sides and the allowed diagonals */
     double W[LB__MAXPOLY][LB__MAXPOLY], L[LB__MAXPOLY][LB__MAXPOLY];
     uint8_t ok[LB__MAXPOLY][LB__MAXPOLY], K[LB__MAXPOLY][LB__MAXPOLY];
     for (uint32_t a = 0; a < n; ++a)
         for (uint32_t b = a + 1; b < n; ++b) {
-            const int edge = b == a + 1 || (a == 0 && b == n - 1);
-            ok[a][b] = (uint8_t)(edge || f->ce[a] == 0xff ||
-                                 !lb__cube_edges_share_face(g, f->ce[a], f->ce[b]));
-            /* squared lengths of the sides and diagonals a triangle may use */
+            ok[a][b] = (uint8_t)((f->ok >> LB__PAIR(a, b)) & 1);
+            if (!ok[a][b]) continue;
             const double *A = pos + 3 * f->e[a], *B = pos + 3 * f->e[b];
             const double d[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
             L[a][b] = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
         }
+    if (n == 4) { /* the loop below for a quadrilateral: the same choice and order */
+        double best = INFINITY;
+        int k = 1;
+        if (ok[0][2]) { /* triangles 0 2 3 and 0 1 2 */
+            double w = worst_cos(L[0][2], L[2][3], L[0][3]);
+            const double w2 = worst_cos(L[0][1], L[1][2], L[0][2]);
+            if (w2 > w) w = w2;
+            if (w < best) {
+                best = w;
+                k = 2;
+            }
+        }
+        if (ok[1][3]) { /* triangles 0 1 3 and 1 2 3 */
+            double w = worst_cos(L[0][1], L[1][3], L[0][3]);
+            const double w2 = worst_cos(L[1][2], L[2][3], L[1][3]);
+            if (w2 > w) w = w2;
+            if (w < best) k = 1;
+        }
+        const uint32_t *e = f->e;
+        const uint32_t t2[6] = {e[0], e[2], e[3], e[0], e[1], e[2]},
+                       t1[6] = {e[0], e[1], e[3], e[1], e[2], e[3]};
+        memcpy(T, k == 2 ? t2 : t1, sizeof t2);
+        return T + 6;
+    }
     for (uint32_t len = 2; len < n; ++len)
         for (uint32_t a = 0; a + len < n; ++a) {
             const uint32_t b = a + len;
-            double best = INFINITY; /* the largest smallest-angle cosine: lower is better */
+            if (!ok[a][b]) continue; /* never a side of a triangle: W, K unused */
+            double best = INFINITY;  /* the largest smallest-angle cosine: lower is better */
             uint8_t bk = (uint8_t)(a + 1);
             for (uint32_t k = b - 1; k > a; --k) {
                 if (!ok[a][k] || !ok[k][b]) continue;
@@ -453,7 +474,7 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
             }
         }
         uint32_t *T = B->tri;
-        for (size_t f = 0; f < C->nf; ++f) T = triangulate(&C->faces[f], B->vpos, g, T);
+        for (size_t f = 0; f < C->nf; ++f) T = triangulate(&C->faces[f], B->vpos, T);
         B->nt = nt;
     }
 done:

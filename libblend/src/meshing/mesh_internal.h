@@ -36,7 +36,16 @@ typedef struct lb__mccase {
     uint8_t nloop;
     uint8_t len[4];
     uint8_t e[12];
+    /* per loop, the vertex pairs a < b a triangle may join (bit
+     * LB__PAIR(a, b)): the loop's sides, and the diagonals whose two cube
+     * edges lie on no common face of the cell */
+    uint64_t ok[4];
 } lb__mccase;
+
+/* The bit of vertex pair (a, b), a < b, of a polygon (lb__mccase.ok). */
+#define LB__PAIR(a, b) ((a)*LB__MAXPOLY + (b))
+/* Every pair allowed (a tetrahedron's polygons). */
+#define LB__ALL_PAIRS (~(uint64_t)0)
 
 typedef struct lb__mctable {
     lb__mccase c[256];
@@ -211,10 +220,10 @@ LB_INTERNAL int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t 
                                   const double *c);
 
 /* Add a polygon of n (3..LB__MAXPOLY) vertices (indices from lb__cell_edge),
- * counter-clockwise seen from outside; ce[i] is vertex i's cube edge (0..11)
- * when diagonals on the cell's faces must be avoided, or NULL. 0 when out of
- * memory. */
-LB_INTERNAL int lb__cell_polygon(lb__bctx *C, const uint32_t *e, const uint8_t *ce, uint32_t n);
+ * counter-clockwise seen from outside; ok holds the vertex pairs its
+ * triangles may join (LB__PAIR bits; LB__ALL_PAIRS: any diagonal). 0 when
+ * out of memory. */
+LB_INTERNAL int lb__cell_polygon(lb__bctx *C, const uint32_t *e, uint64_t ok, uint32_t n);
 
 /* One cell (i, j, k) with corner values c (some inside, some outside; bit o
  * of cfg set: corner o inside): its polygons, by the cube cases or by the
@@ -234,9 +243,5 @@ LB_INTERNAL void lb__cube_edge(int e, int *p, int *q);
  * with a triangulation off the cell's faces (the manifold argument in
  * cubes.c needs it), else 0. */
 LB_INTERNAL int lb__mctable_check(const lb__mctable *t);
-
-static inline int lb__cube_edges_share_face(const lb__grid *g, int a, int b) {
-    return (g->mc.share[a] >> b) & 1;
-}
 
 #endif

@@ -102,7 +102,7 @@ int lb__tetra_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double
             if (id < 0) return 0;
             e[q] = (uint32_t)id;
         }
-        if (!lb__cell_polygon(C, e, NULL, (uint32_t)ne)) return 0;
+        if (!lb__cell_polygon(C, e, LB__ALL_PAIRS, (uint32_t)ne)) return 0;
     }
     return 1;
 }
