@@ -53,19 +53,12 @@ typedef struct face {
 #define REF 0x80000000u
 
 struct lb__bctx {
+    lb__bctx_head h; /* first: the edge map (mesh_internal.h) */
     const lb__grid *g;
     lb__block *B;
     const lb__block *blocks; /* the run's blocks, B's next blocks (index + 1) */
     const uint32_t *nbr;
-    int gnext; /* bit d: the grid has a block after B along d */
-    /* local edge id -> vertex index (e, REF for a reference), valid where
-     * the entry's stamp is the block's: side by side, one cache line per
-     * lookup */
-    struct emap {
-        uint32_t stamp;
-        uint32_t e;
-    } * emap;
-    uint32_t stamp;
+    int gnext;                 /* bit d: the grid has a block after B along d */
     size_t ne;                 /* own crossing edges so far (< EMAP_SIZE) */
     double *ea, *eb, *pa, *pb; /* inside end, outside end, their phi */
     double *ga, *gb;           /* and their gradients */
@@ -95,15 +88,14 @@ static inline size_t face_entry(int d, const uint32_t l[3], int mask) {
     return ((size_t)d * LB__FACE_NODES + l[d1] * (LB__MB + 1) + l[d2]) * 3 + (size_t)m;
 }
 
-int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, int oq,
-                      const double *c) {
+int64_t lb__cell_edge_new(lb__bctx *C, size_t lid, uint32_t i, uint32_t j, uint32_t k, int op,
+                          int oq, const double *c) {
     const lb__block *B = C->B;
-    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    const uint32_t D0 = C->h.D0, D1 = C->h.D1;
     const uint32_t li = i + (op & 1), lj = j + ((op >> 1) & 1), lk = k + ((op >> 2) & 1);
     const int mask = op ^ oq;
-    const size_t lid = ((size_t)(lk * D1 + lj) * D0 + li) * 8 + (size_t)mask;
-    if (C->emap[lid].stamp == C->stamp) return C->emap[lid].e;
-    C->emap[lid].stamp = C->stamp;
+    lb__emap_entry *em = &C->h.emap[lid];
+    em->stamp = C->h.stamp;
     /* on B's far face along the axes in far (and a next block exists
      * there): the next block at offset far owns the edge */
     const uint32_t loc[3] = {li, lj, lk};
@@ -123,7 +115,7 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
                 C->ref[2 * r] = o - 1;
                 C->ref[2 * r + 1] = O->ftab[fe].idx;
                 memcpy(C->rpos + 3 * r, O->ftab[fe].pos, 3 * sizeof(double));
-                C->emap[lid].e = REF | (uint32_t)r;
+                em->e = REF | (uint32_t)r;
                 return (int64_t)(REF | (uint32_t)r);
             }
         }
@@ -160,7 +152,7 @@ int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, i
         C->key[e] = lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask;
         ++C->norph;
     }
-    C->emap[lid].e = (uint32_t)e;
+    em->e = (uint32_t)e;
     return (int64_t)e;
 }
 
@@ -194,6 +186,43 @@ static inline double worst_cos(double l0, double l1, double l2) {
     return den > 0.0 ? (u + v - s) / (2.0 * den) : 1.0;
 }
 
+static inline double dist2(const double *A, const double *B) {
+    const double d[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
+    return d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+}
+
+/* triangulate's dynamic programme for a quadrilateral, written out: the
+ * same choice (the later split on a tie) and the same triangle order. */
+static uint32_t *triangulate4(const face *f, const double *pos, uint32_t *T) {
+    const uint32_t *e = f->e;
+    const double *P0 = pos + 3 * e[0], *P1 = pos + 3 * e[1], *P2 = pos + 3 * e[2],
+                 *P3 = pos + 3 * e[3];
+    const double L01 = dist2(P0, P1), L12 = dist2(P1, P2), L23 = dist2(P2, P3), L03 = dist2(P0, P3);
+    double best = INFINITY;
+    int k = 1;
+    if ((f->ok >> LB__PAIR(0, 2)) & 1) { /* triangles 0 2 3 and 0 1 2 */
+        const double L02 = dist2(P0, P2);
+        double w = worst_cos(L02, L23, L03);
+        const double w2 = worst_cos(L01, L12, L02);
+        if (w2 > w) w = w2;
+        if (w < best) {
+            best = w;
+            k = 2;
+        }
+    }
+    if ((f->ok >> LB__PAIR(1, 3)) & 1) { /* triangles 0 1 3 and 1 2 3 */
+        const double L13 = dist2(P1, P3);
+        double w = worst_cos(L01, L13, L03);
+        const double w2 = worst_cos(L12, L23, L13);
+        if (w2 > w) w = w2;
+        if (w < best) k = 1;
+    }
+    const uint32_t t2[6] = {e[0], e[2], e[3], e[0], e[1], e[2]},
+                   t1[6] = {e[0], e[1], e[3], e[1], e[2], e[3]};
+    memcpy(T, k == 2 ? t2 : t1, sizeof t2);
+    return T + 6;
+}
+
 /* Cut polygon f (vertices placed in pos) into f->n - 2 triangles along the
  * allowed diagonals, choosing the triangulation whose smallest angle is
  * largest (dynamic programming over sub-polygons on the cosine of the
@@ -208,6 +237,7 @@ static uint32_t *triangulate(const face *f, const double *pos, uint32_t *T) {
         T[2] = f->e[2];
         return T + 3;
     }
+    if (n == 4) return triangulate4(f, pos, T);
     /* squared lengths of the sides and the allowed diagonals */
     double W[LB__MAXPOLY][LB__MAXPOLY], L[LB__MAXPOLY][LB__MAXPOLY];
     uint8_t ok[LB__MAXPOLY][LB__MAXPOLY], K[LB__MAXPOLY][LB__MAXPOLY];
@@ -215,34 +245,8 @@ static uint32_t *triangulate(const face *f, const double *pos, uint32_t *T) {
         for (uint32_t b = a + 1; b < n; ++b) {
             ok[a][b] = (uint8_t)((f->ok >> LB__PAIR(a, b)) & 1);
             if (!ok[a][b]) continue;
-            const double *A = pos + 3 * f->e[a], *B = pos + 3 * f->e[b];
-            const double d[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]};
-            L[a][b] = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            L[a][b] = dist2(pos + 3 * f->e[a], pos + 3 * f->e[b]);
         }
-    if (n == 4) { /* the loop below for a quadrilateral: the same choice and order */
-        double best = INFINITY;
-        int k = 1;
-        if (ok[0][2]) { /* triangles 0 2 3 and 0 1 2 */
-            double w = worst_cos(L[0][2], L[2][3], L[0][3]);
-            const double w2 = worst_cos(L[0][1], L[1][2], L[0][2]);
-            if (w2 > w) w = w2;
-            if (w < best) {
-                best = w;
-                k = 2;
-            }
-        }
-        if (ok[1][3]) { /* triangles 0 1 3 and 1 2 3 */
-            double w = worst_cos(L[0][1], L[1][3], L[0][3]);
-            const double w2 = worst_cos(L[1][2], L[2][3], L[1][3]);
-            if (w2 > w) w = w2;
-            if (w < best) k = 1;
-        }
-        const uint32_t *e = f->e;
-        const uint32_t t2[6] = {e[0], e[2], e[3], e[0], e[1], e[2]},
-                       t1[6] = {e[0], e[1], e[3], e[1], e[2], e[3]};
-        memcpy(T, k == 2 ? t2 : t1, sizeof t2);
-        return T + 6;
-    }
     for (uint32_t len = 2; len < n; ++len)
         for (uint32_t a = 0; a + len < n; ++a) {
             const uint32_t b = a + len;
@@ -286,7 +290,7 @@ static uint32_t *triangulate(const face *f, const double *pos, uint32_t *T) {
 lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     lb__bctx *C = calloc(1, sizeof *C);
     if (!C) return NULL;
-    C->emap = calloc(EMAP_SIZE, sizeof *C->emap);
+    C->h.emap = calloc(EMAP_SIZE, sizeof *C->h.emap);
     C->ea = malloc(3 * EMAP_SIZE * sizeof *C->ea);
     C->eb = malloc(3 * EMAP_SIZE * sizeof *C->eb);
     C->ga = malloc(3 * EMAP_SIZE * sizeof *C->ga);
@@ -310,7 +314,7 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     S->nidx = malloc(LB__SLAB_NODES * sizeof *S->nidx);
     S->edges = malloc(10 * EMAP_SIZE * sizeof *S->edges);
     S->eact = malloc(EMAP_SIZE * sizeof *S->eact);
-    if (!ok || !C->emap || !C->ea || !C->eb || !C->ga || !C->gb || !C->pa || !C->pb || !C->key ||
+    if (!ok || !C->h.emap || !C->ea || !C->eb || !C->ga || !C->gb || !C->pa || !C->pb || !C->key ||
         !C->eloc || !C->orph || !C->ref || !C->rpos || !C->perm || !C->faces || !S->nodes ||
         !S->nidx || !S->edges || !S->eact) {
         lb__bctx_free(C);
@@ -321,7 +325,7 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
 
 void lb__bctx_free(lb__bctx *C) {
     if (!C) return;
-    free(C->emap);
+    free(C->h.emap);
     free(C->ea);
     free(C->eb);
     free(C->pa);
@@ -407,11 +411,13 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
     C->nbr = nbr;
     C->gnext = gnext;
     C->ne = C->nf = C->nref = C->norph = 0;
-    if (++C->stamp == 0) { /* wrapped: clear the stamps once */
-        memset(C->emap, 0, EMAP_SIZE * sizeof *C->emap);
-        C->stamp = 1;
+    if (++C->h.stamp == 0) { /* wrapped: clear the stamps once */
+        memset(C->h.emap, 0, EMAP_SIZE * sizeof *C->h.emap);
+        C->h.stamp = 1;
     }
     const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    C->h.D0 = D0;
+    C->h.D1 = D1;
     lb_status s = LB_OK;
     for (uint32_t k = 0; k < B->nc[2]; ++k)
         for (uint32_t j = 0; j < B->nc[1]; ++j) {

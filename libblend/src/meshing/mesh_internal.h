@@ -213,11 +213,35 @@ LB_INTERNAL lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g
 
 /* ---- the cell methods' side of extract.c */
 
+/* The head of a thread's extraction state (lb__bctx's first member,
+ * extract.c), read inline by the cell methods: the block's edge map (local
+ * edge id -> vertex index, valid where the entry's stamp is the block's;
+ * side by side, one cache line per lookup) and its node strides. */
+typedef struct lb__emap_entry {
+    uint32_t stamp, e;
+} lb__emap_entry;
+
+typedef struct lb__bctx_head {
+    lb__emap_entry *emap;
+    uint32_t stamp;
+    uint32_t D0, D1; /* the block's nodes along x, along y */
+} lb__bctx_head;
+
+/* The edge's vertex when the edge map has it, else lb__cell_edge_new's. */
+LB_INTERNAL int64_t lb__cell_edge_new(lb__bctx *C, size_t lid, uint32_t i, uint32_t j, uint32_t k,
+                                      int op, int oq, const double *c);
+
 /* The vertex on the crossing edge between corners op and oq (op a subset of
  * oq) of cell (i, j, k) of the block, c its 8 corner values: its index in the
- * block, created on first use; -1 when out of memory. */
-LB_INTERNAL int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, int oq,
-                                  const double *c);
+ * block, created on first use (lb__cell_edge_new); -1 when out of memory. */
+static inline int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, int op, int oq,
+                                    const double *c) {
+    const lb__bctx_head *H = (const lb__bctx_head *)(const void *)C;
+    const uint32_t li = i + (op & 1), lj = j + ((op >> 1) & 1), lk = k + ((op >> 2) & 1);
+    const size_t lid = ((size_t)(lk * H->D1 + lj) * H->D0 + li) * 8 + (size_t)(op ^ oq);
+    if (H->emap[lid].stamp == H->stamp) return H->emap[lid].e;
+    return lb__cell_edge_new(C, lid, i, j, k, op, oq, c);
+}
 
 /* Add a polygon of n (3..LB__MAXPOLY) vertices (indices from lb__cell_edge),
  * counter-clockwise seen from outside; ok holds the vertex pairs its
