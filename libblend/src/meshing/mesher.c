@@ -672,8 +672,10 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     /* the block's own vertices are the mesh's next ones */
     const size_t base = M->nvertices;
     S->base[bi] = (uint32_t)base;
-    memcpy(M->positions + 3 * base, B->vpos, 3 * B->np * sizeof(double));
-    memcpy(M->normals + 3 * base, B->vnrm, 3 * B->np * sizeof(double));
+    if (B->np) { /* a block may have no vertex (and no arrays) */
+        memcpy(M->positions + 3 * base, B->vpos, 3 * B->np * sizeof(double));
+        memcpy(M->normals + 3 * base, B->vnrm, 3 * B->np * sizeof(double));
+    }
     size_t nv = base + B->np;
     uint32_t *local = S->local; /* orphan -> mesh vertex */
     for (size_t i = 0; i < no; ++i) {
