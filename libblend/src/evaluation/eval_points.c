@@ -18,9 +18,10 @@
 /* The coordinates and the four output columns never overlap (points and
  * registers are separate arrays): restrict lets the loop be vectorised
  * without a run-time check per pair. */
-static void run_ellipsoid(const lb__instr *in, size_t n, const double *restrict x,
-                          const double *restrict y, const double *restrict z, double *restrict v,
-                          double *restrict gx, double *restrict gy, double *restrict gz) {
+LB_VECTOR_CLONES static void run_ellipsoid(const lb__instr *in, size_t n, const double *restrict x,
+                                           const double *restrict y, const double *restrict z,
+                                           double *restrict v, double *restrict gx,
+                                           double *restrict gy, double *restrict gz) {
     const double c0 = in->prim.c[0], c1 = in->prim.c[1], c2 = in->prim.c[2];
     /* reciprocals once per chunk: one division per point (1/f), and a
      * branch-free body the compiler vectorises */
@@ -81,9 +82,10 @@ LB__INLINE void prim_loop(lb_primitive_kind kind, const lb__instr *in, size_t n,
 /* Zero-convention slab or half-space: |n . (M X + t - c)| / w - 1 is one
  * affine function of X, a . X + b, so the map and 1/w fold into a and b once
  * per chunk and the loop is branch-free (the compiler vectorises it). */
-static void run_plane(const lb__instr *in, size_t n, const double *restrict x,
-                      const double *restrict y, const double *restrict z, double *restrict v,
-                      double *restrict gx, double *restrict gy, double *restrict gz) {
+LB_VECTOR_CLONES static void run_plane(const lb__instr *in, size_t n, const double *restrict x,
+                                       const double *restrict y, const double *restrict z,
+                                       double *restrict v, double *restrict gx, double *restrict gy,
+                                       double *restrict gz) {
     const lb_primitive *P = &in->prim;
     const double iw = 1.0 / P->s0, *M = in->A.M, *t = in->A.t;
     double a[3], b = 0.0;
@@ -265,9 +267,10 @@ static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n
                            const double *y, const double *z, const double *dg, double *G,
                            size_t *count, lb_error *err);
 
-static lb_status run_op(const lb_evaluator *ev, const lb__instr *in, const lb__plan *plan, size_t n,
-                        const double *px, const double *py, const double *pz, double *regs,
-                        size_t *count, lb_error *err) {
+LB_VECTOR_CLONES static lb_status run_op(const lb_evaluator *ev, const lb__instr *in,
+                                         const lb__plan *plan, size_t n, const double *px,
+                                         const double *py, const double *pz, double *regs,
+                                         size_t *count, lb_error *err) {
     const lb__node *nd = &in->op;
     if (nd->family == LB__F_LOCAL || nd->family == LB__F_CLEAN)
         return lb__local_run(ev, in, n, px, py, pz, regs, err);
