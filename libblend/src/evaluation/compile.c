@@ -294,6 +294,7 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
             lb__affine_identity(&in->A);
             in->identity = 1;
             in->code = LB__I_ELLIPSOID;
+            for (int i = 0; i < 3; ++i) in->ia[i] = 1.0 / in->prim.a[i];
         }
     } else {
         int fail = 0;

@@ -34,11 +34,14 @@ static iv prim_bounds(const lb__instr *in, const double bc[3], const double br[3
     const lb_primitive *P = &in->prim;
     if (in->code == LB__I_ELLIPSOID) {
         /* zero-convention ellipsoid in world axes: nearest and farthest
-         * points of the box, inline (the common case: spheres) */
+         * points of the box, inline (the common case: spheres); times the
+         * reciprocal semi-axes (a relative error of an ulp or two, far
+         * inside the 1e-12 widening below) instead of six divisions */
         double sn = 0.0, sf = 0.0;
         for (int i = 0; i < 3; ++i) {
             const double d = fabs(bc[i] - P->c[i]);
-            const double dn = (d > br[i] ? d - br[i] : 0.0) / P->a[i], df = (d + br[i]) / P->a[i];
+            const double dn = (d > br[i] ? d - br[i] : 0.0) * in->ia[i],
+                         df = (d + br[i]) * in->ia[i];
             sn += dn * dn;
             sf += df * df;
         }

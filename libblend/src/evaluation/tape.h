@@ -47,6 +47,7 @@ typedef struct lb__instr {
     int fast;                  /* LB__FAST_* */
     int mode;                  /* exponent mode for the fast kernels */
     double lip;                /* primitives: Lipschitz factor of rho in the primitive frame */
+    double ia[3];              /* LB__I_ELLIPSOID: the reciprocals of its semi-axes */
     size_t aoff;               /* operators: offset of this instruction's slots in a plan's act */
 } lb__instr;
 
