@@ -217,9 +217,13 @@ static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxe
                 hi[i] = t[i];
             const int done = fabs(ph) <= tol * gl || (hi[i] - lo[i]) <= 1e-12 || last;
             if (done) {
+                /* one division for the normal (and its length within an ulp
+                 * or two of 1) */
+                const double in = gl > 0.0 ? 1.0 / gl : 1.0 / L;
+                const double *src = gl > 0.0 ? gp : e;
                 for (int d = 0; d < 3; ++d) {
                     pos[3 * i + d] = X[d];
-                    nrm[3 * i + d] = gl > 0.0 ? gp[d] / gl : e[d] / L;
+                    nrm[3 * i + d] = src[d] * in;
                 }
                 continue;
             }
@@ -265,7 +269,7 @@ static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxe
                     0.5 * M * step * step <= 0.01 * tol * fabs(sh)) {
                     for (int d = 0; d < 3; ++d) {
                         pos[3 * i + d] = A[d] + tn * e[d];
-                        nrm[3 * i + d] = gp[d] / gl;
+                        nrm[3 * i + d] = gp[d] * igl;
                     }
                     continue;
                 }
