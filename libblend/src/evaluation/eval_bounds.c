@@ -15,6 +15,7 @@
  *   with the ranges at their extremes.
  * Every operator bound is widened by 1e-9 (1 + |v|) for the solvers'
  * tolerance, and clamped to [-1e100, 1e100] (the core's argument range). */
+#include "../operators/bt_two.h"
 #include "tape.h"
 
 #include <stdlib.h>
@@ -268,6 +269,13 @@ static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, s
     if (na == 1) {
         v1 = lo[0] / m[0];
         v2 = hi[0] / m[0];
+    } else if (in->fast == LB__FAST_DISPLACEMENT && in->mode == LB__P_TWO) {
+        /* lb__bt_union_ws's p = 2 path, the reciprocals of r and m taken
+         * once for both ends (the same bits) */
+        double *ir = ws, *im = ws + na;
+        lb__bt_recip(na, r, m, ir, im);
+        v1 = lb__bt_two_union_recip(na, lo, r, m, ir, im, NULL, ws + 2 * na);
+        v2 = lb__bt_two_union_recip(na, hi, r, m, ir, im, NULL, ws + 2 * na);
     } else if (in->fast == LB__FAST_DISPLACEMENT) {
         v1 = lb__bt_union_ws(na, lo, r, p, m, in->mode, NULL, NULL, NULL, ws);
         v2 = lb__bt_union_ws(na, hi, r, p, m, in->mode, NULL, NULL, NULL, ws);
