@@ -46,6 +46,12 @@ static inline void lb__bt_setup(size_t k, const double *x, const double *r, cons
     lb__bt_setup_recip(k, x, r, im, b, lo, hi, argmin);
 }
 
+/* v / m: v itself when m is 1 (the default slope), the same bits without
+ * the division, which the non-blending region below takes twice per point. */
+static inline double lb__over_m(double v, double m) {
+    return m == 1.0 ? v : v / m;
+}
+
 /* Non-blending region: no argument but the argmin j is within its range at
  * h = x_j/m_j (every other breakpoint b_i >= hi). Then BT = x_j/m_j exactly. */
 static inline int lb__bt_alone(size_t k, const double *x, const double *m, const double *b,
@@ -53,7 +59,7 @@ static inline int lb__bt_alone(size_t k, const double *x, const double *m, const
     for (size_t i = 0; i < k; ++i)
         if (i != j && b[i] < hi) return 0;
     for (size_t i = 0; i < k; ++i) {
-        if (dx) dx[i] = i == j ? 1.0 / m[j] : 0.0;
+        if (dx) dx[i] = i == j ? lb__over_m(1.0, m[j]) : 0.0;
         if (dr) dr[i] = 0.0;
         if (dm) dm[i] = i == j ? -x[j] / (m[j] * m[j]) : 0.0;
     }
@@ -153,7 +159,7 @@ static inline double lb__bt_two_union_ws(size_t k, const double *x, const double
     double lo, hi;
     size_t j;
     lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
-    if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
+    if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return lb__over_m(x[j], m[j]);
     const double h = lb__bt_two(k, b, m, ir, lo, hi);
     lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, w, dx, dr, dm);
     return h;
@@ -176,7 +182,7 @@ static inline double lb__bt_two_union_recip(size_t k, const double *x, const dou
     double lo, hi;
     size_t j;
     lb__bt_setup_recip(k, x, r, im, b, &lo, &hi, &j);
-    if (lb__bt_alone(k, x, m, b, hi, j, dx, NULL, NULL)) return x[j] / m[j];
+    if (lb__bt_alone(k, x, m, b, hi, j, dx, NULL, NULL)) return lb__over_m(x[j], m[j]);
     const double h = lb__bt_two(k, b, m, ir, lo, hi);
     lb__bt_grads(k, x, r, NULL, m, ir, LB__P_INTEGER, h, j, NULL, w, dx, NULL, NULL);
     return h;

@@ -64,7 +64,7 @@ static double bt_newton_ws(size_t k, const double *x, const double *r, const dou
     double lo, hi;
     size_t j;
     lb__bt_setup(k, x, r, m, ir, im, b, &lo, &hi, &j);
-    if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return x[j] / m[j];
+    if (lb__bt_alone(k, x, m, b, hi, j, dx, dr, dm)) return lb__over_m(x[j], m[j]);
     bt_ctx ctx = {k, x, r, p, m, ir, im, mode == LB__P_TWO ? LB__P_INTEGER : mode, w, NAN};
     const double h = lb__root_solve(bt_T, &ctx, lo, hi, hi);
     /* w at h: the last evaluation's, moved to h to first order when the solver
