@@ -308,7 +308,8 @@ typedef struct run {
      * far, and the free ones (at most one per block) */
     unsigned char **all, **free;
     size_t nall, nfree;
-    /* waiting for a next block to be done: gen counts the blocks done */
+    /* waiting for a next block to be done: gen counts the wake-ups (a
+     * block done, a stop) */
     pthread_mutex_t wm;
     pthread_cond_t wc;
     atomic_ulong gen;
@@ -585,9 +586,11 @@ static void block_share(run *R, size_t bi) {
     }
 }
 
-/* Wake the blocks waiting for a next block's node values (or for stop). */
+/* Wake the threads waiting for a next block to be done (or for stop): a new
+ * generation, under the lock the waiters check it with. */
 static void wake(run *R) {
     pthread_mutex_lock(&R->wm);
+    atomic_fetch_add(&R->gen, 1);
     pthread_cond_broadcast(&R->wc);
     pthread_mutex_unlock(&R->wm);
 }
@@ -628,6 +631,12 @@ static size_t doubled(size_t cap, size_t need, size_t sz) {
     return c;
 }
 
+/* The home slot of an orphan's key in a table of cap (a power of 2) slots;
+ * collisions go on to the next slots. */
+static size_t tab_slot(uint64_t key, size_t cap) {
+    return (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
+}
+
 /* A table of cap (a power of 2) slots for at least n keys, half full at most:
  * the old entries moved over. */
 static int tab_fit(mstate *S, size_t n) {
@@ -638,7 +647,7 @@ static int tab_fit(mstate *S, size_t n) {
     if (!t) return 0;
     for (size_t i = 0; i < S->cap; ++i) {
         if (!S->tab[i].key) continue;
-        size_t h = (size_t)((S->tab[i].key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
+        size_t h = tab_slot(S->tab[i].key, cap);
         while (t[h].key) h = (h + 1) & (cap - 1);
         t[h] = S->tab[i];
     }
@@ -681,7 +690,7 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     for (size_t i = 0; i < no; ++i) {
         const uint64_t key = B->okey[i];
         const size_t cap = S->cap;
-        size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 20) & (cap - 1);
+        size_t h = tab_slot(key, cap);
         while (S->tab[h].key && S->tab[h].key != key) h = (h + 1) & (cap - 1);
         if (!S->tab[h].key) {
             S->tab[h].key = key;
@@ -812,10 +821,7 @@ static void finish_block(run *R, size_t i, size_t t) {
     if (!ok) return;
     atomic_store(&R->fin[i], 1);
     /* a thread waiting for a next block of its own may go on */
-    pthread_mutex_lock(&R->wm);
-    atomic_fetch_add(&R->gen, 1);
-    pthread_cond_broadcast(&R->wc);
-    pthread_mutex_unlock(&R->wm);
+    wake(R);
     try_merge(R);
 }
 
@@ -1095,12 +1101,14 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
             s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     }
     if (!s && M->nvertices) { /* the arrays' spare capacity goes */
-        double *p = realloc(M->positions, 3 * M->nvertices * sizeof *p);
+        /* never to 0 bytes: realloc(p, 0) may free p and return NULL */
+        const size_t nv = M->nvertices, nt = M->ntriangles ? M->ntriangles : 1;
+        double *p = realloc(M->positions, 3 * nv * sizeof *p);
         if (p) M->positions = p;
-        double *q = realloc(M->normals, 3 * M->nvertices * sizeof *q);
+        double *q = realloc(M->normals, 3 * nv * sizeof *q);
         if (q) M->normals = q;
-        uint32_t *r = realloc(M->triangles, 3 * M->ntriangles * sizeof *r);
-        if (r && M->ntriangles) M->triangles = r;
+        uint32_t *r = realloc(M->triangles, 3 * nt * sizeof *r);
+        if (r) M->triangles = r;
     }
     if (!s && P.cancelled) s = lb__fail(err, LB_ERR_CANCELLED, "%s: cancelled by the caller", FN);
     if (!s && P.fn && P.fn(1.0, P.user)) {
