@@ -268,6 +268,39 @@ static void test_independent_formulas(void **state) {
 
 /* Shared defs stay shared: a def used twice under the same transform is one
  * set of instructions; under a different transform it is a second copy. */
+/* Scenes an issue found wrong (tests/data/regressions/): a def given as two
+ * arguments of one operator released its register twice, so two live values
+ * shared it and the tape disagreed with the recursive walk (and meshes were
+ * open). The tape must equal the walk at random points, and the point-box
+ * bounds must contain the walk's value. */
+static void test_regressions_match_reference(void **state) {
+    (void)state;
+    static const char *const files[] = {"def-twice-in-one-operator.json", "mesh-not-closed.json"};
+    tally_t t = {"regressions: tape = walk", 0, 0, 0};
+    rng_t g = {99};
+    for (size_t f = 0; f < 2; ++f) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/tests/data/regressions/%s", SOURCE_DIR, files[f]);
+        loaded L;
+        load(path, &L);
+        for (int i = 0; i < 20000; ++i) {
+            const double X[3] = {rng_range(&g, L.lo[0], L.hi[0]), rng_range(&g, L.lo[1], L.hi[1]),
+                                 rng_range(&g, L.lo[2], L.hi[2])};
+            double v, vr, gr[3], blo, bhi;
+            lb_error e = {LB_OK, ""};
+            if (lb_evaluator_eval(L.ev, 1, &X[0], &X[1], &X[2], &v, NULL, NULL, NULL, 1, &e) ||
+                lb_scene_eval_reference(L.sc, X, &vr, gr, &e) ||
+                lb_evaluator_bounds(L.ev, X, X, &blo, &bhi, &e))
+                fail_msg("%s: %s", path, e.message);
+            tally_check(&t, fabs(v - vr) <= 1e-11 * (1.0 + fabs(vr)) && vr >= blo && vr <= bhi,
+                        "%s at (%g %g %g): tape %.17g, walk %.17g, bounds [%.17g, %.17g]", path,
+                        X[0], X[1], X[2], v, vr, blo, bhi);
+        }
+        unload(&L);
+    }
+    tally_end(&t, 40000);
+}
+
 static void test_dag_sharing(void **state) {
     (void)state;
     static const char text[] =
@@ -475,6 +508,7 @@ int main(void) {
         cmocka_unit_test(test_bounds_contain_samples),
         cmocka_unit_test(test_independent_formulas),
         cmocka_unit_test(test_dag_sharing),
+        cmocka_unit_test(test_regressions_match_reference),
         cmocka_unit_test(test_bad_points),
     };
     return cmocka_run_group_tests(tests, setup, NULL);

@@ -22,9 +22,10 @@ import subprocess
 import sys
 import time
 
-BT, SRC, WORK, SECONDS = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
-sys.path.insert(0, os.path.join(SRC, "tests", "mesh"))
-import meshcheck  # noqa: E402
+if __name__ == "__main__":
+    BT, SRC, WORK, SECONDS = sys.argv[1], sys.argv[2], sys.argv[3], float(sys.argv[4])
+    sys.path.insert(0, os.path.join(SRC, "tests", "mesh"))
+    import meshcheck  # noqa: E402
 
 PER_COMMAND_TIMEOUT = 60  # seconds; sanitizer builds are ~3x slower
 failures = []
@@ -226,4 +227,5 @@ def main():
     sys.exit(1 if failures else 0)
 
 
-main()
+if __name__ == "__main__":
+    main()

@@ -367,8 +367,13 @@ static lb_status allocate_registers(lb_evaluator *ev, uint32_t root, lb_error *e
             const size_t ns = in->op.k * (in->op.family == LB__F_BOUNDED ? 2 : 1);
             for (size_t j = 0; j < ns; ++j) {
                 const uint32_t a = in->src[j];
-                int dup = 0; /* an argument used twice is released once */
-                for (size_t q = 0; q < j; ++q) dup |= in->src[q] == a;
+                /* an argument used twice (a def as two arguments of one
+                 * operator) is released once: src[q] < j already holds
+                 * registers, so compare registers, not instruction indices
+                 * (comparing a register with an index released it twice,
+                 * and two live values then shared one register) */
+                int dup = 0;
+                for (size_t q = 0; q < j; ++q) dup |= in->src[q] == reg_of[a];
                 if (!dup && last[a] == i) freelist[nfree++] = reg_of[a];
                 in->src[j] = reg_of[a];
             }
