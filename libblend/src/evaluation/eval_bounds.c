@@ -14,7 +14,13 @@
  *   functions; their bounds come from the root brackets of spec sections 4-6
  *   with the ranges at their extremes.
  * Every operator bound is widened by 1e-9 (1 + |v|) for the solvers'
- * tolerance, and clamped to [-1e100, 1e100] (the core's argument range). */
+ * tolerance. Unbounded stays unbounded: an end that nothing finite bounds
+ * (an unknown lower end, a value beyond the core's argument range 1e100)
+ * is stored as -INFINITY or +INFINITY, never as a large finite stand-in
+ * that later arithmetic could cancel; every operator below either handles
+ * infinite ends exactly (min, max, complement, the bulge and bounded
+ * brackets) or returns an infinite end where one of its corners is
+ * infinite. */
 #include "../operators/bt_two.h"
 #include "tape.h"
 
@@ -24,10 +30,6 @@
 typedef lb__iv iv;
 
 #define BIG LB_MAX_ABS_ARG
-
-static double clampd(double v) {
-    return v < -BIG ? -BIG : v > BIG ? BIG : v;
-}
 
 /* returned by value: in registers, not through memory that the caller
  * would read back as one wide load (a stalled store forward) */
@@ -115,8 +117,16 @@ static iv prim_bounds(const lb__instr *in, const double bc[3], const double br[3
  * (a struct copy went through the stack as two narrow stores and one wide
  * load, a stalled store forward on every instruction of every pass). */
 static inline void store_iv(iv *r, iv o) {
-    r->lo = clampd(o.lo);
-    r->hi = clampd(o.hi);
+    /* beyond the argument range (or NaN): unbounded on that side; an end
+     * past the range on the other side is pulled in, which stays sound */
+    r->lo = !(o.lo >= -BIG) ? -INFINITY : o.lo > BIG ? BIG : o.lo;
+    r->hi = !(o.hi <= BIG) ? INFINITY : o.hi < -BIG ? -BIG : o.hi;
+}
+
+static int finite_all(const double *v, size_t n) {
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(v[i])) return 0;
+    return 1;
 }
 
 /* dual (union-form) argument interval: intersection -x, difference -x_0 */
@@ -153,7 +163,7 @@ static void bulge_bounds(const lb__node *n, const iv *x, iv *out) {
             if (gh < H) H = gh;
         }
     }
-    if (unknown_lo) L = -BIG;
+    if (unknown_lo) L = -INFINITY;
     if (n->op == LB_UNION) {
         out->lo = L;
         out->hi = H;
@@ -181,7 +191,7 @@ static void bounded_bounds(const lb__node *n, const iv *x, const iv *c, iv *out)
             if (tc < t) t = tc;
             if (t - 1.0 < L) L = t - 1.0;
         }
-        out->lo = unknown ? -BIG : L;
+        out->lo = unknown ? -INFINITY : L;
         out->hi = H;
         /* Where every bounding value stays above -1 the union is monotone
          * (non-decreasing) in each x_i and each c_i: with y = x + 1 and
@@ -200,7 +210,8 @@ static void bounded_bounds(const lb__node *n, const iv *x, const iv *c, iv *out)
             ch[i] = c[i].hi;
         }
         double v1, v2;
-        if (mono &&
+        if (mono && finite_all(xl, k) && finite_all(xh, k) && finite_all(cl, k) &&
+            finite_all(ch, k) &&
             !lb__node_apply(n, LB_CONVENTION_ZERO, xl, cl, NULL, &v1, NULL, NULL, NULL, NULL) &&
             !lb__node_apply(n, LB_CONVENTION_ZERO, xh, ch, NULL, &v2, NULL, NULL, NULL, NULL)) {
             if (v1 > out->lo) out->lo = v1;
@@ -247,6 +258,16 @@ static bscr scratch(const lb_evaluator *ev, iv *R) {
                   S + 5 * K, S + 14 * K};
 }
 
+/* The union-form root of displacement or conic at finite argument values
+ * (the general paths of fast_bounds, without the reciprocal sharing). */
+static double blend_finite(const lb__instr *in, const double *u, const double *r, const double *p,
+                           const double *m, size_t na, double *ws) {
+    if (na == 1) return u[0] / m[0];
+    if (in->fast == LB__FAST_DISPLACEMENT)
+        return lb__bt_union_ws(na, u, r, p, m, in->mode, NULL, NULL, NULL, ws);
+    return lb__conic_union(u, r, in->op.shape, m, NULL, NULL, NULL);
+}
+
 /* Displacement and conic (no bulge) on the arguments a box can reach
  * (cull's list): the culled ones are inactive at both corners, so the
  * kernel on the rest gives the same values, without re-validation. ws: 9k
@@ -266,7 +287,33 @@ static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, s
         m[j] = n->m[act[j]];
     }
     double v1, v2;
-    if (na == 1) {
+    /* Infinite ends: any argument at -inf takes the root to -inf (h <= u/m);
+     * an argument at +inf adds nothing to T at a finite root, so the upper
+     * end is the blend of the others (+inf when none is left). */
+    int lo_inf = 0;
+    size_t nh = 0;
+    for (size_t j = 0; j < na; ++j) {
+        lo_inf |= lo[j] == -INFINITY;
+        nh += hi[j] != INFINITY;
+    }
+    if (lo_inf || nh < na) {
+        iv o = {-INFINITY, INFINITY};
+        if (!lo_inf) o.lo = blend_finite(in, lo, r, p, m, na, ws);
+        if (nh) {
+            size_t q = 0;
+            for (size_t j = 0; j < na; ++j)
+                if (hi[j] != INFINITY) {
+                    hi[q] = hi[j];
+                    r[q] = r[j];
+                    p[q] = p[j];
+                    m[q] = m[j];
+                    ++q;
+                }
+            o.hi = blend_finite(in, hi, r, p, m, nh, ws);
+        }
+        v1 = o.lo;
+        v2 = o.hi;
+    } else if (na == 1) {
         v1 = lo[0] / m[0];
         v2 = hi[0] / m[0];
     } else if (in->fast == LB__FAST_DISPLACEMENT && in->mode == LB__P_TWO) {
@@ -295,6 +342,12 @@ static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, s
     out->hi += 1e-9 * (1.0 + fabs(out->hi));
 }
 
+static int all_finite_iv(const iv *x, size_t k) {
+    for (size_t i = 0; i < k; ++i)
+        if (!isfinite(x[i].lo) || !isfinite(x[i].hi)) return 0;
+    return 1;
+}
+
 static int any_above_one(const iv *x, size_t k) {
     for (size_t i = 0; i < k; ++i)
         if (x[i].hi > 1.0) return 1;
@@ -317,6 +370,19 @@ static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const 
             out->hi = 1.0 - x[0].lo > 0.0 ? 1.0 - x[0].lo : 0.0;
         }
         return; /* exact */
+    } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
+        /* exact, infinite ends included */
+        const int mn = n->family == LB__F_MIN;
+        *out = x[0];
+        for (size_t i = 1; i < k; ++i) {
+            out->lo = mn ? fmin(out->lo, x[i].lo) : fmax(out->lo, x[i].lo);
+            out->hi = mn ? fmin(out->hi, x[i].hi) : fmax(out->hi, x[i].hi);
+        }
+        return;
+    } else if (n->family == LB__F_PERLIN && !all_finite_iv(x, k)) {
+        out->lo = 0.0; /* soft fields are >= 0; nothing finite bounds the top */
+        out->hi = INFINITY;
+        return;
     } else if (n->family == LB__F_PERLIN && any_above_one(x, k)) {
         /* Perlin's products are monotone only on [0, 1]: an argument a soft
          * union took above 1 flips a factor's sign. Interval products then
@@ -340,14 +406,26 @@ static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const 
             xl[i] = dec ? x[i].hi : x[i].lo;
             xh[i] = dec ? x[i].lo : x[i].hi;
         }
-        if (lb__node_apply(n, conv, xl, NULL, NULL, &v1, NULL, NULL, NULL, NULL) ||
-            lb__node_apply(n, conv, xh, NULL, NULL, &v2, NULL, NULL, NULL, NULL)) {
-            out->lo = -BIG; /* outside what the operator accepts: no information */
-            out->hi = BIG;
-            return;
-        }
-        out->lo = v1 < v2 ? v1 : v2;
-        out->hi = v1 < v2 ? v2 : v1;
+        /* a corner with an infinite argument, or one the operator refuses:
+         * nothing is known at that end (an end at 1e100 would be a finite
+         * stand-in that the operator's arithmetic can cancel) */
+        const int ok1 = finite_all(xl, k) &&
+                        !lb__node_apply(n, conv, xl, NULL, NULL, &v1, NULL, NULL, NULL, NULL);
+        const int ok2 = finite_all(xh, k) &&
+                        !lb__node_apply(n, conv, xh, NULL, NULL, &v2, NULL, NULL, NULL, NULL);
+        /* The lower end from xl, the upper from xh (monotone), each
+         * unknown where its corner is. Rounding in operators such as the
+         * R-functions (x + y - sqrt(x^2 + y^2)) is relative to the
+         * arguments, not to the result: widen by their size too. */
+        double big = 0.0;
+        for (size_t i = 0; i < 2 * k; ++i)
+            if (isfinite(xl[i]) && fabs(xl[i]) > big) big = fabs(xl[i]);
+        out->lo = ok1 ? (ok2 ? fmin(v1, v2) : v1) : -INFINITY;
+        out->hi = ok2 ? (ok1 ? fmax(v1, v2) : v2) : INFINITY;
+        out->lo -= 1e-9 * (1.0 + fabs(out->lo)) + 1e-14 * big;
+        out->hi += 1e-9 * (1.0 + fabs(out->hi)) + 1e-14 * big;
+        if (conv == LB_CONVENTION_SOFT && out->lo < 0.0) out->lo = 0.0;
+        return;
     }
     out->lo -= 1e-9 * (1.0 + fabs(out->lo));
     out->hi += 1e-9 * (1.0 + fabs(out->hi));

@@ -964,6 +964,13 @@ void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv 
     const lb__node *nd = &in->op;
     const lb_convention conv = ev->conv;
     double lo[2], hi[2];
+    if (!isfinite(x[0].lo) || !isfinite(x[0].hi) || !isfinite(x[1].lo) || !isfinite(x[1].hi)) {
+        /* a child unbounded on the box: nothing finite is known (the
+         * interval scheme's rule, eval_bounds.c) */
+        out->lo = conv == LB_CONVENTION_SOFT ? 0.0 : -INFINITY;
+        out->hi = INFINITY;
+        return;
+    }
     for (int a = 0; a < 2; ++a) {
         double f[2] = {x[a].lo, x[a].hi}, g[2];
         lb__local_in(nd, conv, f, g);
