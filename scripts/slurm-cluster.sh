@@ -5,8 +5,11 @@
 #   slurm-cluster.sh stop DIR    stop them (by their pid files)
 #   slurm-cluster.sh env DIR     print the SLURM_CONF line to eval
 # Nothing in /etc/slurm changes: every command needs SLURM_CONF=DIR/slurm.conf.
-# Start is idempotent: a running cluster with the same DIR is reused. The
-# packages (slurm-wlm, munge) come from scripts/install-deps.sh.
+# Start is idempotent: a running cluster with the same DIR is reused. Its two
+# ports (slurmctld, slurmd) are free ports picked at the first start and
+# recorded in DIR/ports, so clusters in different folders (the test suite's
+# and a user's) run side by side. The packages (slurm-wlm, munge) come from
+# scripts/install-deps.sh.
 set -euo pipefail
 cmd=${1:-}
 dir=${2:-}
@@ -48,6 +51,27 @@ start)
   cpus=$(nproc)
   mem=$(awk '/MemTotal/ {print int($2 / 1024 * 0.8)}' /proc/meminfo)
   mkdir -p "$dir/state" "$dir/spool" "$dir/munge"
+  # the ports: the recorded ones while this cluster runs (or they are still
+  # free), else two free ones that the kernel hands out, recorded
+  ports=""
+  if [ -f "$dir/ports" ]; then
+    ports=$(cat "$dir/ports")
+    if ! { alive "$dir/slurmctld.pid" && alive "$dir/slurmd.pid"; } &&
+       ! python3 -c 'import socket, sys
+for p in sys.argv[1:]:
+    s = socket.socket(); s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1); s.bind(("", int(p))); s.close()' $ports 2>/dev/null; then
+      ports=""
+    fi
+  fi
+  if ! [[ "$ports" =~ ^[0-9]+\ [0-9]+$ ]]; then
+    ports=$(python3 -c 'import socket
+a, b = socket.socket(), socket.socket()
+a.bind(("", 0)); b.bind(("", 0))
+print(a.getsockname()[1], b.getsockname()[1])')
+    echo "$ports" > "$dir/ports"
+  fi
+  ctld_port=${ports% *}
+  d_port=${ports#* }
   cat > "$conf.new" <<EOF
 ClusterName=libblend
 SlurmctldHost=$host
@@ -69,8 +93,8 @@ SelectType=select/cons_tres
 SelectTypeParameters=CR_Core
 ReturnToService=2
 MpiDefault=none
-SlurmctldPort=6917
-SlurmdPort=6918
+SlurmctldPort=$ctld_port
+SlurmdPort=$d_port
 NodeName=$host CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=debug Nodes=ALL Default=YES MaxTime=INFINITE State=UP
 EOF
