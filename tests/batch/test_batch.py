@@ -126,7 +126,9 @@ check(kinds[0] == "job" and kinds[-1] == "job_end" and kinds.count("task_end") =
 ends = [e for e in ev if e["event"] == "task_end"]
 check(all(e["status"] == "done" and e["seconds"] > 0 and e["peak_rss_kb"] > 0 for e in ends),
       "task_end fields: %s" % ends[:1])
-check(len(os.listdir(os.path.join(out1, ".libblend-manifest"))) == 6, "one manifest per task")
+check(sorted(os.listdir(os.path.join(out1, ".libblend-manifest"))) ==
+      ["cmp_%04d.json" % i for i in range(6)] + ["tasks.lock"],
+      "one manifest per task, and the tasks' lock file")
 m = json.load(open(os.path.join(out1, ".libblend-manifest", "cmp_0003.json")))
 ident = json.loads(m["identity"])
 check(ident["scene_hash"] == rows[3][2] and ident["libblend"] and len(m["outputs"]) == 3,
@@ -252,7 +254,7 @@ r = bt("pov", sc, "-o", a + ".pov", "--set", "root.args[7].radius=1")
 check(r.returncode == 2 and "$.root.args has 2 elements" in r.stderr and
       not os.path.exists(a + ".pov"), "a path that does not exist is named: " + r.stderr)
 r = bt("render", sc, "-o", a + ".png", "--set", "root.args[0].radius=oops")
-check(r.returncode == 2 and "not JSON" in r.stderr, "a value that is not JSON: " + r.stderr)
+check(r.returncode == 2 and "not one JSON value" in r.stderr, "a value that is not JSON: " + r.stderr)
 
 # ---- bad job files: exit 2, the file, the place, what is allowed, nothing written
 good = dict(BASE, output_dir="bad-out")
@@ -325,17 +327,29 @@ for name, doc, want in CASES:
 # scene), the product of the axes, or comparisons (first <= last,
 # increasing keys), and the text that is not JSON
 check(schema_caught >= len(CASES) - 5, "the JSON Schema rejects %d of %d bad jobs" % (schema_caught, len(CASES)))
-# a task whose sweep value makes its scene invalid fails alone: exit 1, the others run
+# a task whose sweep value makes its scene invalid: the job is refused before
+# anything runs (exit 2, the task and the override named), nothing created
 bad_value = dict(BASE, output_dir="partly", sweep=[{"path": "root.args[0].radius", "values": [0.5, -1, 0.45]}],
                  outputs={"mesh": {"resolution": 24}})
 p = write_job(os.path.join(bad_dir, "partly.json"), bad_value)
+for args in ((), ("--list",)):
+    r = bt("batch", p, "--log-json", *args)
+    check(r.returncode == 2 and "radius" in r.stderr and "--set root.args[0].radius=-1" in r.stderr,
+          "an invalid task %s: exit 2 naming the override: %d %s" % (args, r.returncode, r.stderr))
+    check(not os.path.exists(os.path.join(bad_dir, "partly")), "an invalid task %s: nothing created" % (args,))
+# a task that fails while running (its output path is a folder) fails alone:
+# the others run, the error is logged, the exit status is the failure's
+good_value = dict(bad_value, sweep=[{"path": "root.args[0].radius", "values": [0.5, 0.4, 0.45]}])
+p = write_job(os.path.join(bad_dir, "partly.json"), good_value)
+os.makedirs(os.path.join(bad_dir, "partly", "cmp_0001.ply"))
 r = bt("batch", p, "--log-json")
 st = [e["status"] for e in events(r.stdout) if e["event"] == "task_end"]
 err = [e.get("error", "") for e in events(r.stdout) if e["event"] == "task_end"]
-check(r.returncode == 1 and st == ["done", "failed", "done"] and "radius" in err[1],
-      "one failing task: exit 1, the others done, the error logged: %s %s" % (st, err))
+check(r.returncode == 2 and st == ["done", "failed", "done"] and "cmp_0001.ply" in err[1],
+      "one failing task: exit 2 (its output path cannot take a file), the others done, the error "
+      "logged: %d %s %s" % (r.returncode, st, err))
 r = bt("batch", p, "--fail-fast", "--log-json")
-check(r.returncode == 1 and [e["status"] for e in events(r.stdout) if e["event"] == "task_end"] ==
+check(r.returncode == 2 and [e["status"] for e in events(r.stdout) if e["event"] == "task_end"] ==
       ["skipped", "failed"], "--fail-fast stops at the failure")
 
 # ---- SIGKILL at random points: nothing corrupt, nothing complete redone

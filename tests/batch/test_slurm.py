@@ -65,7 +65,9 @@ try:
     r = subprocess.run([BT, "batch", jl], capture_output=True, text=True)
     check(r.returncode == 0, "local run: " + r.stderr[-500:])
     ref = digest(os.path.join(dl, "out"))
-    check(len(ref) == 8 * 2 + 1 + 8, "local outputs: %d files" % len(ref))
+    # 8 meshes and images, the sheet, 8 manifests and the (empty) task lock file
+    check(len(ref) == 8 * 2 + 1 + 8 + 1 and ref.get(".libblend-manifest/tasks.lock") ==
+          hashlib.sha256(b"").hexdigest(), "local outputs: %d files" % len(ref))
 
     # through Slurm: 4 array tasks of 2 tasks each
     ds, js = job_in("slurm")
@@ -79,6 +81,25 @@ try:
     logs = sorted(os.listdir(os.path.join(ds, "out", "logs")))
     check(len([l for l in logs if l.endswith(".jsonl")]) == 4 and
           len([l for l in logs if l.endswith(".log")]) == 4, "one log per array task: %s" % logs)
+
+    # hostile folder names through the real sbatch: the #SBATCH lines keep
+    # one line each, nothing from a path runs, the logs land in OUT/logs
+    tiny = {"format": "libblend-job", "version": 1, "name": "tiny",
+            "scene": os.path.join(SRC, "scenes", "default.json"),
+            "outputs": {"mesh": {"resolution": 12}}}
+    for k, name in enumerate(["p'$(touch PWNED)'p \"q\" `touch PWNED` ü",
+                              "new\nline$(touch PWNED)\\%A"]):
+        dh, jh = job_in(os.path.join("hostile%d" % k, name), tiny)
+        r = subprocess.run([BT, "batch", jh, "--submit", "--array-size", "1"], capture_output=True,
+                           text=True, timeout=600, cwd=dh)
+        check(r.returncode == 0, "hostile folder %r: submitted: %s" % (name, r.stderr[-500:]))
+        hout = os.path.join(dh, "out")
+        check(os.path.exists(os.path.join(hout, "tiny_0000.ply")), "hostile folder %r: meshed" % name)
+        check(os.path.exists(os.path.join(hout, "logs", "tiny_shard_0.jsonl")),
+              "hostile folder %r: the shard's log: %s" % (name, os.listdir(os.path.join(hout, "logs"))))
+        pw = [p for p in (os.path.join(dh, "PWNED"), os.path.join(WORK, "PWNED"), "/tmp/PWNED")
+              if os.path.exists(p)]
+        check(not pw, "hostile folder %r: nothing from the path ran: %s" % (name, pw))
 
     # kill one array task mid-render, then resubmit the same script
     slow = dict(JOB, outputs={"mesh": {"resolution": 40},

@@ -2,16 +2,18 @@
  * task list (scenes x sweep axes x frames), run locally, by task, shard or
  * frame range, resumable through per-task manifests, logged as JSON lines;
  * --slurm writes (and --submit submits) an array job running the shards. */
-#define _XOPEN_SOURCE 700
+#define _GNU_SOURCE /* fopencookie */
 #include "blendtool.h"
 
 #include <cjson/cJSON.h>
 #include <ctype.h>
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -129,6 +131,38 @@ static char *dupstr(const char *s) {
     return d;
 }
 
+/* One safe file name and one --list field: ASCII letters, digits, '_', '-',
+ * '.', '+' and well-formed UTF-8 beyond ASCII; not starting with '.' or
+ * '-' (hidden files, options); 1 to 200 bytes. Nothing a shell, a tab-
+ * separated list or a #SBATCH line gives a meaning to. */
+static int safe_word(const char *s, int allow_lead_dot) {
+    const unsigned char *u = (const unsigned char *)s;
+    const size_t n = strlen(s);
+    if (n < 1 || n > 200 || (!allow_lead_dot && u[0] == '.') || u[0] == '-') return 0;
+    for (size_t i = 0; i < n;) {
+        const unsigned char c = u[i];
+        if (c < 0x80) {
+            if (!(isalnum(c) || c == '_' || c == '-' || c == '.' || c == '+')) return 0;
+            ++i;
+            continue;
+        }
+        /* a UTF-8 sequence: its lead byte, then continuation bytes */
+        const size_t len = c >= 0xF0 && c <= 0xF4  ? 4
+                           : c >= 0xE0             ? 3
+                           : c >= 0xC2 && c < 0xE0 ? 2
+                                                   : 0;
+        if (!len || i + len > n) return 0;
+        for (size_t k = 1; k < len; ++k)
+            if ((u[i + k] & 0xC0) != 0x80) return 0;
+        i += len;
+    }
+    return strcmp(s, ".") && strcmp(s, "..");
+}
+
+#define SAFE_WORD_ALLOWED                                                                          \
+    "1 to 200 bytes of letters, digits, '_', '-', '.', '+' or UTF-8 letters, not starting "        \
+    "with '.' or '-'"
+
 static char *num_text(double x) {
     char b[64];
     snprintf(b, sizeof b, "%.17g", x);
@@ -197,13 +231,17 @@ static int parse_axis(const job *J, const cJSON *a, const char *path, axis *X) {
     if ((rc = get_int(J, rg, "count", rp, 1, MAX_TASKS, &count))) return rc;
     if (count < 1)
         return bad(J, rp, "\"count\" is missing; allowed: an integer from 1 to %d", MAX_TASKS);
+    const double va = f->valuedouble, vb = t->valuedouble;
+    if (!isfinite(va) || !isfinite(vb) || fabs(va) > 1e300 || fabs(vb) > 1e300)
+        return bad(J, rp, "from %g to %g; allowed: finite numbers of magnitude at most 1e300", va,
+                   vb);
     X->n = (size_t)count;
     X->values = calloc(X->n, sizeof *X->values);
     for (size_t i = 0; i < X->n && X->values; ++i) {
         const double u = X->n == 1 ? 0.0 : (double)i / (double)(X->n - 1);
-        X->values[i] = num_text(f->valuedouble + (t->valuedouble - f->valuedouble) * u);
+        X->values[i] = num_text(va + (vb - va) * u);
     }
-    return 0;
+    return X->values ? 0 : BT_EXIT_INTERNAL;
 }
 
 /* the value of a keyframed path at frame fr: linear, step or smooth (ease
@@ -411,6 +449,61 @@ static void relative(const job *J, const char *p, char *out, size_t len) {
         snprintf(out, len, "%s/%s", J->dir, p);
 }
 
+/* The first \\u0000 escape inside a JSON string of text, or NULL: cJSON
+ * would decode it into a NUL that silently ends the C string. */
+/* A pattern: at least one '#', the placeholders {name}, {scene}, {task},
+ * and around them what a safe name allows; why names the first fault. */
+static int pattern_ok(const char *p, char *why, size_t whylen) {
+    char probe[512];
+    size_t o = 0;
+    int hashes = 0;
+    for (const char *c = p; *c; ++c) {
+        if (o + 8 >= sizeof probe) {
+            snprintf(why, whylen, "more than 200 bytes");
+            return 0;
+        }
+        if (*c == '{') {
+            const char *e = strchr(c, '}');
+            if (!e ||
+                (strncmp(c, "{name}", 6) && strncmp(c, "{scene}", 7) && strncmp(c, "{task}", 6))) {
+                snprintf(why, whylen, "an unknown placeholder at \"%.20s\"", c);
+                return 0;
+            }
+            probe[o++] = 'x';
+            c = e;
+        } else {
+            hashes += *c == '#';
+            probe[o++] = *c == '#' ? '0' : *c;
+        }
+    }
+    probe[o] = '\0';
+    if (!hashes) {
+        snprintf(why, whylen, "no # for the frame number");
+        return 0;
+    }
+    if (strlen(p) > 200 || !safe_word(probe, 0)) {
+        snprintf(why, whylen, "characters outside a safe name");
+        return 0;
+    }
+    return 1;
+}
+
+static const char *nul_escape(const char *text, size_t len) {
+    int in = 0;
+    for (size_t i = 0; i < len; ++i) {
+        if (!in) {
+            in = text[i] == '"';
+        } else if (text[i] == '"') {
+            in = 0;
+        } else if (text[i] == '\\' && i + 1 < len) {
+            if (text[i + 1] == 'u' && i + 5 < len && !strncmp(text + i + 2, "0000", 4))
+                return text + i;
+            ++i; /* the escaped character */
+        }
+    }
+    return NULL;
+}
+
 static int parse_job(job *J, const char *file) {
     memset(J, 0, sizeof *J);
     J->file = file;
@@ -428,6 +521,24 @@ static int parse_job(job *J, const char *file) {
         bt_error(CMD,
                  "%s: cannot read the job file (%s); allowed: a readable file of at most 16 MiB",
                  file, why);
+        return BT_EXIT_BAD_INPUT;
+    }
+    const char *nul = nul_escape(text, len);
+    if (nul) {
+        long line = 1, col = 1;
+        for (const char *c = text; c < nul; ++c) {
+            if (*c == '\n') {
+                ++line;
+                col = 1;
+            } else {
+                ++col;
+            }
+        }
+        free(text);
+        bt_error(CMD,
+                 "%s:%ld:%ld: a string holds \\u0000 (a NUL byte), which would cut it short; "
+                 "allowed: strings without NUL",
+                 file, line, col);
         return BT_EXIT_BAD_INPUT;
     }
     const char *end = NULL;
@@ -475,11 +586,9 @@ static int parse_job(job *J, const char *file) {
     /* name: the job file's stem unless given */
     const cJSON *nm = cJSON_GetObjectItemCaseSensitive(doc, "name");
     if (nm) {
-        if (!cJSON_IsString(nm) || !*nm->valuestring || strlen(nm->valuestring) > 200 ||
-            strpbrk(nm->valuestring, "/\\ \t\n")) {
-            rc = bad(J, "$.name",
-                     "is %s; allowed: a file-name word (no /, spaces), at most 200 bytes",
-                     cJSON_IsString(nm) ? nm->valuestring : kind(nm));
+        if (!cJSON_IsString(nm) || !safe_word(nm->valuestring, 0)) {
+            rc = bad(J, "$.name", "is %s; allowed: a name of " SAFE_WORD_ALLOWED,
+                     !cJSON_IsString(nm) ? kind(nm) : "not a safe name");
             goto out;
         }
         snprintf(J->name, sizeof J->name, "%s", nm->valuestring);
@@ -488,6 +597,12 @@ static int parse_job(job *J, const char *file) {
         snprintf(J->name, sizeof J->name, "%s", b ? b + 1 : file);
         char *dot = strrchr(J->name, '.');
         if (dot && dot != J->name) *dot = '\0';
+        if (!safe_word(J->name, 0)) {
+            rc = bad(J, "$.name",
+                     "missing, and the job file's name is not a safe output name; allowed: "
+                     "give \"name\", " SAFE_WORD_ALLOWED);
+            goto out;
+        }
     }
     /* scenes */
     const cJSON *sc = cJSON_GetObjectItemCaseSensitive(doc, "scene"),
@@ -590,12 +705,12 @@ static int parse_job(job *J, const char *file) {
     relative(J, od ? od->valuestring : "out", J->outdir, sizeof J->outdir);
     const cJSON *pt = cJSON_GetObjectItemCaseSensitive(doc, "pattern");
     if (pt) {
-        if (!cJSON_IsString(pt) || !strchr(pt->valuestring, '#') || strchr(pt->valuestring, '/') ||
-            strlen(pt->valuestring) > 200) {
+        char why[160] = "";
+        if (!cJSON_IsString(pt) || !pattern_ok(pt->valuestring, why, sizeof why)) {
             rc = bad(J, "$.pattern",
-                     "is %s; allowed: a name with #### for the frame (zero-padded "
-                     "to the number of #), optionally {name}, {scene}, {task}",
-                     cJSON_IsString(pt) ? pt->valuestring : kind(pt));
+                     "is %s%s; allowed: #### for the frame (zero-padded to the number of #), "
+                     "{name}, {scene}, {task}, and " SAFE_WORD_ALLOWED,
+                     cJSON_IsString(pt) ? "a pattern with " : kind(pt), why);
             goto out;
         }
         snprintf(J->pattern, sizeof J->pattern, "%s", pt->valuestring);
@@ -604,6 +719,17 @@ static int parse_job(job *J, const char *file) {
                  J->nscenes > 1 ? "{name}_{scene}_" : "{name}_",
                  J->has_frames && J->naxes ? "t{task}_" : "");
     }
+    /* the scene stems become part of the names */
+    for (size_t i = 0; strstr(J->pattern, "{scene}") && i < J->nscenes; ++i)
+        if (!safe_word(J->scene_stems[i], 0)) {
+            char path[64];
+            snprintf(path, sizeof path, sc ? "$.scene" : "$.scenes[%zu]", i);
+            rc = bad(J, path,
+                     "the file name's stem \"%s\" goes into the output names ({scene}) but is "
+                     "not a safe name; allowed: " SAFE_WORD_ALLOWED " (rename the file)",
+                     J->scene_stems[i]);
+            goto out;
+        }
     long th = 1;
     if ((rc = get_int(J, doc, "threads", "$", 0, 1024, &th))) goto out;
     J->threads = (int)th;
@@ -808,8 +934,10 @@ static int task_done(const job *J, const task *T, const char *ident) {
 /* ---- logging ---- */
 
 typedef struct logger {
-    FILE *f; /* JSON lines, or NULL */
-    int bar; /* progress on a terminal */
+    FILE *f;    /* JSON lines, or NULL */
+    int bar;    /* progress on a terminal */
+    int failed; /* a line could not be written (errno in err) */
+    int err;
 } logger;
 
 static double now(void) {
@@ -821,9 +949,9 @@ static double now(void) {
 static void log_event(logger *L, cJSON *e) {
     if (L->f) {
         char *t = cJSON_PrintUnformatted(e);
-        if (t) {
-            fprintf(L->f, "%s\n", t);
-            fflush(L->f);
+        if (t && !L->failed && (fprintf(L->f, "%s\n", t) < 0 || fflush(L->f) != 0)) {
+            L->failed = 1;
+            L->err = errno;
         }
         free(t);
     }
@@ -846,13 +974,93 @@ static int write_bytes(const char *path, const void *data, size_t len) {
     return bt_write_file(CMD, path, data, len);
 }
 
+/* A manifest vouches for the bytes this process wrote, never for what a
+ * path holds afterwards (another process may have replaced it): every
+ * output goes through a stream that hashes what passes on its way to the
+ * temporary file, and the hash is taken before the file is linked into
+ * place. */
+typedef struct hash_tee {
+    FILE *to;
+    XXH3_state_t *h;
+} hash_tee;
+
+static ssize_t tee_write(void *c, const char *buf, size_t n) {
+    hash_tee *t = c;
+    if (fwrite(buf, 1, n, t->to) != n) return -1;
+    XXH3_128bits_update(t->h, buf, n);
+    return (ssize_t)n;
+}
+
+typedef struct hashed_out {
+    bt_out out;
+    hash_tee t;
+    FILE *f; /* write here */
+} hashed_out;
+
+static int hashed_open(const char *path, hashed_out *H) {
+    memset(H, 0, sizeof *H);
+    int rc = bt_output_open(CMD, path, &H->out);
+    if (rc) return rc;
+    H->t.to = H->out.f;
+    H->t.h = XXH3_createState();
+    cookie_io_functions_t io = {NULL, tee_write, NULL, NULL};
+    if (H->t.h) XXH3_128bits_reset(H->t.h);
+    H->f = H->t.h ? fopencookie(&H->t, "w", io) : NULL;
+    if (!H->f) {
+        XXH3_freeState(H->t.h);
+        bt_output_discard(&H->out);
+        bt_error(CMD, "%s: out of memory", path);
+        return BT_EXIT_INTERNAL;
+    }
+    return 0;
+}
+
+static void hashed_discard(hashed_out *H) {
+    if (H->f) fclose(H->f);
+    H->f = NULL;
+    XXH3_freeState(H->t.h);
+    H->t.h = NULL;
+    bt_output_discard(&H->out);
+}
+
+/* flush, hash, link into place; failed: nothing at the path */
+static int hashed_commit(const char *path, hashed_out *H, char hex[33]) {
+    const int bad_write = fclose(H->f) != 0;
+    H->f = NULL;
+    const XXH128_hash_t r = XXH3_128bits_digest(H->t.h);
+    XXH3_freeState(H->t.h);
+    H->t.h = NULL;
+    const uint64_t h[2] = {r.high64, r.low64};
+    bt_hash_hex(h, hex);
+    if (bad_write || ferror(H->out.f)) {
+        bt_error(CMD, "%s: writing the output failed (%s); nothing was written", path,
+                 strerror(errno));
+        bt_output_discard(&H->out);
+        return BT_EXIT_INTERNAL;
+    }
+    return bt_output_commit(CMD, &H->out);
+}
+
+static int hashed_bytes(const char *path, const void *data, size_t len, char hex[33]) {
+    hashed_out H;
+    int rc = hashed_open(path, &H);
+    if (rc) return rc;
+    if (len && fwrite(data, 1, len, H.f) != len) {
+        hashed_discard(&H);
+        bt_error(CMD, "%s: writing the output failed (%s); nothing was written", path,
+                 strerror(errno));
+        return BT_EXIT_INTERNAL;
+    }
+    return hashed_commit(path, &H, hex);
+}
+
 static int run_task(const job *J, const task *T, const char *ident, const uint64_t scene_hash[2],
                     lb_scene *sc, logger *L, int threads) {
     lb_error e = {LB_OK, ""};
     lb_evaluator *ev = NULL;
     lb_status s = lb_evaluator_create(sc, &ev, &e);
     if (s) return bt_fail(CMD, J->scenes[T->scene], s, &e);
-    char names[3][600];
+    char names[3][600], hexes[3][33];
     const size_t n = outputs_of(J, T, names);
     cJSON *manifest = cJSON_CreateObject();
     cJSON_AddStringToObject(manifest, "identity", ident);
@@ -867,25 +1075,40 @@ static int run_task(const job *J, const task *T, const char *ident, const uint64
         o.resolution = (unsigned)J->mesh_res;
         o.threads = threads;
         lb_mesh *m = NULL;
+        hashed_out H;
         if (!lb_scene_bounds(sc, o.bmin, o.bmax)) {
             bt_error(CMD, "%s: the scene has no bounds; allowed: a scene with \"bounds\"",
                      J->scenes[T->scene]);
             rc = BT_EXIT_BAD_INPUT;
-        } else if ((s = lb_mesh_create(ev, &o, &m, &e)) ||
-                   (s = lb_mesh_write(m, full, J->mesh_fmt, &e))) {
+        } else if ((s = lb_mesh_create(ev, &o, &m, &e))) {
             rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
+        } else if (!(rc = hashed_open(full, &H))) {
+            if ((s = lb_mesh_write_stream(m, H.f, J->mesh_fmt, &e))) {
+                hashed_discard(&H);
+                rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
+            } else {
+                rc = hashed_commit(full, &H, hexes[k]);
+            }
         }
         lb_mesh_free(m);
         ++k;
     }
     if (!rc && J->pov) {
-        snprintf(full, sizeof full, "%s/%s", J->outdir, names[k++]);
+        snprintf(full, sizeof full, "%s/%s", J->outdir, names[k]);
         lb_pov_options o = {0, 0, (double)J->pov_w / (double)J->pov_h, 0.0, threads};
-        if ((s = lb_scene_write_pov(sc, ev, &o, full, NULL, &e)))
-            rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
+        hashed_out H;
+        if (!(rc = hashed_open(full, &H))) {
+            if ((s = lb_scene_write_pov_stream(sc, ev, &o, H.f, NULL, &e))) {
+                hashed_discard(&H);
+                rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
+            } else {
+                rc = hashed_commit(full, &H, hexes[k]);
+            }
+        }
+        ++k;
     }
     if (!rc && J->image) {
-        snprintf(full, sizeof full, "%s/%s", J->outdir, names[k++]);
+        snprintf(full, sizeof full, "%s/%s", J->outdir, names[k]);
         bt_render_dir R;
         if ((rc = bt_render_dir_open(&R)) == 0) {
             lb_pov_options o = {0, 0, (double)J->img_w / (double)J->img_h, 0.0, threads};
@@ -914,41 +1137,62 @@ static int run_task(const job *J, const task *T, const char *ident, const uint64
                     bt_error(CMD, "%s: writing the image failed: %s", full, err);
                     rc = BT_EXIT_INTERNAL;
                 } else {
-                    rc = write_bytes(full, img, len);
+                    rc = hashed_bytes(full, img, len, hexes[k]);
                 }
                 free(img);
             }
             bt_render_dir_close(&R);
         }
+        ++k;
     }
     for (size_t i = 0; i < n && !rc; ++i) {
-        uint64_t h[2];
-        char hex[33];
-        snprintf(full, sizeof full, "%s/%s", J->outdir, names[i]);
-        if (hash_file(full, h)) {
-            bt_error(CMD, "%s: cannot read back the output (%s)", full, strerror(errno));
-            rc = BT_EXIT_INTERNAL;
-            break;
-        }
-        bt_hash_hex(h, hex);
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "file", names[i]);
-        cJSON_AddStringToObject(o, "hash", hex);
+        cJSON_AddStringToObject(o, "hash", hexes[i]);
         cJSON_AddItemToArray(outs, o);
         cJSON *ev2 = event("output", T);
         cJSON_AddStringToObject(ev2, "file", names[i]);
-        cJSON_AddStringToObject(ev2, "hash", hex);
+        cJSON_AddStringToObject(ev2, "hash", hexes[i]);
         log_event(L, ev2);
     }
     if (!rc) { /* the manifest last: only a complete task has one */
-        char mp[8192], *text = cJSON_Print(manifest);
+        char mp[8192], *text = cJSON_Print(manifest), mhex[33];
         manifest_path(J, T, mp, sizeof mp);
-        rc = text ? write_bytes(mp, text, strlen(text)) : BT_EXIT_INTERNAL;
+        rc = text ? hashed_bytes(mp, text, strlen(text), mhex) : BT_EXIT_INTERNAL;
         free(text);
     }
     cJSON_Delete(manifest);
     lb_evaluator_free(ev);
     return rc;
+}
+
+/* A task's lock, held while the task is checked and run: an open file
+ * description lock (F_OFD_SETLK) on one byte of OUT/.libblend-manifest/
+ * tasks.lock, at an offset hashed from the task's name, so every process
+ * and every job writing into OUT locks the same byte for the same output
+ * names. The kernel releases it when the descriptor closes or the process
+ * dies however it dies; the file itself stays (empty), as the manifest
+ * folder does. Returns the descriptor, -1 when another process holds the
+ * task and wait is 0, -2 on an error (errno). */
+static int task_lock(const job *J, const task *T, int wait) {
+    char lp[8192];
+    snprintf(lp, sizeof lp, "%s/.libblend-manifest/tasks.lock", J->outdir);
+    const int fd = open(lp, O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0) return -2;
+    struct flock fl;
+    memset(&fl, 0, sizeof fl);
+    fl.l_type = F_WRLCK;
+    fl.l_whence = SEEK_SET;
+    fl.l_start = (off_t)(XXH3_64bits(T->name, strlen(T->name)) >> 2); /* 62 bits */
+    fl.l_len = 1;
+    while (fcntl(fd, wait ? F_OFD_SETLKW : F_OFD_SETLK, &fl) != 0) {
+        if (errno == EINTR) continue;
+        const int e = errno;
+        close(fd);
+        errno = e;
+        return e == EAGAIN || e == EACCES ? -1 : -2;
+    }
+    return fd;
 }
 
 static int mkdirs(const char *path) {
@@ -979,9 +1223,11 @@ static int contact_sheet(const job *J, size_t ntasks, logger *L) {
         task_free(&T);
         struct stat st;
         if (stat(full, &st) != 0) {
-            bt_error(CMD, "%s: the contact sheet needs every task's image; missing %s", J->file,
-                     full);
-            rc = BT_EXIT_INTERNAL;
+            bt_error(CMD,
+                     "%s: the contact sheet needs every task's image; missing %s; allowed: run "
+                     "the job (or the missing tasks) first",
+                     J->file, full);
+            rc = BT_EXIT_BAD_INPUT;
         }
     }
     if (!rc) {
@@ -1019,8 +1265,81 @@ static int contact_sheet(const job *J, size_t ntasks, logger *L) {
 
 /* ---- Slurm ---- */
 
+/* Slurm partition lists: names of [A-Za-z0-9_.-] separated by commas */
+static int partition_ok(const char *p) {
+    if (!*p || strlen(p) > 1000 || *p == ',' || p[strlen(p) - 1] == ',') return 0;
+    for (const char *c = p; *c; ++c)
+        if (!(isalnum((unsigned char)*c) || *c == '_' || *c == '-' || *c == '.' ||
+              (*c == ',' && c[1] != ',')))
+            return 0;
+    return 1;
+}
+
+/* text as one shell word: single quotes, each ' as '\'' (no byte can end
+ * it: inside single quotes the shell gives no character a meaning) */
+static void sh_quote(char *out, size_t len, size_t *o, const char *text) {
+    const char *parts[2] = {"'", "'\\''"};
+    size_t n = *o;
+    if (n + 1 < len) out[n++] = '\'';
+    for (const char *c = text; *c && n + 5 < len; ++c) {
+        if (*c == '\'')
+            for (const char *q = parts[1]; *q; ++q) out[n++] = *q;
+        else
+            out[n++] = *c;
+    }
+    if (n + 1 < len) out[n++] = '\'';
+    out[n < len ? n : len - 1] = '\0';
+    *o = n;
+}
+
+/* A value sbatch's #SBATCH parser passes through unchanged inside double
+ * quotes, and its file-name patterns leave alone: no '"', '\', '%' (file
+ * name patterns), no control character. */
+static int directive_ok(const char *v) {
+    for (const unsigned char *c = (const unsigned char *)v; *c; ++c)
+        if (*c < 32 || *c == 127 || *c == '"' || *c == '\\' || *c == '%') return 0;
+    return 1;
+}
+
+/* The largest time and peak memory of the job's tasks that the shard logs
+ * of earlier runs (OUT/logs/NAME_shard_*.jsonl) record as done (0 when
+ * none do). */
+static void measured_costs(const job *J, double *sec, double *rss_kb) {
+    *sec = *rss_kb = 0.0;
+    char logs[8192];
+    snprintf(logs, sizeof logs, "%s/logs", J->outdir);
+    DIR *d = opendir(logs);
+    if (!d) return;
+    char prefix[300];
+    snprintf(prefix, sizeof prefix, "%s_shard_", J->name);
+    for (struct dirent *e; (e = readdir(d));) {
+        const size_t nl = strlen(e->d_name), pl = strlen(prefix);
+        if (nl <= pl + 6 || strncmp(e->d_name, prefix, pl) || strcmp(e->d_name + nl - 6, ".jsonl"))
+            continue;
+        char path[8600];
+        snprintf(path, sizeof path, "%s/%s", logs, e->d_name);
+        FILE *f = fopen(path, "r");
+        char line[4096];
+        while (f && fgets(line, sizeof line, f)) {
+            cJSON *ev = cJSON_Parse(line);
+            const cJSON *k = cJSON_GetObjectItemCaseSensitive(ev, "event"),
+                        *st = cJSON_GetObjectItemCaseSensitive(ev, "status"),
+                        *s2 = cJSON_GetObjectItemCaseSensitive(ev, "seconds"),
+                        *r = cJSON_GetObjectItemCaseSensitive(ev, "peak_rss_kb");
+            if (cJSON_IsString(k) && !strcmp(k->valuestring, "task_end") && cJSON_IsString(st) &&
+                !strcmp(st->valuestring, "done")) {
+                if (cJSON_IsNumber(s2) && s2->valuedouble > *sec) *sec = s2->valuedouble;
+                if (cJSON_IsNumber(r) && r->valuedouble > *rss_kb) *rss_kb = r->valuedouble;
+            }
+            cJSON_Delete(ev);
+        }
+        if (f) fclose(f);
+    }
+    closedir(d);
+}
+
 static int slurm_script(const job *J, size_t ntasks, int array, const char *partition,
-                        const char *self, char *out, size_t outlen) {
+                        long time_min, long mem_mb, const char *self, char *out, size_t outlen) {
     if (mkdirs(J->outdir)) {
         bt_error(CMD, "%s: cannot create the output folder (%s)", J->outdir, strerror(errno));
         return BT_EXIT_BAD_INPUT;
@@ -1035,7 +1354,37 @@ static int slurm_script(const job *J, size_t ntasks, int array, const char *part
         bt_error(CMD, "%s: the output folder's path is too long", dirabs);
         return BT_EXIT_BAD_INPUT;
     }
-    char text[65536];
+    /* --time and --mem: given, else measured on the job's tasks in the
+     * shard logs of an earlier submission (twice the slowest task per task of the largest shard,
+     * plus 5 minutes; twice the largest peak plus 256 MB), else 30 minutes per task of the largest
+     * shard and 4096 MB (docs/batch.md) */
+    const size_t per_shard = (ntasks + (size_t)array - 1) / (size_t)array;
+    double sec = 0.0, rss = 0.0;
+    if (!time_min || !mem_mb) measured_costs(J, &sec, &rss);
+    if (!time_min) {
+        const double t =
+            sec > 0.0 ? ceil(2.0 * sec * (double)per_shard / 60.0) + 5.0 : 30.0 * (double)per_shard;
+        time_min = t < 10.0 ? 10 : t > 525600.0 ? 525600 : (long)t;
+    }
+    if (!mem_mb) mem_mb = rss > 0.0 ? (long)ceil(2.0 * rss / 1024.0) + 256 : 4096;
+    /* every path is a shell word in single quotes; the log folder goes into
+     * a #SBATCH line only where sbatch keeps it as it is */
+    char logs[8300], qself[20000], qjob[20000], qlog[20000];
+    size_t o1 = 0, o2 = 0, o3 = 0;
+    if (snprintf(logs, sizeof logs, "%s/logs", dirabs) >= (int)sizeof logs) {
+        bt_error(CMD, "%s: paths too long for the script", dirabs);
+        return BT_EXIT_BAD_INPUT;
+    }
+    char logfile[8800];
+    if (snprintf(logfile, sizeof logfile, "%s/%s_shard_", logs, J->name) >= (int)sizeof logfile) {
+        bt_error(CMD, "%s: paths too long for the script", dirabs);
+        return BT_EXIT_BAD_INPUT;
+    }
+    sh_quote(qself, sizeof qself, &o1, self);
+    sh_quote(qjob, sizeof qjob, &o2, jobabs);
+    sh_quote(qlog, sizeof qlog, &o3, logfile);
+    const int direct = directive_ok(logs);
+    char text[80000];
     const int tl = snprintf(
         text, sizeof text,
         "#!/bin/sh\n"
@@ -1043,18 +1392,27 @@ static int slurm_script(const job *J, size_t ntasks, int array, const char *part
         "# Submitting it again redoes only what is missing or incomplete.\n"
         "#SBATCH --job-name=%s\n"
         "#SBATCH --array=0-%d\n"
-        "#SBATCH --output=%s/logs/%s_%%A_%%a.log\n"
+        "%s%s%s"
         "#SBATCH --ntasks=1\n"
         "#SBATCH --cpus-per-task=1\n"
+        "#SBATCH --time=%ld\n"
+        "#SBATCH --mem=%ldM\n"
         "%s%s%s"
-        "exec '%s' batch '%s' --shard \"$SLURM_ARRAY_TASK_ID/%d\" --threads 1 "
-        "--log '%s/logs/%s_shard_'\"$SLURM_ARRAY_TASK_ID\"'.jsonl'\n",
-        BT_VERSION, ntasks, array, J->name, array - 1, dirabs, J->name,
+        "%s%s%s"
+        "exec %s batch %s --shard \"$SLURM_ARRAY_TASK_ID/%d\" --threads 1 "
+        "--log %s\"$SLURM_ARRAY_TASK_ID\"'.jsonl'\n",
+        BT_VERSION, ntasks, array, J->name, array - 1, direct ? "#SBATCH --output=\"" : "",
+        direct ? logs : "", direct ? "/%x_%A_%a.log\"\n" : "", time_min, mem_mb,
         partition ? "#SBATCH --partition=" : "", partition ? partition : "", partition ? "\n" : "",
-        self, jobabs, array, dirabs, J->name);
-    char logs[8300];
-    if (tl >= (int)sizeof text ||
-        snprintf(logs, sizeof logs, "%s/logs", dirabs) >= (int)sizeof logs) {
+        direct ? ""
+               : "# the output folder's path has characters a #SBATCH line cannot carry:\n"
+                 "# the shard's messages go to its log from here (Slurm's own to\n"
+                 "# slurm-JOB_TASK.out in the folder it was submitted from)\n"
+                 "exec >>",
+        direct ? "" : qlog, direct ? "" : "\"$SLURM_ARRAY_TASK_ID\"'.log' 2>&1\n", qself, qjob,
+        array, qlog);
+    if (tl >= (int)sizeof text || o1 + 1 >= sizeof qself || o2 + 1 >= sizeof qjob ||
+        o3 + 1 >= sizeof qlog) {
         bt_error(CMD, "%s: paths too long for the script", dirabs);
         return BT_EXIT_BAD_INPUT;
     }
@@ -1103,6 +1461,7 @@ static void job_free(job *J) {
 static int run(int argc, char **argv) {
     const char *file = NULL, *v = NULL, *logpath = NULL, *partition = NULL;
     int list = 0, log_json = 0, fail_fast = 0, slurm = 0, submit = 0, array = 4, threads = -1;
+    long time_min = 0, mem_mb = 0; /* --time, --mem of --slurm: 0 = measured or default */
     int sheet_only = 0;
     long task_id = -1, shard_i = -1, shard_n = 0, fa = -1, fb = -1;
     for (int i = 1; i < argc; ++i) {
@@ -1136,8 +1495,9 @@ static int run(int argc, char **argv) {
                 return BT_EXIT_BAD_INPUT;
             }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--frames", &v))) {
-            if (r < 0 || parse_range(v, &fa, &fb)) {
-                if (r >= 0) bt_error(CMD, "--frames %s: expected A-B (or one frame A)", v);
+            if (r < 0 || parse_range(v, &fa, &fb) || fa < 0) {
+                if (r >= 0)
+                    bt_error(CMD, "--frames %s: expected A-B (or one frame A) with 0 <= A <= B", v);
                 return BT_EXIT_BAD_INPUT;
             }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--log", &v))) {
@@ -1155,7 +1515,32 @@ static int run(int argc, char **argv) {
             }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--partition", &v))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
+            if (!partition_ok(v)) {
+                bt_error(CMD,
+                         "--partition: %zu bytes that Slurm cannot take as a partition list; "
+                         "allowed: names of letters, digits, '_', '-', '.', separated by commas",
+                         strlen(v));
+                return BT_EXIT_BAD_INPUT;
+            }
             partition = v;
+        } else if ((r = bt_option(CMD, argc, argv, &i, "--time", &v))) {
+            char *end = NULL;
+            if (r < 0) return BT_EXIT_BAD_INPUT;
+            errno = 0;
+            time_min = strtol(v, &end, 10);
+            if (errno || !end || *end || end == v || time_min < 1 || time_min > 525600) {
+                bt_error(CMD, "--time %s: expected minutes per array task, 1 to 525600", v);
+                return BT_EXIT_BAD_INPUT;
+            }
+        } else if ((r = bt_option(CMD, argc, argv, &i, "--mem", &v))) {
+            char *end = NULL;
+            if (r < 0) return BT_EXIT_BAD_INPUT;
+            errno = 0;
+            mem_mb = strtol(v, &end, 10);
+            if (errno || !end || *end || end == v || mem_mb < 16 || mem_mb > 16777216) {
+                bt_error(CMD, "--mem %s: expected megabytes per array task, 16 to 16777216", v);
+                return BT_EXIT_BAD_INPUT;
+            }
         } else if (argv[i][0] == '-' && argv[i][1]) {
             bt_error(CMD, "unknown option %s; see blendtool batch --help", argv[i]);
             return BT_EXIT_BAD_INPUT;
@@ -1210,7 +1595,7 @@ static int run(int argc, char **argv) {
         char self[4096];
         const ssize_t sl = readlink("/proc/self/exe", self, sizeof self - 1);
         self[sl > 0 ? sl : 0] = '\0';
-        rc = slurm_script(&J, nt, array, partition, self, script, sizeof script);
+        rc = slurm_script(&J, nt, array, partition, time_min, mem_mb, self, script, sizeof script);
         if (!rc) printf("%s\n", script);
         if (!rc && submit) {
             fflush(stdout);
@@ -1233,7 +1618,7 @@ static int run(int argc, char **argv) {
                 bt_error(CMD, "sbatch --wait %s: some array tasks failed (logs in %s/logs)", script,
                          J.outdir);
             else if (J.sheet) {
-                logger L0 = {NULL, 0};
+                logger L0 = {NULL, 0, 0, 0};
                 rc = contact_sheet(&J, nt, &L0);
             }
         }
@@ -1266,6 +1651,36 @@ static int run(int argc, char **argv) {
         job_free(&J);
         return rc;
     }
+    if (sheet_only && J.image && !J.sheet) { /* the documented defaults */
+        J.sheet_cols = 4;
+        J.sheet_w = 160;
+        J.sheet_h = 120;
+    }
+    if (sheet_only && !J.image) {
+        bt_error(CMD,
+                 "--sheet: %s has no image outputs to put on a sheet; allowed: a job with "
+                 "\"outputs\": {\"image\": {...}}",
+                 file);
+        job_free(&J);
+        return BT_EXIT_BAD_INPUT;
+    }
+    /* every selected task's scene is read before anything is created: a job
+     * whose scene or overrides are invalid leaves no output folder */
+    for (size_t i = lo; i < hi && !sheet_only; ++i) {
+        task T;
+        if ((rc = make_task(&J, i, &T))) break;
+        if (fa < 0 || (T.frame >= fa && T.frame <= fb)) {
+            lb_scene *sc = NULL;
+            uint64_t h[2];
+            rc = bt_load_scene_set(CMD, J.scenes[T.scene], T.sets, T.nsets, &sc, h);
+            lb_scene_free(sc);
+        }
+        task_free(&T);
+        if (rc) {
+            job_free(&J);
+            return rc;
+        }
+    }
     if (mkdirs(J.outdir)) {
         bt_error(CMD, "%s: cannot create the output folder (%s)", J.outdir, strerror(errno));
         job_free(&J);
@@ -1278,7 +1693,7 @@ static int run(int argc, char **argv) {
         job_free(&J);
         return BT_EXIT_BAD_INPUT;
     }
-    logger L = {NULL, 0};
+    logger L = {NULL, 0, 0, 0};
     if (log_json) L.f = stdout;
     if (logpath) {
         L.f = fopen(logpath, "a");
@@ -1301,8 +1716,17 @@ static int run(int argc, char **argv) {
     cJSON_AddNumberToObject(je, "first", (double)lo);
     cJSON_AddNumberToObject(je, "end", (double)hi);
     log_event(&L, je);
-    size_t done = 0, skipped = 0, failed = 0;
-    for (size_t i = lo; i < hi; ++i) {
+    size_t done = 0, skipped = 0, failed = 0, nbusy = 0;
+    int worst = 0; /* the exit code of the failed tasks: 1 when any failed inside */
+    /* Tasks locked by another process (another run on the same OUT folder)
+     * are passed over and taken at the end, waiting for their locks: by
+     * then the other process has usually finished them, and they are
+     * skipped as complete. */
+    size_t *busy = malloc((hi - lo + 1) * sizeof *busy);
+    if (!busy) rc = BT_EXIT_INTERNAL;
+    for (size_t q = lo; busy && q < hi + nbusy; ++q) {
+        const int second = q >= hi;
+        const size_t i = second ? busy[q - hi] : q;
         task T;
         if (make_task(&J, i, &T)) {
             rc = BT_EXIT_INTERNAL;
@@ -1312,11 +1736,23 @@ static int run(int argc, char **argv) {
             task_free(&T);
             continue;
         }
+        const int lk = task_lock(&J, &T, second);
+        if (lk == -1) {
+            busy[nbusy++] = i;
+            task_free(&T);
+            continue;
+        }
         const double t0 = now();
-        if (L.bar) fprintf(stderr, "\r[%zu/%zu] %s ", i - lo + 1, hi - lo, T.name), fflush(stderr);
+        if (L.bar) fprintf(stderr, "\r[%zu/%zu] %s ", q - lo + 1, hi - lo, T.name), fflush(stderr);
         lb_scene *sc = NULL;
         uint64_t h[2] = {0, 0};
-        int trc = bt_load_scene_set(CMD, J.scenes[T.scene], T.sets, T.nsets, &sc, h);
+        int trc = 0;
+        if (lk < 0) {
+            bt_error(CMD, "%s: cannot lock the task in %s (%s)", T.name, mdir, strerror(errno));
+            trc = BT_EXIT_INTERNAL;
+        } else {
+            trc = bt_load_scene_set(CMD, J.scenes[T.scene], T.sets, T.nsets, &sc, h);
+        }
         char *ident = trc ? NULL : identity(&J, &T, h);
         const char *status = "done";
         if (!trc && task_done(&J, &T, ident)) {
@@ -1326,9 +1762,11 @@ static int run(int argc, char **argv) {
             log_event(&L, event("task_start", &T));
             trc = run_task(&J, &T, ident, h, sc, &L, J.threads);
         }
+        if (lk >= 0) close(lk); /* the lock goes with the descriptor */
         if (trc) {
             status = "failed";
             ++failed;
+            if (trc != BT_EXIT_BAD_INPUT || !worst) worst = trc;
         } else if (strcmp(status, "skipped")) {
             ++done;
         }
@@ -1345,18 +1783,27 @@ static int run(int argc, char **argv) {
         task_free(&T);
         if (trc && fail_fast) break;
     }
+    free(busy);
     if (L.bar) fprintf(stderr, "\n");
-    if (!failed && J.sheet && lo == 0 && hi == nt && fa < 0) rc = contact_sheet(&J, nt, &L);
+    if (!rc && !failed && J.sheet && lo == 0 && hi == nt && fa < 0) rc = contact_sheet(&J, nt, &L);
     cJSON *e = event("job_end", NULL);
     cJSON_AddNumberToObject(e, "done", (double)done);
     cJSON_AddNumberToObject(e, "skipped", (double)skipped);
     cJSON_AddNumberToObject(e, "failed", (double)failed);
     log_event(&L, e);
-    if (L.f && L.f != stdout) fclose(L.f);
+    if (L.f && L.f != stdout && fclose(L.f) != 0 && !L.failed) {
+        L.failed = 1;
+        L.err = errno;
+    }
+    if (L.failed) {
+        bt_error(CMD, "%s: writing the log failed (%s); the outputs and manifests are complete",
+                 logpath ? logpath : "standard output", strerror(L.err));
+        if (!rc) rc = BT_EXIT_INTERNAL;
+    }
     fprintf(stderr, "blendtool batch: %s: %zu done, %zu skipped (complete), %zu failed\n", J.name,
             done, skipped, failed);
     job_free(&J);
-    return rc ? rc : failed ? BT_EXIT_INTERNAL : BT_EXIT_OK;
+    return rc ? rc : failed ? worst : BT_EXIT_OK;
 }
 
 const bt_command bt_cmd_batch = {

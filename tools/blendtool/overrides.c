@@ -9,6 +9,7 @@
 #include <cjson/cJSON.h>
 #include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <xxhash.h>
@@ -53,21 +54,50 @@ char *bt_read_file(const char *path, size_t max, size_t *len, char *why, size_t 
     return buf;
 }
 
+/* every number in v is finite (cJSON reads 1e999 as infinity) */
+static int all_finite(const cJSON *v) {
+    if (cJSON_IsNumber(v)) return isfinite(v->valuedouble);
+    for (const cJSON *c = v->child; c; c = c->next)
+        if (!all_finite(c)) return 0;
+    return 1;
+}
+
 int bt_set_parse(const char *cmd, const char *arg, bt_set *out) {
     const char *eq = strchr(arg, '=');
     if (!eq || eq == arg) {
         bt_error(cmd, "--set %s: expected PATH=VALUE, e.g. --set root.args[0].radius=0.5", arg);
         return -1;
     }
-    cJSON *v = cJSON_Parse(eq + 1);
+    cJSON *v = cJSON_ParseWithOpts(eq + 1, NULL, 1); /* nothing may follow the value */
     if (!v) {
         bt_error(cmd,
-                 "--set %s: the value %s is not JSON; allowed: a number, true, false, null, a "
-                 "\"quoted string\", an array or an object",
+                 "--set %s: the value %s is not one JSON value; allowed: a number, true, false, "
+                 "null, a \"quoted string\", an array or an object, with nothing after it",
                  arg, eq + 1);
         return -1;
     }
+    const int finite = all_finite(v);
     cJSON_Delete(v);
+    if (!finite) {
+        bt_error(cmd,
+                 "--set %s: the value %s holds a number beyond the range of a double; allowed: "
+                 "finite numbers (magnitude below 1.8e308)",
+                 arg, eq + 1);
+        return -1;
+    }
+    for (const char *c = arg; c < eq; ++c)
+        if (*c == '[') { /* an index: digits, no leading zero */
+            const char *d = c + 1;
+            size_t nd = 0;
+            while (d + nd < eq && isdigit((unsigned char)d[nd])) ++nd;
+            if (!nd || d + nd >= eq || d[nd] != ']' || (nd > 1 && d[0] == '0') || nd > 9) {
+                bt_error(cmd,
+                         "--set %s: the index at \"%.*s\" is not [N]; allowed: [0], [1], ... "
+                         "without leading zeros",
+                         arg, (int)(eq - c), c);
+                return -1;
+            }
+        }
     out->path = arg;
     out->plen = (size_t)(eq - arg);
     out->value = eq + 1;
@@ -93,8 +123,10 @@ static int apply_one(cJSON *doc, const bt_set *s, char *why, size_t whylen) {
         if (*p == '[') {
             char *e2 = NULL;
             index = strtol(p + 1, &e2, 10);
-            if (!e2 || e2 >= end || *e2 != ']' || index < 0 || e2 == p + 1) {
-                snprintf(why, whylen, "after %s: expected [INDEX] with INDEX >= 0", where);
+            if (!e2 || e2 >= end || *e2 != ']' || index < 0 || e2 == p + 1 ||
+                !isdigit((unsigned char)p[1]) || (e2 - p > 2 && p[1] == '0') || e2 - p > 10) {
+                snprintf(why, whylen,
+                         "after %s: expected [INDEX], INDEX digits without leading zeros", where);
                 return -1;
             }
             p = e2 + 1;
@@ -143,9 +175,13 @@ static int apply_one(cJSON *doc, const bt_set *s, char *why, size_t whylen) {
         snprintf(why, whylen, "the path is empty; allowed: a path such as root.args[0].radius");
         return -1;
     }
-    cJSON *v = cJSON_Parse(s->value);
-    if (!v) {
-        snprintf(why, whylen, "out of memory");
+    cJSON *v = cJSON_ParseWithOpts(s->value, NULL, 1);
+    if (!v || !all_finite(v)) {
+        cJSON_Delete(v);
+        snprintf(why, whylen,
+                 "the value %.60s is not one finite JSON value; allowed: a number, true, false, "
+                 "null, a \"quoted string\", an array or an object",
+                 s->value);
         return -1;
     }
     if (index >= 0) {
