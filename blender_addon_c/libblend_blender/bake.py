@@ -19,9 +19,10 @@ meshed instead, and the status says so).
 """
 import json
 import os
-import tempfile
 
 import bpy
+
+from . import atomic
 
 FORMAT = "libblend-bake"
 VERSION = 1
@@ -61,7 +62,7 @@ def write(path, mesh, key, frame, resolution, name):
     import numpy as np
     d = os.path.dirname(path)
     os.makedirs(d, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".frame-", suffix=".tmp", dir=d)
+    fd, tmp = atomic.temp_beside(path, ".frame-")
     info = {"format": FORMAT, "version": VERSION, "frame": frame, "resolution": resolution,
             "field": name}
     arrays = {}
@@ -75,7 +76,7 @@ def write(path, mesh, key, frame, resolution, name):
                      normals=np.asarray(mesh.normals, dtype=np.float32),
                      triangles=np.asarray(mesh.triangles, dtype=np.int32),
                      key=np.array(key), meta=np.array(meta), **arrays)
-        os.replace(tmp, path)
+        atomic.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)

@@ -3,14 +3,13 @@ problems in Blender's status bar instead of raising."""
 import json
 import os
 import shutil
-import tempfile
 
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, IntProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 from mathutils import Matrix
 
-from . import bake, binding, compat, live, props, render_section, tree
+from . import atomic, bake, binding, compat, live, props, render_section, tree
 
 
 def _active(context):
@@ -312,12 +311,11 @@ class LIBBLEND_OT_reload_library(bpy.types.Operator):
 
 
 def _atomic_write(path, text):
-    d = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".libblend-", dir=d)
+    fd, tmp = atomic.temp_beside(path, ".libblend-")
     try:
         with os.fdopen(fd, "w") as f:
             f.write(text)
-        os.replace(tmp, path)
+        atomic.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.unlink(tmp)
@@ -520,8 +518,15 @@ class LIBBLEND_OT_export_pov(bpy.types.Operator, ExportHelper):
             inc = include_file()
             dst = os.path.join(os.path.dirname(os.path.abspath(self.filepath)), "libblend.inc")
             if inc and os.path.abspath(inc) != dst:  # render with: povray +I<file> (no +L needed)
-                shutil.copyfile(inc, dst + ".tmp")
-                os.replace(dst + ".tmp", dst)
+                fd, tmp = atomic.temp_beside(dst, ".libblend-")
+                os.close(fd)
+                try:
+                    shutil.copyfile(inc, tmp)
+                    atomic.replace(tmp, dst)
+                except BaseException:
+                    if os.path.exists(tmp):
+                        os.unlink(tmp)
+                    raise
         except (tree.TreeError, binding.LibblendError) as e:
             return _refused(self, e, paths)
         except OSError as e:

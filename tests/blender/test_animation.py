@@ -268,12 +268,20 @@ for f, (mm, ii) in {2: (part_m, part_i), 4: (part_m, part_i), 3: (one_m, one_i)}
 
 # ---------------------------------------------------------------- bake
 activate(out)
+os.umask(0o022)  # so that the mode check below tells 0644 from mkstemp's 0600
 check(bpy.ops.libblend.bake(frame_start=1, frame_end=4) == {"FINISHED"}, "bake")
 folder = bake.folder(out)
 check(folder == os.path.join(WORK, "libblend_cache", "anim"), "next to the .blend: " + folder)
 check(bake.frames(folder) == list(FRAMES), "one file per frame: %s" % bake.frames(folder))
 check(not [n for n in os.listdir(folder) if not n.startswith("frame_")], "no temporary files")
 print("bake:", out.libblend.bake_info)
+# a render node running as another user reads the bake: the files' mode is
+# 0666 less the umask, as any Unix tool's (mkstemp alone leaves 0600)
+_umask = os.umask(0o022)
+os.umask(_umask)
+for f in FRAMES:
+    mode = os.stat(bake.frame_path(folder, f)).st_mode & 0o777
+    check(mode == 0o666 & ~_umask, "baked frame %d mode %o, expected %o" % (f, mode, 0o666 & ~_umask))
 for f in FRAMES:
     c = bake.read(bake.frame_path(folder, f))
     i = meshcheck.check(c.positions.astype(np.float64), c.triangles.astype(np.int64))
