@@ -403,6 +403,87 @@ static void test_every_null_combination(void **state) {
     assert_true(failures_checked > 2000);
 }
 
+/* Misuse beyond NULL, as a binding might commit it: counts that disagree
+ * with their pointers, NaN and inverted boxes, negative thread counts, huge
+ * coordinates. Each must be refused with a message (or, for functions
+ * without a status, leave the output untouched or finite), never crash or
+ * return a wrong answer with status 0. */
+static void test_misuse_shapes(void **state) {
+    (void)state;
+    long refused = 0;
+#define REFUSED(call)                                                                              \
+    do {                                                                                           \
+        lb_error e_ = {LB_OK, ""};                                                                 \
+        const lb_status s_ = (call);                                                               \
+        (void)e_;                                                                                  \
+        if (s_ != LB_ERR_INVALID_ARGUMENT || !e_.message[0])                                       \
+            fail_msg("%s: status %d \"%s\"", #call, s_, e_.message);                               \
+        ++refused;                                                                                 \
+    } while (0)
+    /* a mesh whose counts disagree with its arrays */
+    lb_mesh bad = *C.mesh;
+    bad.triangles = NULL;
+    bad.ntriangles = 5;
+    uint32_t edges[64], corner[64];
+    size_t ne = 0;
+    REFUSED(lb_mesh_edges(&bad, edges, corner, &ne, &e_));
+    bad = *C.mesh;
+    bad.nvertices = 0; /* triangles naming vertices that are not there */
+    static uint32_t ed2[1u << 20], ce2[1u << 20];
+    if (3 * bad.ntriangles <= (1u << 20)) REFUSED(lb_mesh_edges(&bad, ed2, ce2, &ne, &e_));
+    /* boxes: NaN, inverted, beyond the coordinate range; negative threads */
+    const double up[3] = {0, 0, 1}, zero[3] = {0, 0, 0};
+    const double lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, nan3[3] = {NAN, 0, 0},
+                 big3[3] = {1e300, 1, 1};
+    double h = 12345.0, blo, bhi;
+    REFUSED(lb_render_floor_height(C.ev, lo, hi, up, -5, &h, &e_));
+    REFUSED(lb_render_floor_height(C.ev, nan3, hi, up, 1, &h, &e_));
+    REFUSED(lb_render_floor_height(C.ev, hi, lo, up, 1, &h, &e_));
+    REFUSED(lb_render_floor_height(C.ev, lo, big3, up, 1, &h, &e_));
+    REFUSED(lb_render_floor_height(C.ev, lo, hi, zero, 1, &h, &e_));
+    assert_true(h == 12345.0); /* untouched on refusal */
+    REFUSED(lb_evaluator_bounds(C.ev, nan3, hi, &blo, &bhi, &e_));
+    REFUSED(lb_evaluator_bounds(C.ev, hi, lo, &blo, &bhi, &e_));
+    double px = 0, py = 0, pz = 0, v = 0;
+    REFUSED(lb_evaluator_eval(C.ev, 1, &px, &py, &pz, &v, NULL, NULL, NULL, -5, &e_));
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    memcpy(o.bmin, hi, sizeof o.bmin);
+    memcpy(o.bmax, lo, sizeof o.bmax);
+    o.resolution = 8;
+    lb_mesh *m = NULL;
+    REFUSED(lb_mesh_create(C.ev, &o, &m, &e_));
+    memcpy(o.bmin, nan3, sizeof o.bmin);
+    memcpy(o.bmax, hi, sizeof o.bmax);
+    REFUSED(lb_mesh_create(C.ev, &o, &m, &e_));
+    memcpy(o.bmin, lo, sizeof o.bmin);
+    o.threads = -5;
+    REFUSED(lb_mesh_create(C.ev, &o, &m, &e_));
+    assert_null(m);
+    /* a camera very far away: the lights are finite and around the target */
+    const double far[3] = {1e200, -3e199, 2e199}, at[3] = {0, 0, 0};
+    lb_render_light L[3];
+    memset(L, 0, sizeof L);
+    lb_render_three_point(far, at, up, L);
+    for (int k = 0; k < 3; ++k) {
+        double n2 = 0.0;
+        for (int d = 0; d < 3; ++d) {
+            assert_true(isfinite(L[k].location[d]));
+            n2 += L[k].location[d] / 1e200 * (L[k].location[d] / 1e200);
+        }
+        assert_true(n2 > 0.01 && L[k].color[0] > 0.0); /* placed, at the camera's scale */
+    }
+    /* one beyond what a double holds: nothing written */
+    const double huge[3] = {1.7e308, -1.7e308, 0};
+    memset(L, 0, sizeof L);
+    lb_render_three_point(huge, at, up, L);
+    for (int k = 0; k < 3; ++k)
+        for (int d = 0; d < 3; ++d) assert_true(L[k].location[d] == 0.0 && isfinite(L[k].color[d]));
+#undef REFUSED
+    printf("%ld misuse shapes refused with a message\n", refused);
+    assert_true(refused >= 12);
+}
+
 static int setup(void **state) {
     (void)state;
     lb_error e = {LB_OK, ""};
@@ -426,6 +507,7 @@ static int teardown(void **state) {
 }
 
 int main(void) {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_every_null_combination)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_every_null_combination),
+                                       cmocka_unit_test(test_misuse_shapes)};
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -48,7 +48,9 @@ LB_API const char *lb_output_temp_name(const lb_output *output);
 
 /* Flush and close; when every write succeeded, put the file in place
  * (link or rename), else remove it and fail with LB_ERR_IO naming the path
- * and the reason. Frees output; NULL is refused. */
+ * and the reason. Frees output; NULL is refused. Like free(), a second
+ * commit or discard of the same output is misuse that cannot be detected
+ * (the handle is gone): set your copy to NULL after either call. */
 LB_API lb_status lb_output_commit(lb_output *output, lb_error *err);
 
 /* Close and remove the temporary file; nothing reaches the path (a device

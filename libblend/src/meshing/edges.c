@@ -34,6 +34,11 @@ lb_status lb_mesh_edges(const lb_mesh *mesh, uint32_t *edges, uint32_t *corner_e
                         "%s: %zu triangles; allowed: at most %u (32-bit corner indices)", fn, nt,
                         (unsigned)(UINT32_MAX / 3));
     const uint32_t *T = mesh->triangles;
+    if (!T)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: the mesh has %zu triangles but no triangle array; allowed: a mesh "
+                        "from lb_mesh_create, or triangles non-NULL whenever ntriangles > 0",
+                        fn, nt);
     for (size_t q = 0; q < nc; ++q)
         if (T[q] >= nv)
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
