@@ -3,8 +3,32 @@
 #define _POSIX_C_SOURCE 200809L
 #include "blendtool.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+
+/* the input rules of scene files: a regular file (no FIFO or device that
+ * could block or never end), of a bounded size */
+#define BT_MAX_IMAGE_BYTES ((off_t)1 << 30)
+static int image_file_ok(const char *path) {
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        bt_error("compare", "%s: cannot open the image (%s)", path, strerror(errno));
+        return 0;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        bt_error("compare", "%s: not a regular file; allowed: an image file (PNG, EXR, TIFF, ...)",
+                 path);
+        return 0;
+    }
+    if (st.st_size > BT_MAX_IMAGE_BYTES) {
+        bt_error("compare", "%s: %lld bytes; allowed: image files of at most %lld bytes", path,
+                 (long long)st.st_size, (long long)BT_MAX_IMAGE_BYTES);
+        return 0;
+    }
+    return 1;
+}
 
 static int number(const char *opt, const char *v, double lo, double hi, double *out) {
     char *end = NULL;
@@ -43,6 +67,7 @@ static int run(int argc, char **argv) {
         bt_error("compare", "two images needed; usage: blendtool compare A B");
         return BT_EXIT_BAD_INPUT;
     }
+    if (!image_file_ok(a) || !image_file_ok(b)) return BT_EXIT_BAD_INPUT;
     double mx = 0.0, mean = 0.0, pct = 0.0;
     char err[1024] = "the image writer is not available (above)";
     const bt_imageio *io = NULL;
@@ -64,6 +89,9 @@ const bt_command bt_cmd_compare = {
     "fails when a channel differs by more than T (default 0.004, about one step of\n"
     "an 8-bit image); the images match when at most P %% of the pixels fail\n"
     "(default 0). Prints MATCH or DIFFER with the largest and mean differences.\n"
+    "The headers are read first: sizes are compared, and an image of more than\n"
+    "67108864 pixels (8192 x 8192) or 16 channels refused, before any pixel is\n"
+    "decoded; an image must be a regular file of at most 1 GiB.\n"
     "Exit status: 0 match, 3 the images differ, 2 an image cannot be read, the sizes\n"
-    "differ or bad options.\n",
+    "differ, an image over a limit or bad options.\n",
     run};

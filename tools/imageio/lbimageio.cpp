@@ -5,6 +5,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <OpenImageIO/strutil.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -120,6 +121,16 @@ extern "C" int lbi_contact_sheet(const char *const *images, const char *const *l
     for (size_t i = 0; i < n; ++i) {
         ImageBuf img;
         if (read_rgb(images[i], false, img, err, errlen)) return -1;
+        // the sheet is an sRGB-encoded image: linear light (EXR outputs)
+        // is encoded as sRGB first, or it shows far too dark
+        const std::string cs = img.spec().get_string_attribute("oiio:ColorSpace");
+        if (Strutil::iequals(cs, "linear") || Strutil::iequals(cs, "lin_srgb") ||
+            Strutil::iequals(cs, "scene_linear") ||
+            (cs.empty() && Strutil::iequals(img.file_format_name(), "openexr"))) {
+            img = ImageBufAlgo::colorconvert(img, "linear", "sRGB", true);
+            if (img.has_error())
+                return fail(err, errlen, images[i] + std::string(": ") + img.geterror());
+        }
         ImageBuf cell = ImageBufAlgo::resize(img, "", 0.0f, ROI(0, cell_w, 0, cell_h, 0, 1, 0, 3));
         if (cell.has_error())
             return fail(err, errlen, images[i] + std::string(": ") + cell.geterror());
@@ -142,6 +153,32 @@ extern "C" int lbi_contact_sheet(const char *const *images, const char *const *l
 extern "C" int lbi_compare(const char *a, const char *b, double failv, double *max_error,
                            double *mean_error, double *fail_percent, char *err, size_t errlen) {
     if (!a || !b) return fail(err, errlen, "lbi_compare: NULL argument");
+    // the headers first: sizes checked before any pixel is decoded, so a
+    // small file declaring a huge image costs nothing
+    ImageSpec ha, hb;
+    for (int i = 0; i < 2; ++i) {
+        const char *path = i ? b : a;
+        auto in = ImageInput::open(path);
+        if (!in) return fail(err, errlen, std::string(path) + ": " + OIIO::geterror());
+        (i ? hb : ha) = in->spec();
+        in->close();
+        const ImageSpec &h = i ? hb : ha;
+        const double px = (double)h.width * (double)h.height * (double)(h.depth > 0 ? h.depth : 1);
+        if (h.width < 1 || h.height < 1 || px > (double)LBI_MAX_PIXELS || h.nchannels < 1 ||
+            h.nchannels > LBI_MAX_CHANNELS)
+            return fail(err, errlen,
+                        std::string(path) + ": declares " + std::to_string(h.width) + "x" +
+                            std::to_string(h.height) + " pixels of " + std::to_string(h.nchannels) +
+                            " channels; allowed: at most " + std::to_string(LBI_MAX_PIXELS) +
+                            " pixels and " + std::to_string(LBI_MAX_CHANNELS) + " channels");
+    }
+    if (ha.width != hb.width || ha.height != hb.height || ha.nchannels != hb.nchannels)
+        return fail(err, errlen,
+                    std::string("the images differ in size: ") + a + " is " +
+                        std::to_string(ha.width) + "x" + std::to_string(ha.height) + "x" +
+                        std::to_string(ha.nchannels) + ", " + b + " is " +
+                        std::to_string(hb.width) + "x" + std::to_string(hb.height) + "x" +
+                        std::to_string(hb.nchannels));
     ImageBuf A(a), B(b);
     if (!A.read(0, 0, true, TypeDesc::FLOAT))
         return fail(err, errlen, std::string(a) + ": " + A.geterror());

@@ -44,7 +44,11 @@ int lbi_contact_sheet(const char *const *images, const char *const *labels, size
 /* Compare two images channel by channel (OpenImageIO's compare): *max_error
  * the largest difference, *fail_percent the share of pixels with a channel
  * differing by more than fail. Different sizes or channel counts are an
- * error (-1). */
+ * error (-1). The headers are read first: an image declaring more than
+ * LBI_MAX_PIXELS pixels or LBI_MAX_CHANNELS channels is an error before any
+ * pixel is decoded (the caller refuses what is not a regular file). */
+#define LBI_MAX_PIXELS (1L << 26) /* 8192 x 8192: 1 GiB as 4 float channels */
+#define LBI_MAX_CHANNELS 16
 int lbi_compare(const char *a, const char *b, double fail, double *max_error, double *mean_error,
                 double *fail_percent, char *err, size_t errlen);
 
