@@ -20,6 +20,7 @@ PACKAGES=(
   fonts-dejavu-core          # the contact sheets' labels
   slurm-wlm munge            # tests: batch jobs on a single-node Slurm cluster (scripts/slurm-cluster.sh)
   parallel                   # tests: batch task lists through GNU parallel
+  time                       # tests: GNU time measures blendtool's peak memory (input limits)
 )
 
 

@@ -439,7 +439,7 @@ static void test_limits(void **state) {
     }
     len += (size_t)snprintf(many + len, cap - len, "]}]}}");
     assert_true(len < cap);
-    expect(many, strlen(many), LB_ERR_NO_MEMORY,
+    expect(many, strlen(many), LB_ERR_INVALID_ARGUMENT,
            (const char *const[3]){"more than 100000 nodes", "allowed: at most 100000 nodes"});
     free(inner);
     free(many);

@@ -29,6 +29,13 @@ extern "C" {
 #define LB_SCENE_MAX_BYTES (64u * 1024u * 1024u) /* scene file size */
 #define LB_SCENE_MAX_DEPTH 64                    /* nesting of nodes below the root */
 #define LB_SCENE_MAX_NODES 100000                /* nodes in one scene, refs included */
+/* What a scene of LB_SCENE_MAX_NODES nodes can hold, checked on the text
+ * before it is parsed (a node is one object, with a few more for its
+ * material and parameters; at most 8 arrays and 40 values each): a file
+ * beyond them cannot be a scene, and is refused without building a tree. */
+#define LB_SCENE_MAX_JSON_OBJECTS (4 * LB_SCENE_MAX_NODES + 64)
+#define LB_SCENE_MAX_JSON_ARRAYS (8 * LB_SCENE_MAX_NODES + 64)
+#define LB_SCENE_MAX_JSON_VALUES (40 * LB_SCENE_MAX_NODES + 1024)
 #define LB_SCENE_MAX_LIGHTS 16
 /* Bulge-eliminated blends nested inside each other's arguments: each level
  * re-evaluates its arguments 4 times for the Hessian terms of its gradient. */
@@ -47,6 +54,15 @@ extern "C" {
 /* Largest |coordinate| anywhere in a scene (centres, translations, bounds)
  * and of evaluation points. */
 #define LB_SCENE_MAX_COORD 1e9
+/* Compile-time work of local unions (their intersection curves are found
+ * by evaluating both children on a grid and along the curves): counted in
+ * instruction runs as it is done; lb_evaluator_create stops and refuses
+ * the scene (LB_ERR_INVALID_ARGUMENT, naming the local_union) once it
+ * passes the limit, which this machine reaches in a few seconds. A local
+ * union met inside a child counts as LB_LOCAL_RUN_WEIGHT instructions
+ * (its curve query and two blends). */
+#define LB_SCENE_MAX_COMPILE_COST 5e8
+#define LB_LOCAL_RUN_WEIGHT 16
 
 typedef struct lb_scene lb_scene;
 typedef struct lb_evaluator lb_evaluator;
@@ -174,6 +190,12 @@ LB_API size_t lb_evaluator_size(const lb_evaluator *ev);
 /* Instruction runs one point costs (the cost model above): at least
  * lb_evaluator_size, at most LB_SCENE_MAX_COST_FACTOR times it. 0 for NULL. */
 LB_API double lb_evaluator_cost(const lb_evaluator *ev);
+
+/* Instruction runs that compiling took to find the local unions' curves
+ * (every child evaluation and interval pass over a child's instructions; a
+ * nested local union counts LB_LOCAL_RUN_WEIGHT runs): at most
+ * LB_SCENE_MAX_COMPILE_COST. 0 for NULL or a scene without local unions. */
+LB_API double lb_evaluator_compile_cost(const lb_evaluator *ev);
 
 /* The intersection curves and blending volumes of the local_union nodes,
  * as text (one line per node, one per curve: vertices, length, diameter,

@@ -908,7 +908,7 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
                     "and refs to share subtrees)",
                     LB_SCENE_MAX_DEPTH, LB_SCENE_MAX_DEPTH);
     if (++c->count > LB_SCENE_MAX_NODES)
-        return perr(c, LB_ERR_NO_MEMORY, "more than %d nodes; allowed: at most %d nodes",
+        return perr(c, LB_ERR_INVALID_ARGUMENT, "more than %d nodes; allowed: at most %d nodes",
                     LB_SCENE_MAX_NODES, LB_SCENE_MAX_NODES);
     if (cJSON_GetObjectItemCaseSensitive(j, "ref")) return parse_ref(c, j, depth, out);
     const char *type = NULL;
@@ -1330,6 +1330,17 @@ static lb_status parse_document(pctx *c, const cJSON *root) {
             c->defs = calloc(nd ? nd : 1, sizeof *c->defs);
             if (!c->defs) s = oom(c);
             for (const cJSON *d = defs->child; d && !s; d = d->next) {
+                /* a def's name goes into node paths, messages, `info` and
+                 * POV-Ray comments: one line of text, nothing to escape */
+                for (const unsigned char *q = (const unsigned char *)d->string; *q && !s; ++q)
+                    if (*q < 0x20 || *q == 0x7f)
+                        s = perr(c, LB_ERR_INVALID_ARGUMENT,
+                                 "def \"%.60s\" has a control character; allowed: names "
+                                 "without control characters (no newline, tab, ...)",
+                                 d->string);
+                if (!*d->string)
+                    s = perr(c, LB_ERR_INVALID_ARGUMENT,
+                             "a def with an empty name; allowed: a non-empty name");
                 for (size_t i = 0; i < c->ndefs; ++i)
                     if (strcmp(c->defs[i].name, d->string) == 0)
                         s = perr(c, LB_ERR_INVALID_ARGUMENT,
@@ -1410,9 +1421,13 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: the scene is %zu bytes; allowed: at most %u bytes", file, length,
                         LB_SCENE_MAX_BYTES);
-    /* nesting pre-scan, outside strings */
+    /* Pre-scan, outside strings, allocating nothing: the nesting, and the
+     * number of objects, arrays and values (commas), each capped at what a
+     * scene of LB_SCENE_MAX_NODES nodes can hold (scene.h), so a file that
+     * cannot be a scene (63 MB of []) is refused before any parser builds a
+     * tree of it. */
     {
-        size_t depth = 0, line = 1, col = 1;
+        size_t depth = 0, line = 1, col = 1, nobj = 0, narr = 0, nval = 0;
         int in_str = 0, esc = 0;
         for (size_t i = 0; i < length; ++i) {
             const char ch = text[i];
@@ -1430,6 +1445,21 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
                     in_str = 0;
                 continue;
             }
+            const char *over = NULL;
+            size_t cap = 0;
+            if (ch == '{' && ++nobj > LB_SCENE_MAX_JSON_OBJECTS)
+                over = "objects", cap = LB_SCENE_MAX_JSON_OBJECTS;
+            else if (ch == '[' && ++narr > LB_SCENE_MAX_JSON_ARRAYS)
+                over = "arrays", cap = LB_SCENE_MAX_JSON_ARRAYS;
+            else if ((ch == ',' || ch == '[' || ch == '{') && ++nval > LB_SCENE_MAX_JSON_VALUES)
+                over = "values", cap = LB_SCENE_MAX_JSON_VALUES;
+            if (over)
+                return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                                "%s:%zu:%zu: more than %zu JSON %s; allowed: what a scene of at "
+                                "most %d nodes holds (at most %d objects, %d arrays, %d values)",
+                                file, line, col - 1, cap, over, LB_SCENE_MAX_NODES,
+                                LB_SCENE_MAX_JSON_OBJECTS, LB_SCENE_MAX_JSON_ARRAYS,
+                                LB_SCENE_MAX_JSON_VALUES);
             if (ch == '"')
                 in_str = 1;
             else if (ch == '[' || ch == '{') {
@@ -1443,6 +1473,10 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
                 --depth;
         }
     }
+    /* the strict check first, alone: its tree is freed before cJSON builds
+     * one, so the peak is one parser's tree, not both; its message is given
+     * only when cJSON accepted the text (cJSON's messages come first) */
+    const lb_status strict = strict_json(text, length, file, err);
     const char *end = NULL;
     cJSON *doc = cJSON_ParseWithLengthOpts(text, length, &end, 0);
     if (!doc) {
@@ -1480,10 +1514,9 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
                             file, line, col);
         }
     }
-    lb_status strict = strict_json(text, length, file, err);
     if (strict) {
         cJSON_Delete(doc);
-        return strict;
+        return strict_json(text, length, file, err); /* its message again, over any later one */
     }
     lb_scene *s = calloc(1, sizeof *s);
     if (!s) {
