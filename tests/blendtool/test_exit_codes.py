@@ -64,6 +64,112 @@ def write(name, text):
     return p
 
 
+def careless_rows():
+    """What careless users tried (issue 28): each gets its documented code, a
+    message naming the place and what is allowed, and nothing created."""
+    global rows
+    sph = {"type": "sphere", "center": [0, 0, 0], "radius": 1}
+    many = write("many.json", json.dumps({
+        "format": "libblend-scene", "version": 1, "convention": "zero",
+        "bounds": {"min": [-1] * 3, "max": [1] * 3},
+        "defs": {"a": {"type": "min", "args": [sph] * 60000}},
+        "root": {"type": "min", "args": [{"ref": "a"}] + [sph] * 50000}}))
+    o = os.path.join(WORK, "many.ply")
+    for cmd, extra in (("validate", []), ("info", []), ("mesh", ["-q", "-o", o])):
+        expect(f"{cmd}: over 100000 nodes", [cmd, many, *extra], 2, "more than 100000 nodes", many,
+               [o])
+    nl = write("nl.json", json.dumps({"format": "libblend-scene", "version": 1,
+                                      "convention": "zero", "defs": {"a\nb": sph},
+                                      "root": {"ref": "a\nb"}}))
+    expect("info: a def name with a newline", ["info", nl], 2, "control character", nl)
+    # local unions' compile work counts against its limit as it is done: a
+    # flat local_union of 256 spheres (a left fold: each fold evaluates all
+    # before it) is refused with the node's path, in seconds, by every command
+    import math
+    import time
+    ring = [{"type": "sphere", "radius": 0.3,
+             "center": [1.5 * math.cos(2 * math.pi * i / 256), 1.5 * math.sin(2 * math.pi * i / 256),
+                        0.2 * math.sin(7 * i)]} for i in range(256)]
+    flat = write("flat-local.json", json.dumps({
+        "format": "libblend-scene", "version": 1, "convention": "zero",
+        "bounds": {"min": [-3] * 3, "max": [3] * 3},
+        "root": {"type": "local_union", "args": ring}}))
+    for cmd, extra in (("validate", []), ("info", []), ("mesh", ["-q", "-o", o])):
+        t = time.monotonic()
+        expect(f"{cmd}: a local union over the compile-cost limit", [cmd, flat, *extra], 2,
+               "compile-cost limit", "$.root", [o])
+        if time.monotonic() - t > 60:
+            fail(f"{cmd}: the compile-cost refusal took {time.monotonic() - t:.0f} s")
+    # --set values and paths
+    for v, what in (("root.r=0.5junk", "not one JSON value"), ("root.r=1=2", "not one JSON value"),
+                    ("root.r=0.5]", "not one JSON value"), ("root.r=1e999", "beyond the range"),
+                    ("root.args[01].radius=0.5", "leading zeros"),
+                    ("root.args[+1].radius=0.5", "leading zeros")):
+        expect(f"mesh --set {v}", ["mesh", S1, "-q", "--set", v, "-o", o], 2, what, v, [o])
+    # batch: refused jobs create nothing
+    d = os.path.join(WORK, "careless")
+    os.makedirs(d, exist_ok=True)
+    outdir = os.path.join(d, "out")
+
+    def job(name, **kw):
+        j = {"format": "libblend-job", "version": 1, "scene": S1,
+             "outputs": {"mesh": {"resolution": 8}}}
+        j.update(kw)
+        return write(os.path.join("careless", name + ".json"), json.dumps(j))
+    cases = [
+        ("a bad set path", job("badset", set={"root.nope.radius": 1}), "root.nope"),
+        ("/etc/passwd as the scene", job("passwd", scene="/etc/passwd"), "/etc/passwd"),
+        ("a sweep over the whole double range",
+         job("huge", sweep=[{"path": "root.r", "range": {"from": -1e308, "to": 1e308, "count": 3}}]),
+         "magnitude"),
+    ]
+    for label, path, what in cases:
+        for extra in ([], ["--list"]):
+            expect(f"batch {extra}: {label}", ["batch", path, *extra], 2, what, None, [outdir])
+    plain = job("plain")
+    expect("batch --frames -1-2", ["batch", plain, "--frames", "-1-2"], 2, "0 <= A <= B", None,
+           [outdir])
+    expect("batch --frames 2-2 without frames", ["batch", plain, "--frames", "2-2"], 2,
+           "no \"frames\"", None, [outdir])
+    expect("batch --sheet on a mesh-only job", ["batch", plain, "--sheet"], 2, "no image outputs",
+           None, [outdir])
+    # compare on hostile images: the header's size is refused before any pixel
+    # is decoded (a 40000 x 40000 PNG of a few hundred bytes), a FIFO or a
+    # device is not read at all
+    import struct
+    import zlib
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    huge_png = os.path.join(WORK, "huge.png")
+    with open(huge_png, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 40000, 40000, 8, 6, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(b"\0" * 160001 * 4)) + chunk(b"IEND", b""))
+    small = os.path.join(WORK, "small.png")
+    with open(small, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2, 2, 8, 2, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(b"\0" + b"\x10" * 6 + b"\0" + b"\x20" * 6))
+                + chunk(b"IEND", b""))
+    expect("compare: a small PNG declaring 40000 x 40000", ["compare", huge_png, small], 2,
+           "declares 40000x40000", huge_png)
+    expect("compare: sizes differ", ["compare", small, huge_png], 2, "allowed", huge_png)
+    expect("compare: /dev/zero", ["compare", "/dev/zero", small], 2, "not a regular file",
+           "/dev/zero")
+    fifo = os.path.join(WORK, "img-fifo")
+    if not os.path.exists(fifo):
+        os.mkfifo(fifo)
+    expect("compare: a FIFO", ["compare", small, fifo], 2, "not a regular file", fifo)
+    expect("compare: the same image", ["compare", small, small], 0)
+    # a log that cannot be written: exit 1 and said, the outputs complete
+    rows += 1
+    r = bt("batch", plain, "--log", "/dev/full")
+    err = r.stderr.decode(errors="replace")
+    if r.returncode != 1 or "writing the log failed" not in err or "/dev/full" not in err:
+        fail(f"batch --log /dev/full: exit {r.returncode}: {err!r}")
+    if not os.path.exists(os.path.join(outdir, "plain_0000.ply")):
+        fail("batch --log /dev/full: the task's output is missing")
+
+
 def main():
     out = {ext: os.path.join(WORK, "out." + ext) for ext in ("ply", "pov", "png", "txt")}
     outputs = [("mesh", ["mesh", S1, "--resolution", "16", "-q", "--format", "ply", "-o"],
@@ -214,6 +320,7 @@ def main():
                 fail(f"{name}: temporary files left: {left}")
     finally:
         os.umask(old)
+    careless_rows()
     print(f"{rows} exit-status and output-path rows checked")
     if rows < 60:
         fail(f"only {rows} rows")

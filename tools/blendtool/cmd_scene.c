@@ -122,6 +122,7 @@ static int run_info(int argc, char **argv) {
         cJSON_AddNumberToObject(o, "depth", (double)st.depth);
         cJSON_AddNumberToObject(o, "instructions", (double)lb_evaluator_size(ev));
         cJSON_AddNumberToObject(o, "cost_per_point", lb_evaluator_cost(ev));
+        cJSON_AddNumberToObject(o, "compile_cost", lb_evaluator_compile_cost(ev));
         cJSON_AddStringToObject(o, "tree", tree);
         cJSON_AddStringToObject(o, "local_blends", curves);
         char *txt = o ? cJSON_Print(o) : NULL;
@@ -143,8 +144,10 @@ static int run_info(int argc, char **argv) {
         printf("nodes: %zu (%zu primitives, %zu operators), depth %zu\n", st.nodes, st.primitives,
                st.operators, st.depth);
         printf("instructions: %zu\ncost: %.0f instruction runs per point (at most %d x the "
-               "instructions)\ntree:\n%s",
-               lb_evaluator_size(ev), lb_evaluator_cost(ev), LB_SCENE_MAX_COST_FACTOR, tree);
+               "instructions)\ncompile cost: %.0f instruction runs (local unions' curves; at most "
+               "%.0f)\ntree:\n%s",
+               lb_evaluator_size(ev), lb_evaluator_cost(ev), LB_SCENE_MAX_COST_FACTOR,
+               lb_evaluator_compile_cost(ev), LB_SCENE_MAX_COMPILE_COST, tree);
         if (llen) printf("local blends:\n%s", curves);
     }
     free(tree);

@@ -448,3 +448,7 @@ lb_convention lb_evaluator_convention(const lb_evaluator *ev) {
 double lb_evaluator_cost(const lb_evaluator *ev) {
     return ev ? ev->cost : 0.0;
 }
+
+double lb_evaluator_compile_cost(const lb_evaluator *ev) {
+    return ev ? ev->compile_cost : 0.0;
+}

@@ -58,12 +58,40 @@ typedef struct child_eval {
     const lb__instr *in;
     double *regs;
     lb_error *err;
+    double wcone[2]; /* instruction runs of each child's cone per point */
+    double *work;    /* the evaluator's compile cost so far */
 } child_eval;
+
+/* Counts runs of the children's cones, and refuses once the compile cost
+ * passes its limit (scene.h): no valid scene may make compiling explode. */
+static lb_status charge(child_eval *E, double runs) {
+    *E->work += runs;
+    if (*E->work <= LB_SCENE_MAX_COMPILE_COST) return LB_OK;
+    return lb__fail(E->err, LB_ERR_INVALID_ARGUMENT,
+                    "%s: finding the local unions' intersection curves takes more than %.3g "
+                    "instruction runs (the compile-cost limit); allowed: fewer or simpler "
+                    "children under local unions (a local_union of k children folds left, so "
+                    "each fold evaluates every child before it), or clean_union or min where "
+                    "no local blend is needed",
+                    E->in->op.path, LB_SCENE_MAX_COMPILE_COST);
+}
+
+/* instruction runs of one evaluation of a cone */
+static double cone_weight(const lb_evaluator *ev, const uint32_t *cone, size_t n) {
+    double w = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const lb__instr *q = &ev->ins[cone[i]];
+        w += q->code == LB__I_OP && q->op.family == LB__F_LOCAL ? LB_LOCAL_RUN_WEIGHT : 1.0;
+    }
+    return w;
+}
 
 /* g (soft form) of both children and their gradients at n points */
 static lb_status children_at(child_eval *E, size_t n, const double *x, const double *y,
                              const double *z, double *g, double *grad) {
     const lb__instr *in = E->in;
+    lb_status cs = charge(E, (double)n * (E->wcone[0] + E->wcone[1]));
+    if (cs) return cs;
     for (size_t s = 0; s < n; s += LB__CHUNK) {
         const size_t m = n - s < LB__CHUNK ? n - s : LB__CHUNK;
         for (int a = 0; a < 2; ++a) {
@@ -149,6 +177,8 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
     }
     lb__box_centre(bmin, bmax, bc, br);
     const lb__instr *in = E->in;
+    lb_status cs = charge(E, E->wcone[0] + E->wcone[1]);
+    if (cs) return cs;
     for (int a = 0; a < 2; ++a) {
         lb__bounds_pass_list(E->ev, in->cone + (a ? in->ncone[0] : 0), in->ncone[a], bc, br, R);
         const lb__iv f = R[in->src[a]];
@@ -683,7 +713,7 @@ static lb_status make_bvh(child_eval *E, struct lb__curves *C) {
 }
 
 static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double bmin[3],
-                             const double bmax[3], lb_error *err) {
+                             const double bmax[3], double *work, lb_error *err) {
     struct lb__curves *C = calloc(1, sizeof *C);
     double *regs = malloc(lb__regs_len(ev) * sizeof *regs);
     lb__iv *R = malloc(lb__ivs_len(ev) * sizeof *R);
@@ -692,7 +722,13 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
     cellset S = {NULL, 0, 0};
     lb_status s = LB_OK;
     if (!C || !regs || !R) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
-    child_eval E = {ev, in, regs, err};
+    child_eval E = {ev,
+                    in,
+                    regs,
+                    err,
+                    {cone_weight(ev, in->cone, in->ncone[0]),
+                     cone_weight(ev, in->cone + in->ncone[0], in->ncone[1])},
+                    work};
     grid G;
     double size = 0.0;
     if (!s) {
@@ -791,7 +827,7 @@ lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, lb_error *e
                             "%s: local_union finds its children's intersection curves inside the "
                             "scene's bounds; allowed: a scene with \"bounds\"",
                             in->op.path);
-        lb_status s = prepare_one(ev, in, bmin, bmax, err);
+        lb_status s = prepare_one(ev, in, bmin, bmax, &ev->compile_cost, err);
         if (s) return s;
     }
     return LB_OK;

@@ -58,11 +58,12 @@ struct lb_evaluator {
     lb__instr *ins;
     size_t n;
     size_t nregs;
-    uint32_t out;   /* register of the root */
-    size_t total_k; /* sum of operator arities */
-    size_t kmax;    /* largest operator arity (sizes the scratch after the registers) */
-    int cullable;   /* some operator can drop arguments per box (lb__bounds_pass) */
-    double cost;    /* instruction runs per point for the whole tape (the cost model) */
+    uint32_t out;        /* register of the root */
+    size_t total_k;      /* sum of operator arities */
+    size_t kmax;         /* largest operator arity (sizes the scratch after the registers) */
+    int cullable;        /* some operator can drop arguments per box (lb__bounds_pass) */
+    double cost;         /* instruction runs per point for the whole tape (the cost model) */
+    double compile_cost; /* instruction runs the local unions' curve finding took */
 };
 
 /* An interval. */
