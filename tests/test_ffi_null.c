@@ -237,6 +237,7 @@ static lb_status c_evaluator(unsigned mask, int size, lb_error *err, int *hs) {
     lb_status s = lb_evaluator_create(P(0, C.scene), P(1, &ev), P(2, err));
     (void)lb_evaluator_size(ev);
     (void)lb_evaluator_cost(ev);
+    (void)lb_evaluator_compile_cost(ev);
     (void)lb_evaluator_convention(ev);
     lb_evaluator_free(ev);
     return s;

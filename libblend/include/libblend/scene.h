@@ -214,7 +214,8 @@ LB_API lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const doubl
 
 /* An interval [*lo, *hi] guaranteed to contain the field at every point of
  * the box [bmin, bmax] (docs/design.md, "Interval bounds"). bmin <= bmax
- * componentwise; a degenerate box is a point. */
+ * componentwise; a degenerate box is a point. An end nothing finite bounds
+ * is -INFINITY or +INFINITY (never a large finite stand-in). */
 LB_API lb_status lb_evaluator_bounds(const lb_evaluator *ev, const double bmin[3],
                                      const double bmax[3], double *lo, double *hi, lb_error *err);
 
