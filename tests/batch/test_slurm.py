@@ -46,6 +46,22 @@ if r.returncode:
     print("the cluster did not start:", r.stdout, r.stderr)
     sys.exit(1)
 os.environ["SLURM_CONF"] = os.path.join(cluster, "slurm.conf")
+# a second cluster beside the first (a user's beside the suite's): its own
+# free ports, recorded in its folder, both answering
+cluster2 = os.path.join(WORK, "cluster2")
+r2 = subprocess.run(["bash", os.path.join(SRC, "scripts", "slurm-cluster.sh"), "start", cluster2],
+                    capture_output=True, text=True)
+check(r2.returncode == 0, "a second cluster starts beside the first: %s %s" % (r2.stdout, r2.stderr))
+p1 = open(os.path.join(cluster, "ports")).read().split()
+p2 = open(os.path.join(cluster2, "ports")).read().split() if r2.returncode == 0 else []
+check(len(p1) == 2 and len(p2) == 2 and not set(p1) & set(p2),
+      "the two clusters' ports differ: %s %s" % (p1, p2))
+for c in (cluster, cluster2):
+    q = subprocess.run(["sinfo", "-h", "-o", "%T"], capture_output=True, text=True, timeout=30,
+                       env=dict(os.environ, SLURM_CONF=os.path.join(c, "slurm.conf")))
+    check(q.returncode == 0 and q.stdout.strip() in ("idle", "mixed", "allocated"),
+          "%s answers: %r %r" % (c, q.stdout, q.stderr))
+subprocess.run(["bash", os.path.join(SRC, "scripts", "slurm-cluster.sh"), "stop", cluster2])
 try:
     JOB = {"format": "libblend-job", "version": 1, "name": "farm",
            "scene": os.path.join(SRC, "scenes", "bernhardt-compare-local.json"),
