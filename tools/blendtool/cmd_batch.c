@@ -449,6 +449,19 @@ static void relative(const job *J, const char *p, char *out, size_t len) {
         snprintf(out, len, "%s/%s", J->dir, p);
 }
 
+/* line and column (from 1) of at in text */
+static void text_pos(const char *text, const char *at, long *line, long *col) {
+    *line = *col = 1;
+    for (const char *c = text; at && c < at && *c; ++c) {
+        if (*c == '\n') {
+            ++*line;
+            *col = 1;
+        } else {
+            ++*col;
+        }
+    }
+}
+
 /* The first \\u0000 escape inside a JSON string of text, or NULL: cJSON
  * would decode it into a NUL that silently ends the C string. */
 /* A pattern: at least one '#', the placeholders {name}, {scene}, {task},
@@ -525,15 +538,8 @@ static int parse_job(job *J, const char *file) {
     }
     const char *nul = nul_escape(text, len);
     if (nul) {
-        long line = 1, col = 1;
-        for (const char *c = text; c < nul; ++c) {
-            if (*c == '\n') {
-                ++line;
-                col = 1;
-            } else {
-                ++col;
-            }
-        }
+        long line, col;
+        text_pos(text, nul, &line, &col);
         free(text);
         bt_error(CMD,
                  "%s:%ld:%ld: a string holds \\u0000 (a NUL byte), which would cut it short; "
@@ -544,16 +550,8 @@ static int parse_job(job *J, const char *file) {
     const char *end = NULL;
     cJSON *doc = strlen(text) == len ? cJSON_ParseWithOpts(text, &end, 1) : NULL;
     if (!doc) {
-        long line = 1, col = 1;
-        const char *at = end ? end : cJSON_GetErrorPtr();
-        for (const char *c = text; at && c < at && *c; ++c) {
-            if (*c == '\n') {
-                ++line;
-                col = 1;
-            } else {
-                ++col;
-            }
-        }
+        long line, col;
+        text_pos(text, end ? end : cJSON_GetErrorPtr(), &line, &col);
         free(text);
         bt_error(CMD,
                  "%s:%ld:%ld: not valid JSON; allowed: a libblend-job document (docs/batch.md)",
