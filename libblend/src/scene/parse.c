@@ -1516,7 +1516,7 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
     }
     if (strict) {
         cJSON_Delete(doc);
-        return strict_json(text, length, file, err); /* its message again, over any later one */
+        return strict; /* err still holds its message: nothing since has written to it */
     }
     lb_scene *s = calloc(1, sizeof *s);
     if (!s) {
