@@ -233,9 +233,17 @@ static void test_barthe(void **st) {
         const double s = rng_log(&R, 1e-2, 1e2);
         double g2[2];
         const double us = barthe(s * x, s * y, p, q, g2), sw = barthe(y, x, q, p, g2);
-        tally_check(
-            &hom, fabs(us - s * u) <= 1e-13 * s * u && u >= fmax(x, y) && fabs(sw - u) <= 1e-13 * u,
-            "x %g y %g p %g q %g", x, y, p, q);
+        /* and at the ends of the double range, where x^2 + y^2 would
+         * underflow or overflow (x = 4e-321, y = 7e-171 once gave 0 / 0) */
+        const double sx = rng_log(&R, 1e-290, 1e90);
+        double g3[2];
+        const double ux = barthe(sx * x, sx * y, p, q, g3);
+        barthe(x, y, p, q, g);
+        tally_check(&hom,
+                    fabs(us - s * u) <= 1e-13 * s * u && u >= fmax(x, y) &&
+                        fabs(sw - u) <= 1e-13 * u && fabs(ux - sx * u) <= 1e-13 * sx * u &&
+                        fabs(g3[0] - g[0]) + fabs(g3[1] - g[1]) <= 1e-9 * (fabs(g[0]) + fabs(g[1])),
+                    "x %g y %g p %g q %g s %g: %.17g vs %.17g", x, y, p, q, sx, ux, sx * u);
         /* gradient */
         const double pq[2] = {p, q}, xy[2] = {x, y};
         const double step[2] = {1e-4 * fmin(x, y - q * x), 1e-4 * fmin(y, yhi - y)};
@@ -284,13 +292,19 @@ static void test_mix_extremes_and_errors(void **st) {
                     assert_int_equal(lb_clean_union((lb_clean_kind)k, f, C, alpha, &v, gg, &e),
                                      LB_OK);
                     assert_true(isfinite(v) && isfinite(gg[0]) && isfinite(gg[1]));
-                    for (int pq = 0; pq < 3; ++pq) {
-                        const double P = pq == 0 ? 0.0 : pq == 1 ? 0.5 : LB_BARTHE_MAX_PQ;
-                        const double Q = fmin(1.0 - P, LB_BARTHE_MAX_PQ);
+                    for (int pq = 0; pq < 4; ++pq) {
+                        const double P = pq <= 1 ? 0.0 : pq == 2 ? 0.5 : LB_BARTHE_MAX_PQ;
+                        const double Q = pq == 0 ? 0.0 : fmin(1.0 - P, LB_BARTHE_MAX_PQ);
                         assert_int_equal(lb_barthe_blend(f, P, Q, &v, gg, &e), LB_OK);
                         if (!(isfinite(v) && isfinite(gg[0]) && isfinite(gg[1])))
                             fail_msg("UB(%g, %g) p %g: %g (%g, %g)", f[0], f[1], P, v, gg[0],
                                      gg[1]);
+                        /* p = q = 0: the wedge is the open quadrant and UB
+                         * the circle's radius there */
+                        if (pq == 0 && f[0] > 0.0 && f[1] > 0.0 &&
+                            !(fabs(v - hypot(f[0], f[1])) <= 1e-15 * hypot(f[0], f[1])))
+                            fail_msg("UB(%g, %g) p = q = 0: %.17g, not hypot %.17g", f[0], f[1], v,
+                                     hypot(f[0], f[1]));
                     }
                     ++finite;
                 }

@@ -120,20 +120,25 @@ double lb__barthe_eval(const double xy[2], double p, double q, double g[2]) {
         g[1] = first ? 0.0 : 1.0;
         return first ? x : y;
     }
+    /* u is homogeneous of degree 1 in (x, y) and the gradient of degree 0:
+     * solve for (x, y) / m, m = max(x, y) > 0 inside the wedge, so that
+     * squares neither underflow (x = 4e-321, y = 7e-171 gave 0 / 0) nor
+     * overflow */
+    const double m = x > y ? x : y, xs = x / m, ys = y / m;
     const double P = 1.0 - p, Q = 1.0 - q, P2 = P * P, Q2 = Q * Q;
     const double A = Q2 * p * p + P2 * q * q - P2 * Q2;
-    const double B = Q2 * p * x + P2 * q * y;
-    const double D = Q2 * x * x + P2 * y * y;
+    const double B = Q2 * p * xs + P2 * q * ys;
+    const double D = Q2 * xs * xs + P2 * ys * ys;
     double disc = B * B - A * D;
     if (disc < 0.0) disc = 0.0; /* rounding only: inside the wedge it is positive */
-    const double sq = sqrt(disc), u = D / (B + sq);
+    const double sq = sqrt(disc), us = D / (B + sq);
     if (sq > 0.0) {
-        g[0] = Q2 * (x - p * u) / sq;
-        g[1] = P2 * (y - q * u) / sq;
+        g[0] = Q2 * (xs - p * us) / sq;
+        g[1] = P2 * (ys - q * us) / sq;
     } else {
         g[0] = g[1] = 0.5;
     }
-    return u;
+    return us * m;
 }
 
 lb_status lb_barthe_blend(const double x[2], double p, double q, double *value, double grad[2],
