@@ -117,7 +117,7 @@ check "a point beyond 1e9 exits 2" rc 2
 check "the far point is named" err_has "$T/far.txt:1: z = 1e+12; allowed: finite, |coordinate| <= 1e+09"
 run eval --threads abc "$T/sphere.json"
 check "a bad thread count exits 2" rc 2
-check "the thread count message says what is allowed" err_has "expected an integer from 0"
+check "the thread count message says what is allowed" err_has "expected an integer (0: one per CPU), 0 to 1024"
 run eval --points "$T/pts.txt" -o "$T/no/such/dir/out.txt" "$T/sphere.json"
 check "an unwritable output exits 2" rc 2
 check "the output path is named" err_has "$T/no/such/dir/out.txt: cannot create the output file"

@@ -52,6 +52,12 @@ const char *bt_last_error(void);
  * error) when the value is missing. */
 int bt_option(const char *cmd, int argc, char **argv, int *i, const char *name, const char **value);
 
+/* Parse the value of an integer option: the whole text a decimal integer in
+ * [lo, hi]. Returns 0 and sets *out, or prints "OPTION TEXT: expected WHAT,
+ * LO to HI" and returns -1. */
+int bt_parse_long(const char *cmd, const char *option, const char *text, long lo, long hi,
+                  const char *what, long *out);
+
 /* Parse a thread count (0 = all CPUs). Returns 0 or prints an error and
  * returns -1. */
 int bt_parse_threads(const char *cmd, const char *text, int *threads);

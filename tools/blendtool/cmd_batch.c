@@ -1504,13 +1504,10 @@ static int run(int argc, char **argv) {
         } else if ((r = bt_option(CMD, argc, argv, &i, "--threads", &v))) {
             if (r < 0 || bt_parse_threads(CMD, v, &threads)) return BT_EXIT_BAD_INPUT;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--array-size", &v))) {
-            char *end = NULL;
-            if (r < 0) return BT_EXIT_BAD_INPUT;
-            array = (int)strtol(v, &end, 10);
-            if (!end || *end || array < 1 || array > 10000) {
-                bt_error(CMD, "--array-size %s: expected an integer from 1 to 10000", v);
+            long a = 0;
+            if (r < 0 || bt_parse_long(CMD, "--array-size", v, 1, 10000, "an integer", &a))
                 return BT_EXIT_BAD_INPUT;
-            }
+            array = (int)a;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--partition", &v))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
             if (!partition_ok(v)) {
@@ -1522,23 +1519,13 @@ static int run(int argc, char **argv) {
             }
             partition = v;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--time", &v))) {
-            char *end = NULL;
-            if (r < 0) return BT_EXIT_BAD_INPUT;
-            errno = 0;
-            time_min = strtol(v, &end, 10);
-            if (errno || !end || *end || end == v || time_min < 1 || time_min > 525600) {
-                bt_error(CMD, "--time %s: expected minutes per array task, 1 to 525600", v);
+            if (r < 0 ||
+                bt_parse_long(CMD, "--time", v, 1, 525600, "minutes per array task", &time_min))
                 return BT_EXIT_BAD_INPUT;
-            }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--mem", &v))) {
-            char *end = NULL;
-            if (r < 0) return BT_EXIT_BAD_INPUT;
-            errno = 0;
-            mem_mb = strtol(v, &end, 10);
-            if (errno || !end || *end || end == v || mem_mb < 16 || mem_mb > 16777216) {
-                bt_error(CMD, "--mem %s: expected megabytes per array task, 16 to 16777216", v);
+            if (r < 0 ||
+                bt_parse_long(CMD, "--mem", v, 16, 16777216, "megabytes per array task", &mem_mb))
                 return BT_EXIT_BAD_INPUT;
-            }
         } else if (argv[i][0] == '-' && argv[i][1]) {
             bt_error(CMD, "unknown option %s; see blendtool batch --help", argv[i]);
             return BT_EXIT_BAD_INPUT;

@@ -67,16 +67,10 @@ static int run(int argc, char **argv) {
             out = val;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--resolution", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
-            char *end = NULL;
-            errno = 0;
-            const long n = strtol(val, &end, 10);
-            if (errno || !end || *end || end == val || n < 1 || n > LB_MESH_MAX_CELLS_PER_AXIS) {
-                bt_error(CMD,
-                         "--resolution %s: expected an integer from 1 to %d (cells along "
-                         "the longest side)",
-                         val, LB_MESH_MAX_CELLS_PER_AXIS);
+            long n = 0;
+            if (bt_parse_long(CMD, "--resolution", val, 1, LB_MESH_MAX_CELLS_PER_AXIS,
+                              "cells along the longest side", &n))
                 return BT_EXIT_BAD_INPUT;
-            }
             o.resolution = (unsigned)n;
             have_res = 1;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--cell-size", &val))) {

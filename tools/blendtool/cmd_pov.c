@@ -24,13 +24,8 @@ static const char *include_dir(void) {
 }
 
 static int parse_int(const char *cmd, const char *opt, const char *v, long lo, long hi, int *out) {
-    char *end = NULL;
-    errno = 0;
-    const long n = strtol(v, &end, 10);
-    if (errno || !end || *end || end == v || n < lo || n > hi) {
-        bt_error(cmd, "%s %s: expected an integer from %ld to %ld", opt, v, lo, hi);
-        return -1;
-    }
+    long n = 0;
+    if (bt_parse_long(cmd, opt, v, lo, hi, "an integer", &n)) return -1;
     *out = (int)n;
     return 0;
 }

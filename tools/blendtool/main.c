@@ -65,14 +65,23 @@ int bt_option(const char *cmd, int argc, char **argv, int *i, const char *name,
     return 1;
 }
 
-int bt_parse_threads(const char *cmd, const char *text, int *threads) {
+int bt_parse_long(const char *cmd, const char *option, const char *text, long lo, long hi,
+                  const char *what, long *out) {
     char *end = NULL;
     errno = 0;
-    long v = strtol(text, &end, 10);
-    if (errno || !end || *end || end == text || v < 0 || v > 1024) {
-        bt_error(cmd, "--threads %s: expected an integer from 0 (one per CPU) to 1024", text);
+    const long v = strtol(text, &end, 10);
+    if (errno || !end || *end || end == text || v < lo || v > hi) {
+        bt_error(cmd, "%s %s: expected %s, %ld to %ld", option, text, what, lo, hi);
         return -1;
     }
+    *out = v;
+    return 0;
+}
+
+int bt_parse_threads(const char *cmd, const char *text, int *threads) {
+    long v = 0;
+    if (bt_parse_long(cmd, "--threads", text, 0, 1024, "an integer (0: one per CPU)", &v))
+        return -1;
     *threads = (int)v;
     return 0;
 }
