@@ -342,16 +342,15 @@ static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, s
     out->hi += 1e-9 * (1.0 + fabs(out->hi));
 }
 
-static int all_finite_iv(const iv *x, size_t k) {
-    for (size_t i = 0; i < k; ++i)
-        if (!isfinite(x[i].lo) || !isfinite(x[i].hi)) return 0;
-    return 1;
-}
-
-static int any_above_one(const iv *x, size_t k) {
-    for (size_t i = 0; i < k; ++i)
-        if (x[i].hi > 1.0) return 1;
-    return 0;
+/* Where Perlin's arguments lie: 0 all within [0, 1] at the top, 1 some
+ * finite top above 1, 2 some end infinite (unbounded) */
+static int perlin_reach(const iv *x, size_t k) {
+    int r = 0;
+    for (size_t i = 0; i < k; ++i) {
+        if (!isfinite(x[i].lo) || !isfinite(x[i].hi)) return 2;
+        if (x[i].hi > 1.0) r = 1;
+    }
+    return r;
 }
 
 static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const iv *c, iv *out,
@@ -379,11 +378,11 @@ static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const 
             out->hi = mn ? fmin(out->hi, x[i].hi) : fmax(out->hi, x[i].hi);
         }
         return;
-    } else if (n->family == LB__F_PERLIN && !all_finite_iv(x, k)) {
+    } else if (n->family == LB__F_PERLIN && perlin_reach(x, k) == 2) {
         out->lo = 0.0; /* soft fields are >= 0; nothing finite bounds the top */
         out->hi = INFINITY;
         return;
-    } else if (n->family == LB__F_PERLIN && any_above_one(x, k)) {
+    } else if (n->family == LB__F_PERLIN && perlin_reach(x, k) == 1) {
         /* Perlin's products are monotone only on [0, 1]: an argument a soft
          * union took above 1 flips a factor's sign. Interval products then
          * (sound, and exact for points): union 1 - prod(1 - f_i),
