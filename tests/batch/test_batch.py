@@ -19,48 +19,17 @@ import time
 
 import jsonschema
 
-BT, SRC, WORK = sys.argv[1:4]
-BT = os.path.abspath(BT)
-SRC = os.path.abspath(SRC)
-WORK = os.path.abspath(WORK)
-shutil.rmtree(WORK, ignore_errors=True)
-os.makedirs(WORK)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from batchlib import bt, check, digest, fail, finish, setup  # noqa: E402
+
+BT, SRC, WORK = setup()
 SCHEMA = json.load(open(os.path.join(SRC, "docs", "libblend-job.schema.json")))
-failures = []
-
-
-def fail(msg):
-    failures.append(msg)
-    print("FAIL:", msg)
-
-
-def check(cond, msg):
-    if not cond:
-        fail(msg)
-    return cond
-
-
-def bt(*args, cwd=None, timeout=600):
-    return subprocess.run([BT, *args], capture_output=True, text=True, cwd=cwd, timeout=timeout)
 
 
 def write_job(path, job):
     with open(path, "w") as f:
         json.dump(job, f, indent=1)
     return path
-
-
-def digest(folder):
-    """name -> sha256 of every visible file (the manifests included)"""
-    out = {}
-    for root, _, files in os.walk(folder):
-        for n in files:
-            p = os.path.join(root, n)
-            rel = os.path.relpath(p, folder)
-            if rel.startswith("logs"):
-                continue
-            out[rel] = hashlib.sha256(open(p, "rb").read()).hexdigest()
-    return out
 
 
 def events(text):
@@ -434,5 +403,4 @@ check(r.returncode == 2 and "differ in size" in r.stderr, "compare different siz
 r = bt("compare", a, os.path.join(WORK, "nope.png"))
 check(r.returncode == 2, "compare a missing image: " + r.stderr)
 
-print("%d failures" % len(failures))
-sys.exit(1 if failures else 0)
+finish()

@@ -22,26 +22,13 @@ usage: test_batch_hostile.py BLENDTOOL SOURCE_DIR WORK_DIR
 import glob
 import json
 import os
-import shutil
 import subprocess
 import sys
 
-BT, SRC, WORK = (os.path.abspath(a) for a in sys.argv[1:4])
-shutil.rmtree(WORK, ignore_errors=True)
-os.makedirs(WORK)
-failures = []
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from batchlib import bt, check, finish, setup  # noqa: E402
 
-
-def check(cond, msg):
-    if not cond:
-        failures.append(msg)
-        print("FAIL:", msg)
-    return cond
-
-
-def bt(*args, cwd=None, timeout=600):
-    return subprocess.run([BT, *args], capture_output=True, text=True, cwd=cwd, timeout=timeout)
-
+BT, SRC, WORK = setup()
 
 SCENE = os.path.join(SRC, "scenes", "default.json")
 TINY = {"format": "libblend-job", "version": 1, "name": "tiny", "scene": SCENE,
@@ -288,5 +275,4 @@ for fmt in ("png", "exr"):
 r = bt("compare", sheets["png"], sheets["exr"], "--fail", "0.02", "--fail-percent", "1")
 check(r.returncode == 0, "the EXR job's sheet matches the PNG job's: %s %s" % (r.stdout, r.stderr))
 
-print("%d failures" % len(failures))
-sys.exit(1 if failures else 0)
+finish()

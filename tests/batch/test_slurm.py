@@ -14,30 +14,13 @@ import subprocess
 import sys
 import time
 
-BT, SRC, WORK = (os.path.abspath(a) for a in sys.argv[1:4])
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from batchlib import check, digest, finish, setup  # noqa: E402
+
+BT, SRC, WORK = setup(clean=False)
 shutil.rmtree(os.path.join(WORK, "jobs"), ignore_errors=True)
 os.makedirs(os.path.join(WORK, "jobs"), exist_ok=True)
 cluster = os.path.join(WORK, "cluster")
-failures = []
-
-
-def check(cond, msg):
-    if not cond:
-        failures.append(msg)
-        print("FAIL:", msg)
-    return cond
-
-
-def digest(folder):
-    out = {}
-    for root, dirs, files in os.walk(folder):
-        dirs[:] = [d for d in dirs if d != "logs"]
-        for n in files:
-            if n.endswith(".sbatch"):
-                continue
-            p = os.path.join(root, n)
-            out[os.path.relpath(p, folder)] = hashlib.sha256(open(p, "rb").read()).hexdigest()
-    return out
 
 
 r = subprocess.run(["bash", os.path.join(SRC, "scripts", "slurm-cluster.sh"), "start", cluster],
@@ -119,7 +102,7 @@ try:
 
     # kill one array task mid-render, then resubmit the same script
     slow = dict(JOB, outputs={"mesh": {"resolution": 40},
-                              "image": {"width": 640, "height": 480, "quality": 11}})
+                              "image": {"width": 320, "height": 240, "quality": 11}})
     dk, jk = job_in("kill", slow)
     dref, jref = job_in("kill-ref", slow)
     r = subprocess.run([BT, "batch", jref], capture_output=True, text=True)
@@ -163,5 +146,4 @@ try:
           "and every output now equals the reference")
 finally:
     subprocess.run(["bash", os.path.join(SRC, "scripts", "slurm-cluster.sh"), "stop", cluster])
-print("%d failures" % len(failures))
-sys.exit(1 if failures else 0)
+finish()
