@@ -60,9 +60,11 @@ extern "C" {
  * the scene (LB_ERR_INVALID_ARGUMENT, naming the local_union) once it
  * passes the limit, which this machine reaches in a few seconds. A local
  * union met inside a child counts as LB_LOCAL_RUN_WEIGHT instructions
- * (its curve query and two blends). */
+ * (its clean union, blend and mix), and LB_LOCAL_NEAR_WEIGHT more at a point
+ * where one of its blending volumes may reach (the nearest-curve query). */
 #define LB_SCENE_MAX_COMPILE_COST 5e8
 #define LB_LOCAL_RUN_WEIGHT 16
+#define LB_LOCAL_NEAR_WEIGHT 48
 
 typedef struct lb_scene lb_scene;
 typedef struct lb_evaluator lb_evaluator;
@@ -193,7 +195,8 @@ LB_API double lb_evaluator_cost(const lb_evaluator *ev);
 
 /* Instruction runs that compiling took to find the local unions' curves
  * (every child evaluation and interval pass over a child's instructions; a
- * nested local union counts LB_LOCAL_RUN_WEIGHT runs): at most
+ * nested local union counts LB_LOCAL_RUN_WEIGHT runs, and
+ * LB_LOCAL_NEAR_WEIGHT more where its blending volumes may reach): at most
  * LB_SCENE_MAX_COMPILE_COST. 0 for NULL or a scene without local unions. */
 LB_API double lb_evaluator_compile_cost(const lb_evaluator *ev);
 

@@ -40,6 +40,13 @@
 #define ON_SURFACE 1e-10  /* of the scene size */
 #define MIDPOINT_TOL 1e-5 /* of the scene size */
 #define SUBDIVIDE_PASSES 4
+/* a cone shorter than this runs as it stands (reducing costs an interval
+ * pass over it per chunk) */
+#define REDUCE_FROM 24
+#define REDUCE_GROUP 16 /* chunks per group (children_at) */
+/* octree levels with cones of their own (a 64-cell grid halves its longest
+ * side 18 times) */
+#define OCTREE_DEPTH 24
 
 void lb__curves_free(struct lb__curves *c) {
     if (!c) return;
@@ -58,8 +65,16 @@ typedef struct child_eval {
     const lb__instr *in;
     double *regs;
     lb_error *err;
-    double wcone[2]; /* instruction runs of each child's cone per point */
-    double *work;    /* the evaluator's compile cost so far */
+    double wcone[2];               /* instruction runs of each child's cone per point */
+    double *work;                  /* the evaluator's compile cost so far */
+    lb__cone grp[2];               /* each child's cone reduced over the current group of chunks */
+    lb__cone sub[2];               /* and over the current chunk */
+    lb__cone oc[2 * OCTREE_DEPTH]; /* each child's cone reduced over the octree's cells */
+    int noreduce[2];               /* the child's cone holds bulge elimination */
+    lb__iv *ivs;                   /* interval registers of a reduced cone */
+    size_t nivs;
+    double *subregs; /* their register file */
+    size_t nsubregs;
 } child_eval;
 
 /* Counts runs of the children's cones, and refuses once the compile cost
@@ -86,30 +101,108 @@ static double cone_weight(const lb_evaluator *ev, const uint32_t *cone, size_t n
     return w;
 }
 
-/* g (soft form) of both children and their gradients at n points */
+/* the centre and half-size of the box around n points */
+static void points_box(const double *x, const double *y, const double *z, size_t n, double bc[3],
+                       double br[3]) {
+    double bmin[3] = {x[0], y[0], z[0]}, bmax[3] = {x[0], y[0], z[0]};
+    for (size_t j = 1; j < n; ++j) {
+        const double P[3] = {x[j], y[j], z[j]};
+        for (int d = 0; d < 3; ++d) {
+            if (P[d] < bmin[d]) bmin[d] = P[d];
+            if (P[d] > bmax[d]) bmax[d] = P[d];
+        }
+    }
+    lb__box_centre(bmin, bmax, bc, br);
+}
+
+/* g (soft form) of both children and their gradients at n points. A long
+ * cone is reduced over each chunk's bounding box (cone.c): the points come
+ * in spatial order (cell by cell, or along a curve), so a chunk's box is
+ * small and most links of a fold's chain drop out. */
 static lb_status children_at(child_eval *E, size_t n, const double *x, const double *y,
                              const double *z, double *g, double *grad) {
     const lb__instr *in = E->in;
-    lb_status cs = charge(E, (double)n * (E->wcone[0] + E->wcone[1]));
-    if (cs) return cs;
+    double gc[3] = {0.0, 0.0, 0.0}, gr[3] = {0.0, 0.0, 0.0};
     for (size_t s = 0; s < n; s += LB__CHUNK) {
         const size_t m = n - s < LB__CHUNK ? n - s : LB__CHUNK;
+        double bc[3], br[3];
+        /* a group of REDUCE_GROUP chunks is reduced from the whole cone,
+         * each chunk from its group's cone */
+        if (s % (REDUCE_GROUP * LB__CHUNK) == 0) {
+            const size_t gm = n - s < REDUCE_GROUP * LB__CHUNK ? n - s : REDUCE_GROUP * LB__CHUNK;
+            points_box(x + s, y + s, z + s, gm, gc, gr);
+        }
+        points_box(x + s, y + s, z + s, m, bc, br);
         for (int a = 0; a < 2; ++a) {
             const uint32_t *cone = in->cone + (a ? in->ncone[0] : 0);
-            lb_status st = lb__tape_run_list(E->ev, cone, in->ncone[a], m, x + s, y + s, z + s,
-                                             E->regs, E->err);
+            const lb_evaluator *run_ev = E->ev;
+            uint32_t r = in->src[a];
+            double w = E->wcone[a];
+            lb_status st;
+            if (in->ncone[a] >= REDUCE_FROM) {
+                lb__cone *Gc = &E->grp[a], *S = &E->sub[a];
+                /* a reduction is an interval pass over what it reduces:
+                 * charged as one run of that */
+                if (s % (REDUCE_GROUP * LB__CHUNK) == 0 &&
+                    ((st = charge(E, E->wcone[a])) ||
+                     (st = lb__cone_reduce(E->ev, cone, in->ncone[a], gc, gr, Gc, E->err))))
+                    return st;
+                /* a group's cone that is short already runs as it is; one
+                 * that kept nearly everything is reduced per chunk from the
+                 * whole cone */
+                const int grouped = Gc->reduced && Gc->copied;
+                const int chunked = Gc->reduced && (!grouped || Gc->ev.n >= REDUCE_FROM);
+                if (chunked &&
+                    ((st = charge(E, grouped ? Gc->weight : E->wcone[a])) ||
+                     (st = grouped
+                               ? lb__cone_reduce(&Gc->ev, NULL, Gc->ev.n, bc, br, S, E->err)
+                               : lb__cone_reduce(E->ev, cone, in->ncone[a], bc, br, S, E->err))))
+                    return st;
+                if (grouped && (!chunked || !S->copied)) S = Gc;
+                if (Gc->reduced && S->reduced && S->copied) {
+                    run_ev = &S->ev;
+                    r = S->out;
+                    w = S->weight;
+                }
+            }
+            /* a local union whose blending volumes reach the chunk queries
+             * its curves at every point: LB_LOCAL_NEAR_WEIGHT runs more */
+            {
+                const size_t nr = run_ev != E->ev ? run_ev->n : in->ncone[a];
+                size_t near = 0;
+                for (size_t q = 0; q < nr; ++q) {
+                    const lb__instr *c = run_ev != E->ev ? &run_ev->ins[q] : &E->ev->ins[cone[q]];
+                    near += c->code == LB__I_OP && c->op.family == LB__F_LOCAL &&
+                            lb__local_reaches(c->curves, bc, br);
+                }
+                w += (double)near * LB_LOCAL_NEAR_WEIGHT;
+            }
+            if ((st = charge(E, (double)m * w))) return st;
+            if (run_ev != E->ev) {
+                if (lb__regs_len(run_ev) > E->nsubregs) {
+                    double *q = realloc(E->subregs, lb__regs_len(run_ev) * sizeof *q);
+                    if (!q)
+                        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+                    E->subregs = q;
+                    E->nsubregs = lb__regs_len(run_ev);
+                }
+                st = lb__tape_run_counted(run_ev, m, x + s, y + s, z + s, E->subregs, NULL, E->err);
+            } else {
+                st = lb__tape_run_list(E->ev, cone, in->ncone[a], m, x + s, y + s, z + s, E->regs,
+                                       E->err);
+            }
             if (st) return st;
-            const uint32_t r = in->src[a];
+            double *regs = run_ev != E->ev ? E->subregs : E->regs;
             const double k =
                 E->ev->conv == LB_CONVENTION_ZERO ? -LB__LOCAL_ISO / in->op.lp.zero_scale : 1.0;
             for (size_t j = 0; j < m; ++j) {
-                const double f = lb__reg(E->regs, r, 0)[j];
+                const double f = lb__reg(regs, r, 0)[j];
                 double fv[2] = {f, f}, gv[2];
                 lb__local_in(&in->op, E->ev->conv, fv, gv);
                 g[2 * (s + j) + a] = gv[0];
                 if (grad)
                     for (int d = 0; d < 3; ++d)
-                        grad[6 * (s + j) + 3 * a + d] = k * lb__reg(E->regs, r, 1 + d)[j];
+                        grad[6 * (s + j) + 3 * a + d] = k * lb__reg(regs, r, 1 + d)[j];
             }
         }
     }
@@ -168,8 +261,11 @@ typedef struct cellset {
     size_t n, cap;
 } cellset;
 
+/* Cells where both children can cross C. A long cone is reduced cell by
+ * cell (cone.c), each cell's from its parent's (E->oc[depth]), so a cell
+ * costs what its parent's reduced cone holds, not the whole cone. */
 static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], const uint32_t hi[3],
-                        lb__iv *R, cellset *S) {
+                        lb__iv *R, cellset *S, const lb__cone *const cur[2], int depth) {
     double bmin[3], bmax[3], bc[3], br[3];
     for (int d = 0; d < 3; ++d) {
         bmin[d] = G->origin[d] + G->h * lo[d];
@@ -177,11 +273,46 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
     }
     lb__box_centre(bmin, bmax, bc, br);
     const lb__instr *in = E->in;
-    lb_status cs = charge(E, E->wcone[0] + E->wcone[1]);
-    if (cs) return cs;
-    for (int a = 0; a < 2; ++a) {
-        lb__bounds_pass_list(E->ev, in->cone + (a ? in->ncone[0] : 0), in->ncone[a], bc, br, R);
-        const lb__iv f = R[in->src[a]];
+    const lb__cone *next[2] = {cur[0], cur[1]};
+    /* the cheaper child first: most cells are pruned by it alone */
+    const int first = E->wcone[1] < E->wcone[0];
+    for (int t = 0; t < 2; ++t) {
+        const int a = t ? 1 - first : first;
+        const uint32_t *cone = in->cone + (a ? in->ncone[0] : 0);
+        const lb__cone *P = cur[a]; /* NULL: the whole cone */
+        lb__iv f;
+        lb_status cs;
+        const size_t np = P ? P->ev.n : in->ncone[a];
+        int done = 0;
+        if (np >= REDUCE_FROM && depth < OCTREE_DEPTH && !E->noreduce[a]) {
+            lb__cone *C = &E->oc[2 * depth + a];
+            if ((cs = charge(E, P ? P->weight : E->wcone[a])) ||
+                (cs = lb__cone_reduce(P ? &P->ev : E->ev, P ? NULL : cone, np, bc, br, C, E->err)))
+                return cs;
+            if (C->reduced) {
+                f = C->root;
+                if (C->copied) next[a] = C;
+                done = 1;
+            } else {
+                E->noreduce[a] = 1; /* bulge elimination inside: the whole cone from here */
+            }
+        }
+        if (done) {
+        } else if (P) { /* short enough: its interval pass as it stands */
+            if ((cs = charge(E, P->weight))) return cs;
+            if (lb__ivs_len(&P->ev) > E->nivs) {
+                lb__iv *q = realloc(E->ivs, lb__ivs_len(&P->ev) * sizeof *q);
+                if (!q) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+                E->ivs = q;
+                E->nivs = lb__ivs_len(&P->ev);
+            }
+            lb__bounds_pass(&P->ev, bc, br, E->ivs, NULL);
+            f = E->ivs[P->out];
+        } else {
+            if ((cs = charge(E, E->wcone[a]))) return cs;
+            lb__bounds_pass_list(E->ev, cone, in->ncone[a], bc, br, R);
+            f = R[in->src[a]];
+        }
         double fl[2] = {f.lo, f.hi}, gl[2];
         lb__local_in(&in->op, E->ev->conv, fl, gl);
         const double glo = gl[0] < gl[1] ? gl[0] : gl[1], ghi = gl[0] < gl[1] ? gl[1] : gl[0];
@@ -210,8 +341,8 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
     memcpy(lo2, lo, sizeof lo2);
     mid[axis] = lo[axis] + span / 2;
     lo2[axis] = mid[axis];
-    lb_status s = octree(E, G, lo, mid, R, S);
-    return s ? s : octree(E, G, lo2, hi, R, S);
+    lb_status s = octree(E, G, lo, mid, R, S, next, depth + 1);
+    return s ? s : octree(E, G, lo2, hi, R, S, next, depth + 1);
 }
 
 /* ---- step 2: segments on the Kuhn tetrahedra ---- */
@@ -722,13 +853,13 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
     cellset S = {NULL, 0, 0};
     lb_status s = LB_OK;
     if (!C || !regs || !R) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
-    child_eval E = {ev,
-                    in,
-                    regs,
-                    err,
-                    {cone_weight(ev, in->cone, in->ncone[0]),
-                     cone_weight(ev, in->cone + in->ncone[0], in->ncone[1])},
-                    work};
+    child_eval E = {.ev = ev,
+                    .in = in,
+                    .regs = regs,
+                    .err = err,
+                    .wcone = {cone_weight(ev, in->cone, in->ncone[0]),
+                              cone_weight(ev, in->cone + in->ncone[0], in->ncone[1])},
+                    .work = work};
     grid G;
     double size = 0.0;
     if (!s) {
@@ -749,7 +880,8 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
             G.origin[d] = 0.5 * (bmin[d] + bmax[d]) - 0.5 * G.h * G.cells[d] + 1e-7 * G.h * (d + 1);
         }
         const uint32_t zero[3] = {0, 0, 0};
-        s = octree(&E, &G, zero, G.cells, R, &S);
+        const lb__cone *whole[2] = {NULL, NULL};
+        s = octree(&E, &G, zero, G.cells, R, &S, whole, 0);
     }
     /* sample the kept cells' nodes */
     if (!s && S.n) {
@@ -801,6 +933,13 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
     if (!s) s = subdivide(&E, C, size);
     if (!s) s = parameters(&E, C, size);
     if (!s) s = make_bvh(&E, C);
+    for (int q = 0; q < 2; ++q) {
+        lb__cone_free(&E.grp[q]);
+        lb__cone_free(&E.sub[q]);
+    }
+    for (int q = 0; q < 2 * OCTREE_DEPTH; ++q) lb__cone_free(&E.oc[q]);
+    free(E.ivs);
+    free(E.subregs);
     hmap_free(&B.nodes);
     hmap_free(&B.faces);
     free(B.nval);
@@ -901,7 +1040,7 @@ static double wyvill(double a, double *dw) {
 }
 
 /* does any blending volume reach the box? (conservative) */
-static int volume_reaches(const struct lb__curves *C, const double bc[3], const double br[3]) {
+int lb__local_reaches(const struct lb__curves *C, const double bc[3], const double br[3]) {
     if (!C || !C->nseg) return 0;
     const bvh_node *N = &C->bvh[0];
     double s = 0.0;
@@ -935,7 +1074,7 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
         }
         double bc[3], br[3];
         lb__box_centre(lo, hi, bc, br);
-        reach = volume_reaches(in->curves, bc, br);
+        reach = lb__local_reaches(in->curves, bc, br);
     }
     for (size_t j = 0; j < n; ++j) {
         const double f[2] = {lb__reg(regs, r0, 0)[j], lb__reg(regs, r1, 0)[j]};
@@ -1041,17 +1180,22 @@ void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv 
     }
     /* max is always among the convex combination's ends */
     double ulo = lo[0] > lo[1] ? lo[0] : lo[1], uhi = hi[0] > hi[1] ? hi[0] : hi[1];
-    if (ulo < C) { /* outside both can occur: UC2 is increasing in both */
+    /* the clean union's weight is 0 on the whole box (alpha 0 and one child
+     * at most LB_SOFT_MIN_FIELD): UC is max there, exactly */
+    const int wzero = nd->lp.alpha[0] == 0.0 && nd->lp.alpha[1] == 0.0 &&
+                      (hi[0] <= LB_SOFT_MIN_FIELD || hi[1] <= LB_SOFT_MIN_FIELD);
+    if (wzero) {
+    } else if (ulo < C) { /* outside both can occur: UC2 is increasing in both */
         const double v1 = C + ur_val(lo[0] - C, lo[1] - C) / K;
         const double v2 = C + ur_val(hi[0] - C, hi[1] - C) / K;
         if (v1 < ulo) ulo = v1;
         if (v2 > uhi) uhi = v2;
     }
-    if (hi[0] >= C && hi[1] >= C) { /* inside both can occur */
+    if (!wzero && hi[0] >= C && hi[1] >= C) { /* inside both can occur */
         const double v2 = C + hypot(hi[0] - C, hi[1] - C);
         if (v2 > uhi) uhi = v2;
     }
-    if (nd->family == LB__F_LOCAL && volume_reaches(in->curves, bc, br)) {
+    if (nd->family == LB__F_LOCAL && lb__local_reaches(in->curves, bc, br)) {
         /* UB >= max, increasing in both: its largest value at the top corner */
         const struct lb__curves *Cv = in->curves;
         for (size_t c = 0; c < Cv->ncomp; ++c) {

@@ -126,6 +126,40 @@ LB_INTERNAL lb_status lb__tape_run_list(const lb_evaluator *ev, const uint32_t *
 LB_INTERNAL void lb__bounds_pass_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist,
                                       const double bc[3], const double br[3], lb__iv *R);
 
+/* A child's cone reduced over a box (cone.c): the instructions that can
+ * matter there, copied with registers of their own; local and clean unions
+ * that pass one argument through over the whole box are dropped and their
+ * readers read that argument. ev is a shallow copy of the evaluator with
+ * this sub-tape as its instructions (run it with lb__tape_run_counted,
+ * bound it with lb__bounds_pass); out is the register of the cone's value;
+ * weight its instruction runs per point (a local union counts
+ * LB_LOCAL_RUN_WEIGHT). The rest is scratch, kept from box to box. */
+typedef struct lb__cone {
+    lb_evaluator ev;
+    uint32_t out;
+    double weight;
+    int reduced; /* 0: the cone holds bulge elimination, run it as it stands */
+    int copied;  /* 0: more than 3/4 kept, not copied (ev, out, weight unset): run the source */
+    lb__iv root; /* the cone's value over the box (the pass's interval) */
+    lb__instr *ins;
+    uint32_t *src, *srcq, *alias, *reg, *prod, *last, *freel;
+    uint8_t *need;
+    lb__iv *ivq, *R;
+    size_t cap_ins, cap_src, cap_srcq, cap_alias, cap_reg, cap_prod, cap_last, cap_freel, cap_need,
+        cap_q, cap_R;
+} lb__cone;
+/* Reduce instructions list[0..n) of ev (list NULL: ev's first n; tape
+ * order, the cone's value last) over the box centre bc, half-size br, into
+ * S (zeroed before first use, reused after). LB_ERR_NO_MEMORY when memory
+ * is short. */
+LB_INTERNAL lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n,
+                                      const double bc[3], const double br[3], lb__cone *S,
+                                      lb_error *err);
+LB_INTERNAL void lb__cone_free(lb__cone *S);
+/* does a blending volume of these curves reach the box? (conservative) */
+LB_INTERNAL int lb__local_reaches(const struct lb__curves *C, const double bc[3],
+                                  const double br[3]);
+
 /* One intersection component and its blending volume (local.c). */
 typedef struct lb__component {
     size_t first, count; /* vertices [first, first + count) */

@@ -1,0 +1,211 @@
+/* A child's cone reduced over a box, for the local unions' compile-time
+ * evaluation (local.c).
+ *
+ * A local_union of k children folds left, so the left child of the i-th
+ * fold is a chain of i - 1 binary local unions: run as it stands, every
+ * point of fold i costs i instructions and a flat union of k children costs
+ * k^2 per point. Over a small box many links of the chain leave one
+ * argument as it is: no blending volume of theirs reaches the box, and the
+ * clean union is max there (its weight is 0: one argument at most 0 in
+ * soft form; or one argument is inside, >= C, and the other outside) with
+ * the same argument above the other over the whole box, so the link
+ * returns that argument (the soft form in, the scene's form out: the same
+ * value up to rounding of the linear change of form). Such a link is
+ * dropped and its readers read its argument. What remains is copied into a
+ * sub-tape with its own registers, run by the ordinary runners.
+ *
+ * Invariant: at every point of the box the sub-tape's value equals the
+ * cone's up to that rounding, so the curves found with it are the curves
+ * of the full cone. */
+#include "tape.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* grow *p to hold want elements of size sz */
+static int grow(void **p, size_t *cap, size_t want, size_t sz) {
+    if (want <= *cap) return 0;
+    size_t c = *cap ? *cap : 16;
+    while (c < want) c *= 2;
+    void *q = realloc(*p, c * sz);
+    if (!q) return -1;
+    *p = q;
+    *cap = c;
+    return 0;
+}
+
+void lb__cone_free(lb__cone *S) {
+    free(S->ins);
+    free(S->src);
+    free(S->ivq);
+    free(S->srcq);
+    free(S->alias);
+    free(S->need);
+    free(S->reg);
+    free(S->prod);
+    free(S->last);
+    free(S->freel);
+    free(S->R);
+    memset(S, 0, sizeof *S);
+}
+
+/* the soft-form interval of a child interval f (zero: g = C (1 - f / s)) */
+static lb__iv soft_iv(const lb__instr *in, lb_convention conv, lb__iv f) {
+    double fl[2] = {f.lo, f.hi}, g[2];
+    lb__local_in(&in->op, conv, fl, g);
+    lb__iv o = {g[0] < g[1] ? g[0] : g[1], g[0] < g[1] ? g[1] : g[0]};
+    return o;
+}
+
+/* which argument a binary local or clean union passes through over the
+ * box, or -1 (see the head of the file) */
+static int passes(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
+                  const double bc[3], const double br[3]) {
+    if (in->code != LB__I_OP || (in->op.family != LB__F_LOCAL && in->op.family != LB__F_CLEAN))
+        return -1;
+    if (in->op.lp.alpha[0] != 0.0 || in->op.lp.alpha[1] != 0.0) return -1;
+    if (in->op.family == LB__F_LOCAL && lb__local_reaches(in->curves, bc, br)) return -1;
+    const lb__iv g[2] = {soft_iv(in, ev->conv, fa), soft_iv(in, ev->conv, fb)};
+    for (int a = 0; a < 2; ++a)
+        if (!(g[a].lo >= -LB_MAX_ABS_ARG && g[a].hi <= LB_MAX_ABS_ARG)) return -1;
+    for (int a = 0; a < 2; ++a) {
+        const lb__iv me = g[a], other = g[1 - a];
+        /* the clean union is max = me where the weight is 0 (either
+         * argument at most LB_SOFT_MIN_FIELD), or where me is inside (>= C)
+         * and the other outside (< C): there it is the union itself */
+        const int zero_weight = me.hi <= LB_SOFT_MIN_FIELD || other.hi <= LB_SOFT_MIN_FIELD;
+        const int inside_one = me.lo >= LB__LOCAL_ISO && other.hi < LB__LOCAL_ISO;
+        /* max takes the first argument at ties (value and gradient) */
+        const int above = a == 0 ? other.hi <= me.lo : other.hi < me.lo;
+        if (above && (zero_weight || inside_one) &&
+            (ev->conv == LB_CONVENTION_ZERO || me.lo >= 0.0))
+            return a;
+    }
+    return -1;
+}
+
+lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n,
+                          const double bc[3], const double br[3], lb__cone *S, lb_error *err) {
+    const char *path = n ? ev->ins[list ? list[n - 1] : n - 1].op.path : "local_union";
+    if (grow((void **)&S->ivq, &S->cap_q, n, sizeof *S->ivq) ||
+        grow((void **)&S->alias, &S->cap_alias, n, sizeof *S->alias) ||
+        grow((void **)&S->need, &S->cap_need, n, sizeof *S->need) ||
+        grow((void **)&S->reg, &S->cap_reg, n, sizeof *S->reg) ||
+        grow((void **)&S->last, &S->cap_last, n, sizeof *S->last) ||
+        grow((void **)&S->freel, &S->cap_freel, n, sizeof *S->freel) ||
+        grow((void **)&S->prod, &S->cap_prod, ev->nregs, sizeof *S->prod) ||
+        grow((void **)&S->R, &S->cap_R, lb__ivs_len(ev), sizeof *S->R))
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", path);
+    /* the instructions' sources as positions in the list (2 per argument:
+     * arguments, then bounding solids) */
+    size_t nsrc = 0;
+    for (size_t q = 0; q < n; ++q) {
+        const lb__instr *in = &ev->ins[list ? list[q] : q];
+        if (in->code == LB__I_OP) nsrc += in->op.family == LB__F_BOUNDED ? 2 * in->op.k : in->op.k;
+        /* bulge elimination re-runs its cone by the evaluator's indices: no reduction */
+        if (in->code == LB__I_OP && in->cone && in->op.family != LB__F_LOCAL) {
+            S->reduced = 0;
+            return LB_OK;
+        }
+    }
+    if (grow((void **)&S->srcq, &S->cap_srcq, nsrc, sizeof *S->srcq))
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", path);
+    /* 1. the interval pass, instruction by instruction, recording each
+     * instruction's interval and which instruction each source is */
+    size_t so = 0;
+    for (size_t q = 0; q < n; ++q) {
+        const uint32_t i = list ? list[q] : (uint32_t)q;
+        const lb__instr *in = &ev->ins[i];
+        size_t ns = 0;
+        if (in->code == LB__I_OP) ns = in->op.family == LB__F_BOUNDED ? 2 * in->op.k : in->op.k;
+        for (size_t a = 0; a < ns; ++a) S->srcq[so + a] = S->prod[in->src[a]];
+        lb__bounds_pass_list(ev, &i, 1, bc, br, S->R);
+        S->ivq[q] = S->R[in->dst];
+        S->prod[in->dst] = (uint32_t)q;
+        /* 2. pass-through: alias[q] is the list position whose value q takes */
+        S->alias[q] = (uint32_t)q;
+        if (ns == 2) {
+            const int a = passes(ev, in, S->ivq[S->srcq[so]], S->ivq[S->srcq[so + 1]], bc, br);
+            if (a >= 0) S->alias[q] = S->alias[S->srcq[so + a]];
+        }
+        S->last[q] = (uint32_t)so; /* the sources' offset, for the steps below */
+        so += ns;
+    }
+    if (n) S->root = S->ivq[n - 1];
+    /* 3. what the root needs, backwards */
+    memset(S->need, 0, n);
+    if (n) S->need[S->alias[n - 1]] = 1;
+    for (size_t q = n; q-- > 0;) {
+        if (!S->need[q]) continue;
+        const lb__instr *in = &ev->ins[list ? list[q] : q];
+        const size_t ns = in->code != LB__I_OP             ? 0
+                          : in->op.family == LB__F_BOUNDED ? 2 * in->op.k
+                                                           : in->op.k;
+        for (size_t a = 0; a < ns; ++a) S->need[S->alias[S->srcq[S->last[q] + a]]] = 1;
+    }
+    /* 4. copy what is needed; registers by last use (reg[q] = last reader
+     * first, then the register). Not when more than three quarters of the
+     * instructions are kept: the copy would cost more than it saves (the
+     * caller runs the source; the pass's interval stands) */
+    size_t m = 0, msrc = 0;
+    for (size_t q = 0; q < n; ++q) m += S->need[q];
+    S->reduced = 1;
+    S->copied = 4 * m < 3 * n;
+    if (!S->copied) return LB_OK;
+    m = 0;
+    for (size_t q = 0; q < n; ++q) S->reg[q] = UINT32_MAX; /* last reader, as a position */
+    for (size_t q = 0; q < n; ++q) {
+        if (!S->need[q]) continue;
+        const lb__instr *in = &ev->ins[list ? list[q] : q];
+        const size_t ns = in->code != LB__I_OP             ? 0
+                          : in->op.family == LB__F_BOUNDED ? 2 * in->op.k
+                                                           : in->op.k;
+        for (size_t a = 0; a < ns; ++a) S->reg[S->alias[S->srcq[S->last[q] + a]]] = (uint32_t)q;
+        ++m;
+        msrc += ns;
+    }
+    if (grow((void **)&S->ins, &S->cap_ins, m, sizeof *S->ins) ||
+        grow((void **)&S->src, &S->cap_src, msrc, sizeof *S->src))
+        return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", path);
+    uint32_t nfree = 0, nregs = 0, *freel = S->freel; /* free registers, a stack */
+    /* the register of each needed position, kept in last[] (the offsets
+     * are read before being replaced: a position's own entry is written
+     * when it runs, after its sources were read) */
+    size_t k = 0, ko = 0;
+    double weight = 0.0;
+    for (size_t q = 0; q < n; ++q) {
+        if (!S->need[q]) continue;
+        const lb__instr *in = &ev->ins[list ? list[q] : q];
+        const size_t ns = in->code != LB__I_OP             ? 0
+                          : in->op.family == LB__F_BOUNDED ? 2 * in->op.k
+                                                           : in->op.k;
+        lb__instr *c = &S->ins[k];
+        *c = *in;
+        c->src = ns ? S->src + ko : NULL;
+        const uint32_t off = S->last[q];
+        for (size_t a = 0; a < ns; ++a) c->src[a] = S->last[S->alias[S->srcq[off + a]]];
+        /* the output first (a reader never writes into one of its sources),
+         * then the sources read for the last time are free (once each) */
+        c->dst = nfree ? freel[--nfree] : nregs++;
+        S->last[q] = c->dst;
+        for (size_t a = 0; a < ns; ++a) {
+            const uint32_t p = S->alias[S->srcq[off + a]];
+            if (S->reg[p] == (uint32_t)q) {
+                S->reg[p] = UINT32_MAX - 1; /* freed */
+                freel[nfree++] = c->src[a];
+            }
+        }
+        weight += in->code == LB__I_OP && in->op.family == LB__F_LOCAL ? LB_LOCAL_RUN_WEIGHT : 1.0;
+        ko += ns;
+        ++k;
+    }
+    S->ev = *ev;
+    S->ev.ins = S->ins;
+    S->ev.n = m;
+    S->ev.nregs = nregs ? nregs : 1;
+    S->ev.cullable = 0;
+    S->out = n ? S->last[S->alias[n - 1]] : 0;
+    S->ev.out = S->out;
+    S->weight = weight;
+    return LB_OK;
+}
