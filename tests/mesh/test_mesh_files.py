@@ -116,7 +116,7 @@ bad = [
     ((nobounds, "-o", os.path.join(work, "x.ply")), "the scene has no bounds"),
     ((default, "-o", os.path.join(work, "x.ply"), "--bounds", "1,2,3"), "expected six numbers"),
     ((default, "-o", os.path.join(work, "x.ply"), "--bounds", "0,0,0,1,-1,1"), "is not below"),
-    ((default, "-o", os.path.join(work, "x.ply"), "--resolution", "0"), "from 1 to 8192"),
+    ((default, "-o", os.path.join(work, "x.ply"), "--resolution", "0"), "cells along the longest side, 1 to 8192"),
     ((default, "-o", os.path.join(work, "x.ply"), "--cell-size", "1e-7"), "at most 8192 cells per axis"),
     ((os.path.join(work, "missing.json"), "-o", os.path.join(work, "x.ply")), "cannot open"),
     ((default, "-o", "/nonexistent-dir/x.ply"), "/nonexistent-dir/x.ply"),
