@@ -49,6 +49,13 @@ void lb__cone_free(lb__cone *S) {
     memset(S, 0, sizeof *S);
 }
 
+/* source registers of an instruction: its arguments, then (bounded) their
+ * bounding solids */
+static size_t nsrc_of(const lb__instr *in) {
+    if (in->code != LB__I_OP) return 0;
+    return in->op.family == LB__F_BOUNDED ? 2 * in->op.k : in->op.k;
+}
+
 /* the soft-form interval of a child interval f (zero: g = C (1 - f / s)) */
 static lb__iv soft_iv(const lb__instr *in, lb_convention conv, lb__iv f) {
     double fl[2] = {f.lo, f.hi}, g[2];
@@ -101,7 +108,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
     size_t nsrc = 0;
     for (size_t q = 0; q < n; ++q) {
         const lb__instr *in = &ev->ins[list ? list[q] : q];
-        if (in->code == LB__I_OP) nsrc += in->op.family == LB__F_BOUNDED ? 2 * in->op.k : in->op.k;
+        nsrc += nsrc_of(in);
         /* bulge elimination re-runs its cone by the evaluator's indices: no reduction */
         if (in->code == LB__I_OP && in->cone && in->op.family != LB__F_LOCAL) {
             S->reduced = 0;
@@ -116,8 +123,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
     for (size_t q = 0; q < n; ++q) {
         const uint32_t i = list ? list[q] : (uint32_t)q;
         const lb__instr *in = &ev->ins[i];
-        size_t ns = 0;
-        if (in->code == LB__I_OP) ns = in->op.family == LB__F_BOUNDED ? 2 * in->op.k : in->op.k;
+        const size_t ns = nsrc_of(in);
         for (size_t a = 0; a < ns; ++a) S->srcq[so + a] = S->prod[in->src[a]];
         lb__bounds_pass_list(ev, &i, 1, bc, br, S->R);
         S->ivq[q] = S->R[in->dst];
@@ -138,9 +144,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
     for (size_t q = n; q-- > 0;) {
         if (!S->need[q]) continue;
         const lb__instr *in = &ev->ins[list ? list[q] : q];
-        const size_t ns = in->code != LB__I_OP             ? 0
-                          : in->op.family == LB__F_BOUNDED ? 2 * in->op.k
-                                                           : in->op.k;
+        const size_t ns = nsrc_of(in);
         for (size_t a = 0; a < ns; ++a) S->need[S->alias[S->srcq[S->last[q] + a]]] = 1;
     }
     /* 4. copy what is needed; registers by last use (reg[q] = last reader
@@ -157,9 +161,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
     for (size_t q = 0; q < n; ++q) {
         if (!S->need[q]) continue;
         const lb__instr *in = &ev->ins[list ? list[q] : q];
-        const size_t ns = in->code != LB__I_OP             ? 0
-                          : in->op.family == LB__F_BOUNDED ? 2 * in->op.k
-                                                           : in->op.k;
+        const size_t ns = nsrc_of(in);
         for (size_t a = 0; a < ns; ++a) S->reg[S->alias[S->srcq[S->last[q] + a]]] = (uint32_t)q;
         ++m;
         msrc += ns;
@@ -176,9 +178,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
     for (size_t q = 0; q < n; ++q) {
         if (!S->need[q]) continue;
         const lb__instr *in = &ev->ins[list ? list[q] : q];
-        const size_t ns = in->code != LB__I_OP             ? 0
-                          : in->op.family == LB__F_BOUNDED ? 2 * in->op.k
-                                                           : in->op.k;
+        const size_t ns = nsrc_of(in);
         lb__instr *c = &S->ins[k];
         *c = *in;
         c->src = ns ? S->src + ko : NULL;

@@ -1064,16 +1064,8 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
      * blending volume reaches skips the distance queries */
     int reach = nd->family == LB__F_LOCAL && in->curves && in->curves->nseg;
     if (reach && n) {
-        double lo[3] = {x[0], y[0], z[0]}, hi[3] = {x[0], y[0], z[0]};
-        for (size_t j = 1; j < n; ++j) {
-            const double P[3] = {x[j], y[j], z[j]};
-            for (int d = 0; d < 3; ++d) {
-                if (P[d] < lo[d]) lo[d] = P[d];
-                if (P[d] > hi[d]) hi[d] = P[d];
-            }
-        }
         double bc[3], br[3];
-        lb__box_centre(lo, hi, bc, br);
+        points_box(x, y, z, n, bc, br);
         reach = lb__local_reaches(in->curves, bc, br);
     }
     for (size_t j = 0; j < n; ++j) {
