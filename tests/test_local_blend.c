@@ -460,7 +460,7 @@ static void test_cone_reduction(void **st) {
         int fold = 0;
         for (size_t i = 0; i < ev->n; ++i) {
             const lb__instr *ins = &ev->ins[i];
-            if (ins->code != LB__I_OP || ins->op.family != LB__F_LOCAL) continue;
+            if (ins->code != LB__I_OP || ins->op->family != LB__F_LOCAL) continue;
             const int s_right = ++fold; /* the fold's right child: sphere number fold */
             const double centre[3] = {rad * cos(2.0 * M_PI * s_right / k),
                                       rad * sin(2.0 * M_PI * s_right / k),

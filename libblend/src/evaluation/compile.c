@@ -93,7 +93,7 @@ static lb_status cost_error(cctx *c) {
                     "arguments' %u instructions twice each); allowed: at most %d times the "
                     "tape size and %d in all (docs/scene-format.md, \"Cost\"): bulge fewer "
                     "blends, or blend fewer or smaller arguments",
-                    in->code == LB__I_OP ? in->op.path : "$.root", ev->cost, ev->n, in->cost,
+                    in->code == LB__I_OP ? in->op->path : "$.root", ev->cost, ev->n, in->cost,
                     in->ncone[0] + in->ncone[1], LB_SCENE_MAX_COST_FACTOR, LB_SCENE_MAX_COST);
 }
 
@@ -190,7 +190,7 @@ static lb_status cone_of(cctx *c, uint32_t root, uint32_t **list, size_t *len, s
         const lb__instr *in = &ev->ins[i];
         *cost += in->cost;
         if (in->code != LB__I_OP) continue;
-        for (size_t a = 0; a < in->op.k; ++a)
+        for (size_t a = 0; a < in->op->k; ++a)
             for (int b = 0; b < 2; ++b) {
                 const uint32_t *from = b ? in->srcb : in->srci;
                 if (!from || c->mark[from[a]] == c->stamp) continue;
@@ -210,8 +210,8 @@ static lb_status charge(cctx *c, uint32_t idx) {
     lb_evaluator *ev = c->ev;
     lb__instr *in = &ev->ins[idx];
     in->cost = 1.0;
-    const int local = in->code == LB__I_OP && in->op.family == LB__F_LOCAL;
-    if (in->code == LB__I_OP && (in->op.bulge || local)) {
+    const int local = in->code == LB__I_OP && in->op->family == LB__F_LOCAL;
+    if (in->code == LB__I_OP && (in->op->bulge || local)) {
         size_t len = 0, cap = 0;
         uint32_t *list = NULL;
         double w[2] = {0.0, 0.0};
@@ -301,15 +301,20 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         in->code = LB__I_OP;
         in->A = A; /* world -> this node's frame (the POV-Ray export of local blends) */
         in->node = n;
-        in->op = *n;
-        in->op.args = in->op.bounds = NULL;
-        in->op.r = dup_array(n->r, n->k, &fail);
-        in->op.p = dup_array(n->p, n->k, &fail);
-        in->op.m = dup_array(n->m, n->k, &fail);
-        in->op.def_name = NULL;
-        in->op.path = malloc(strlen(n->path) + 1);
-        if (in->op.path)
-            strcpy(in->op.path, n->path);
+        /* operators only carry a copy of their node (a primitive's
+         * instruction stays small: large scenes are mostly primitives) */
+        in->op = malloc(sizeof *in->op);
+        if (!in->op)
+            return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
+        *in->op = *n;
+        in->op->args = in->op->bounds = NULL;
+        in->op->r = dup_array(n->r, n->k, &fail);
+        in->op->p = dup_array(n->p, n->k, &fail);
+        in->op->m = dup_array(n->m, n->k, &fail);
+        in->op->def_name = NULL;
+        in->op->path = malloc(strlen(n->path) + 1);
+        if (in->op->path)
+            strcpy(in->op->path, n->path);
         else
             fail = 1;
         in->src = src;
@@ -345,7 +350,7 @@ static lb_status allocate_registers(lb_evaluator *ev, uint32_t root, lb_error *e
     for (size_t i = 0; i < n; ++i) {
         const lb__instr *in = &ev->ins[i];
         if (in->code != LB__I_OP) continue;
-        const size_t ns = in->op.k * (in->op.bounds || in->op.family == LB__F_BOUNDED ? 2 : 1);
+        const size_t ns = in->op->k * (in->op->bounds || in->op->family == LB__F_BOUNDED ? 2 : 1);
         for (size_t j = 0; j < ns; ++j)
             if (last[in->src[j]] != UINT32_MAX) last[in->src[j]] = (uint32_t)i;
     }
@@ -361,10 +366,10 @@ static lb_status allocate_registers(lb_evaluator *ev, uint32_t root, lb_error *e
         reg_of[i] = nfree ? freelist[--nfree] : (uint32_t)nregs++;
         in->dst = reg_of[i];
         in->aoff = ev->total_k;
-        if (in->code == LB__I_OP) ev->total_k += in->op.k;
-        if (in->code == LB__I_OP && in->op.k > ev->kmax) ev->kmax = in->op.k;
+        if (in->code == LB__I_OP) ev->total_k += in->op->k;
+        if (in->code == LB__I_OP && in->op->k > ev->kmax) ev->kmax = in->op->k;
         if (in->code == LB__I_OP) {
-            const size_t ns = in->op.k * (in->op.family == LB__F_BOUNDED ? 2 : 1);
+            const size_t ns = in->op->k * (in->op->family == LB__F_BOUNDED ? 2 : 1);
             for (size_t j = 0; j < ns; ++j) {
                 const uint32_t a = in->src[j];
                 /* an argument used twice (a def as two arguments of one
@@ -397,10 +402,12 @@ void lb_evaluator_free(lb_evaluator *ev) {
         free(in->srcb);
         free(in->cone);
         lb__curves_free(in->curves);
-        free(in->op.r);
-        free(in->op.p);
-        free(in->op.m);
-        free(in->op.path);
+        if (!in->op) continue;
+        free(in->op->r);
+        free(in->op->p);
+        free(in->op->m);
+        free(in->op->path);
+        free(in->op);
     }
     free(ev->ins);
     free(ev);

@@ -265,7 +265,7 @@ static double blend_finite(const lb__instr *in, const double *u, const double *r
     if (na == 1) return u[0] / m[0];
     if (in->fast == LB__FAST_DISPLACEMENT)
         return lb__bt_union_ws(na, u, r, p, m, in->mode, NULL, NULL, NULL, ws);
-    return lb__conic_union(u, r, in->op.shape, m, NULL, NULL, NULL);
+    return lb__conic_union(u, r, in->op->shape, m, NULL, NULL, NULL);
 }
 
 /* Displacement and conic (no bulge) on the arguments a box can reach
@@ -274,7 +274,7 @@ static double blend_finite(const lb__instr *in, const double *u, const double *r
  * doubles of scratch. */
 static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, size_t na, iv *out,
                         double *ws) {
-    const lb__node *n = &in->op;
+    const lb__node *n = in->op;
     const size_t K = n->k;
     double *lo = ws, *hi = lo + K, *r = hi + K, *p = r + K, *m = p + K;
     ws = m + K;
@@ -487,10 +487,10 @@ static void plan_needs(const lb_evaluator *ev, lb__plan *plan, const lb__plan *p
         const uint16_t *act = plan->act + in->aoff;
         for (uint16_t a = 0; a < plan->nact[i]; ++a) {
             plan->need[in->srci[act[a]]] = 1;
-            if (in->op.family == LB__F_BOUNDED) plan->need[in->srcb[act[a]]] = 1;
+            if (in->op->family == LB__F_BOUNDED) plan->need[in->srcb[act[a]]] = 1;
         }
-        if (in->op.bulge) /* the Hessian terms re-run both arguments' prefixes */
-            for (size_t a = 0; a < in->op.k; ++a) plan->need[in->srci[a]] = 1;
+        if (in->op->bulge) /* the Hessian terms re-run both arguments' prefixes */
+            for (size_t a = 0; a < in->op->k; ++a) plan->need[in->srci[a]] = 1;
     }
     uint32_t c = 0;
     for (size_t q = 0; q < m; ++q) {
@@ -510,21 +510,21 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
         if (in->code != LB__I_OP) {
             o = prim_bounds(in, bc, br);
         } else {
-            const size_t k = in->op.k;
+            const size_t k = in->op->k;
             for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
-            if (in->op.family == LB__F_BOUNDED)
+            if (in->op->family == LB__F_BOUNDED)
                 for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
             if (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC) {
                 uint16_t *act = plan ? plan->act + in->aoff : S.act;
-                const uint16_t na = cull(&in->op, x, act);
+                const uint16_t na = cull(in->op, x, act);
                 if (plan) plan->nact[i] = na;
                 fast_bounds(in, x, act, na, &o, S.fb);
-            } else if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN) {
+            } else if (in->op->family == LB__F_LOCAL || in->op->family == LB__F_CLEAN) {
                 lb__local_bounds(ev, in, x, bc, br, &o);
-                if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
+                if (plan) plan->nact[i] = cull(in->op, x, plan->act + in->aoff);
             } else {
-                op_bounds(ev->conv, &in->op, x, c, &o, S.xl);
-                if (plan) plan->nact[i] = cull(&in->op, x, plan->act + in->aoff);
+                op_bounds(ev->conv, in->op, x, c, &o, S.xl);
+                if (plan) plan->nact[i] = cull(in->op, x, plan->act + in->aoff);
             }
         }
         store_iv(&R[in->dst], o);
@@ -537,14 +537,14 @@ static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const d
                             const double br[3], iv *R, iv *o) {
     const bscr S = scratch(ev, R);
     iv *x = S.x, *c = S.c;
-    const size_t k = in->op.k;
+    const size_t k = in->op->k;
     for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
-    if (in->op.family == LB__F_BOUNDED)
+    if (in->op->family == LB__F_BOUNDED)
         for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
-    if (in->op.family == LB__F_LOCAL || in->op.family == LB__F_CLEAN)
+    if (in->op->family == LB__F_LOCAL || in->op->family == LB__F_CLEAN)
         lb__local_bounds(ev, in, x, bc, br, o);
     else
-        op_bounds(ev->conv, &in->op, x, c, o, S.xl);
+        op_bounds(ev->conv, in->op, x, c, o, S.xl);
 }
 
 /* Operator i (in) keeps the parent's argument list in the child plan: the
@@ -577,7 +577,7 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
             const uint16_t pn = parent->nact[i];
             for (uint16_t j = 0; j < pn; ++j) x[pa[j]] = R[in->src[pa[j]]];
             if (in->fast == LB__FAST_MINMAX) {
-                const int mn = in->op.family == LB__F_MIN;
+                const int mn = in->op->family == LB__F_MIN;
                 o = x[pa[0]];
                 for (uint16_t j = 1; j < pn; ++j) {
                     const iv a = x[pa[j]];
@@ -586,7 +586,7 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                 }
             } else {
                 /* cull among the parent's arguments, as cull() does */
-                const lb__node *n = &in->op;
+                const lb__node *n = in->op;
                 double H = INFINITY;
                 for (uint16_t j = 0; j < pn; ++j) {
                     const iv u = dual_iv(n->op, pa[j], x[pa[j]]);

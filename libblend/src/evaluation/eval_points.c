@@ -164,7 +164,7 @@ static void run_prim(const lb__instr *in, size_t n, const double *x, const doubl
 static double fast_op(const lb__instr *in, size_t k, const uint16_t *act, const double *x,
                       const double *r, const double *p, const double *m, const double *ir,
                       const double *im, double *dx, double *ws) {
-    const lb__node *n = &in->op;
+    const lb__node *n = in->op;
     double *xt = ws, *sg = ws + k;
     ws += 2 * k;
     switch (in->fast) {
@@ -223,7 +223,7 @@ LB__INLINE void bt_two_loop(const size_t K, const lb__instr *in, const uint16_t 
                             const double *const *vs, const double *const *gxs,
                             const double *const *gys, const double *const *gzs, const double *r,
                             const double *m, double *ov, double *ox, double *oy, double *oz) {
-    const lb_setop op = in->op.op;
+    const lb_setop op = in->op->op;
     double sg[4];
     for (size_t i = 0; i < K; ++i)
         sg[i] = op == LB_UNION ? 1.0 : op == LB_INTERSECTION || act[i] == 0 ? -1.0 : 1.0;
@@ -255,7 +255,7 @@ LB__INLINE void bt_two_loop(const size_t K, const lb__instr *in, const uint16_t 
  * every argument value within the fast kernels' range */
 static int bt_two_chunk(const lb__instr *in, size_t k, size_t n, const double *const *vs) {
     if (in->fast != LB__FAST_DISPLACEMENT || in->mode != LB__P_TWO || k < 2 || k > 4 ||
-        in->op.bulge)
+        in->op->bulge)
         return 0;
     int ok = 1;
     for (size_t i = 0; i < k; ++i)
@@ -271,7 +271,7 @@ LB_VECTOR_CLONES static lb_status run_op(const lb_evaluator *ev, const lb__instr
                                          const lb__plan *plan, size_t n, const double *px,
                                          const double *py, const double *pz, double *regs,
                                          size_t *count, lb_error *err) {
-    const lb__node *nd = &in->op;
+    const lb__node *nd = in->op;
     if (nd->family == LB__F_LOCAL || nd->family == LB__F_CLEAN)
         return lb__local_run(ev, in, n, px, py, pz, regs, err);
     const size_t kf = nd->k;
@@ -409,7 +409,7 @@ static lb_status bulge_hvp(const lb_evaluator *ev, const lb__instr *in, size_t n
                            size_t *count, lb_error *err) {
     memset(G, 0, 3 * n * sizeof *G);
     double *regs = malloc(lb__regs_len(ev) * sizeof *regs);
-    if (!regs) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+    if (!regs) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
     double sx[LB__CHUNK], sy[LB__CHUNK], sz[LB__CHUNK], eps[LB__CHUNK], len[LB__CHUNK];
     lb_status s = LB_OK;
     for (int i = 0; i < 2 && !s; ++i) {

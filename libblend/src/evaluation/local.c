@@ -88,7 +88,7 @@ static lb_status charge(child_eval *E, double runs) {
                     "children under local unions (a local_union of k children folds left, so "
                     "each fold evaluates every child before it), or clean_union or min where "
                     "no local blend is needed",
-                    E->in->op.path, LB_SCENE_MAX_COMPILE_COST);
+                    E->in->op->path, LB_SCENE_MAX_COMPILE_COST);
 }
 
 /* instruction runs of one evaluation of a cone */
@@ -96,7 +96,7 @@ static double cone_weight(const lb_evaluator *ev, const uint32_t *cone, size_t n
     double w = 0.0;
     for (size_t i = 0; i < n; ++i) {
         const lb__instr *q = &ev->ins[cone[i]];
-        w += q->code == LB__I_OP && q->op.family == LB__F_LOCAL ? LB_LOCAL_RUN_WEIGHT : 1.0;
+        w += q->code == LB__I_OP && q->op->family == LB__F_LOCAL ? LB_LOCAL_RUN_WEIGHT : 1.0;
     }
     return w;
 }
@@ -172,7 +172,7 @@ static lb_status children_at(child_eval *E, size_t n, const double *x, const dou
                 size_t near = 0;
                 for (size_t q = 0; q < nr; ++q) {
                     const lb__instr *c = run_ev != E->ev ? &run_ev->ins[q] : &E->ev->ins[cone[q]];
-                    near += c->code == LB__I_OP && c->op.family == LB__F_LOCAL &&
+                    near += c->code == LB__I_OP && c->op->family == LB__F_LOCAL &&
                             lb__local_reaches(c->curves, bc, br);
                 }
                 w += (double)near * LB_LOCAL_NEAR_WEIGHT;
@@ -182,7 +182,8 @@ static lb_status children_at(child_eval *E, size_t n, const double *x, const dou
                 if (lb__regs_len(run_ev) > E->nsubregs) {
                     double *q = realloc(E->subregs, lb__regs_len(run_ev) * sizeof *q);
                     if (!q)
-                        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+                        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory",
+                                        in->op->path);
                     E->subregs = q;
                     E->nsubregs = lb__regs_len(run_ev);
                 }
@@ -194,11 +195,11 @@ static lb_status children_at(child_eval *E, size_t n, const double *x, const dou
             if (st) return st;
             double *regs = run_ev != E->ev ? E->subregs : E->regs;
             const double k =
-                E->ev->conv == LB_CONVENTION_ZERO ? -LB__LOCAL_ISO / in->op.lp.zero_scale : 1.0;
+                E->ev->conv == LB_CONVENTION_ZERO ? -LB__LOCAL_ISO / in->op->lp.zero_scale : 1.0;
             for (size_t j = 0; j < m; ++j) {
                 const double f = lb__reg(regs, r, 0)[j];
                 double fv[2] = {f, f}, gv[2];
-                lb__local_in(&in->op, E->ev->conv, fv, gv);
+                lb__local_in(in->op, E->ev->conv, fv, gv);
                 g[2 * (s + j) + a] = gv[0];
                 if (grad)
                     for (int d = 0; d < 3; ++d)
@@ -302,7 +303,8 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
             if ((cs = charge(E, P->weight))) return cs;
             if (lb__ivs_len(&P->ev) > E->nivs) {
                 lb__iv *q = realloc(E->ivs, lb__ivs_len(&P->ev) * sizeof *q);
-                if (!q) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+                if (!q)
+                    return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
                 E->ivs = q;
                 E->nivs = lb__ivs_len(&P->ev);
             }
@@ -314,7 +316,7 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
             f = R[in->src[a]];
         }
         double fl[2] = {f.lo, f.hi}, gl[2];
-        lb__local_in(&in->op, E->ev->conv, fl, gl);
+        lb__local_in(in->op, E->ev->conv, fl, gl);
         const double glo = gl[0] < gl[1] ? gl[0] : gl[1], ghi = gl[0] < gl[1] ? gl[1] : gl[0];
         if (!(glo <= LB__LOCAL_ISO && ghi >= LB__LOCAL_ISO)) return LB_OK;
     }
@@ -329,7 +331,7 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
         if (S->n == S->cap) {
             const size_t nc = S->cap ? 2 * S->cap : 256;
             uint32_t *q = realloc(S->c, 3 * nc * sizeof *q);
-            if (!q) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+            if (!q) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
             S->c = q;
             S->cap = nc;
         }
@@ -459,7 +461,7 @@ static lb_status project(child_eval *E, size_t n, double *p, double size) {
     double *gr = malloc(6 * n * sizeof *gr);
     lb_status s = LB_OK;
     if (!x || !g || !gr)
-        s = lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        s = lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
     for (int it = 0; it < REFINE_STEPS && !s; ++it) {
         for (size_t i = 0; i < n; ++i)
             for (int d = 0; d < 3; ++d) x[d * n + i] = p[3 * i + d];
@@ -513,7 +515,7 @@ static lb_status chain(child_eval *E, const builder *B, struct lb__curves *C) {
     if (!adj || !used || !C->pts || !C->comp) {
         free(adj);
         free(used);
-        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
     }
     for (size_t i = 0; i < 2 * nf; ++i) adj[i] = UINT32_MAX;
     for (size_t s = 0; s < ns; ++s)
@@ -575,7 +577,7 @@ static lb_status subdivide(child_eval *E, struct lb__curves *C, double size) {
             nseg += C->comp[c].count - (C->comp[c].closed ? 0 : 1);
         if (!nseg) return LB_OK;
         double *mid = malloc(3 * nseg * sizeof *mid);
-        if (!mid) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        if (!mid) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
         size_t q = 0;
         for (size_t c = 0; c < C->ncomp; ++c) {
             const lb__component *K = &C->comp[c];
@@ -590,7 +592,7 @@ static lb_status subdivide(child_eval *E, struct lb__curves *C, double size) {
         double *chord = malloc(3 * nseg * sizeof *chord);
         if (!chord) {
             free(mid);
-            return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+            return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
         }
         memcpy(chord, mid, 3 * nseg * sizeof *mid);
         lb_status s = project(E, nseg, mid, size);
@@ -606,7 +608,7 @@ static lb_status subdivide(child_eval *E, struct lb__curves *C, double size) {
         if (!np) {
             free(mid);
             free(chord);
-            return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+            return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
         }
         size_t nv = 0;
         q = 0;
@@ -635,7 +637,7 @@ static lb_status subdivide(child_eval *E, struct lb__curves *C, double size) {
 
 /* feature sizes, limits and support of each component */
 static lb_status parameters(child_eval *E, struct lb__curves *C, double size) {
-    const lb__local_params *L = &E->in->op.lp;
+    const lb__local_params *L = &E->in->op->lp;
     const size_t n = C->nv;
     if (!n) return LB_OK;
     /* gradients at X +- h e_d for the divergence of the unit normals */
@@ -646,7 +648,7 @@ static lb_status parameters(child_eval *E, struct lb__curves *C, double size) {
         free(x);
         free(g);
         free(gr);
-        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
     }
     const size_t N = 7 * n;
     for (size_t i = 0; i < n; ++i)
@@ -695,7 +697,7 @@ static lb_status parameters(child_eval *E, struct lb__curves *C, double size) {
             if (!y || !gy) {
                 free(y);
                 free(gy);
-                s = lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+                s = lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
                 break;
             }
             for (size_t i = 0; i < m; ++i) {
@@ -807,7 +809,7 @@ static lb_status make_bvh(child_eval *E, struct lb__curves *C) {
     uint32_t *order = malloc(ns * sizeof *order);
     if (!C->seg || !C->segc || !C->bvh || !order) {
         free(order);
-        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
     }
     size_t q = 0;
     for (size_t c = 0; c < C->ncomp; ++c) {
@@ -828,7 +830,7 @@ static lb_status make_bvh(child_eval *E, struct lb__curves *C) {
         free(seg);
         free(segc);
         free(order);
-        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op.path);
+        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
     }
     for (size_t i = 0; i < ns; ++i) {
         seg[2 * i] = C->seg[2 * order[i]];
@@ -852,7 +854,7 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
     memset(&B, 0, sizeof B);
     cellset S = {NULL, 0, 0};
     lb_status s = LB_OK;
-    if (!C || !regs || !R) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+    if (!C || !regs || !R) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
     child_eval E = {.ev = ev,
                     .in = in,
                     .regs = regs,
@@ -886,10 +888,10 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
     /* sample the kept cells' nodes */
     if (!s && S.n) {
         if (hmap_init(&B.nodes, 8 * S.n) || hmap_init(&B.faces, 24 * S.n))
-            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
         B.G = &G;
         uint64_t *ids = s ? NULL : malloc(8 * S.n * sizeof *ids);
-        if (!s && !ids) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+        if (!s && !ids) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
         size_t nn = 0;
         for (size_t c = 0; c < S.n && !s; ++c)
             for (int k = 0; k < 8; ++k) {
@@ -906,7 +908,7 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
         double *x = s ? NULL : malloc(3 * nn * sizeof *x);
         B.nval = s ? NULL : malloc(2 * nn * sizeof *B.nval);
         if (!s && (!x || !B.nval))
-            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
         for (size_t i = 0; i < nn && !s; ++i) {
             double p[3];
             node_pos(&G, ids[i], p);
@@ -925,7 +927,7 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
             for (int k = 0; k < 8; ++k)
                 corner[k] = node_id(&G, q[0] + (k & 1), q[1] + (k >> 1 & 1), q[2] + (k >> 2));
             if (tet_segments(&B, corner))
-                s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op.path);
+                s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
         }
     }
     if (!s) s = chain(&E, &B, C);
@@ -959,13 +961,13 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
 lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, lb_error *err) {
     for (size_t i = 0; i < ev->n; ++i) {
         lb__instr *in = &ev->ins[i];
-        if (in->code != LB__I_OP || in->op.family != LB__F_LOCAL) continue;
+        if (in->code != LB__I_OP || in->op->family != LB__F_LOCAL) continue;
         double bmin[3], bmax[3];
         if (!lb_scene_bounds(scene, bmin, bmax))
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "%s: local_union finds its children's intersection curves inside the "
                             "scene's bounds; allowed: a scene with \"bounds\"",
-                            in->op.path);
+                            in->op->path);
         lb_status s = prepare_one(ev, in, bmin, bmax, &ev->compile_cost, err);
         if (s) return s;
     }
@@ -1054,7 +1056,7 @@ int lb__local_reaches(const struct lb__curves *C, const double bc[3], const doub
 
 lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
                         const double *y, const double *z, double *regs, lb_error *err) {
-    const lb__node *nd = &in->op;
+    const lb__node *nd = in->op;
     const lb_convention conv = ev->conv;
     const double k = conv == LB_CONVENTION_ZERO ? -LB__LOCAL_ISO / nd->lp.zero_scale : 1.0;
     double *ov = lb__reg(regs, in->dst, 0), *ox = lb__reg(regs, in->dst, 1),
@@ -1128,7 +1130,7 @@ static double ur_val(double a, double b) {
 
 void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv x[2],
                       const double bc[3], const double br[3], lb__iv *out) {
-    const lb__node *nd = &in->op;
+    const lb__node *nd = in->op;
     const lb_convention conv = ev->conv;
     double lo[2], hi[2];
     if (!isfinite(x[0].lo) || !isfinite(x[0].hi) || !isfinite(x[1].lo) || !isfinite(x[1].hi)) {
@@ -1213,9 +1215,9 @@ size_t lb_evaluator_describe_local(const lb_evaluator *ev, char *buf, size_t siz
     if (!ev) return 0;
     for (size_t i = 0; i < ev->n; ++i) {
         const lb__instr *in = &ev->ins[i];
-        if (in->code != LB__I_OP || in->op.family != LB__F_LOCAL || !in->curves) continue;
+        if (in->code != LB__I_OP || in->op->family != LB__F_LOCAL || !in->curves) continue;
         const struct lb__curves *C = in->curves;
-        lb__text_put(&b, "%s: %zu intersection curve%s, %zu vertices\n", in->op.path, C->ncomp,
+        lb__text_put(&b, "%s: %zu intersection curve%s, %zu vertices\n", in->op->path, C->ncomp,
                      C->ncomp == 1 ? "" : "s", C->nv);
         for (size_t c = 0; c < C->ncomp; ++c) {
             const lb__component *K = &C->comp[c];
@@ -1237,7 +1239,7 @@ const struct lb__curves *lb__local_nth(const lb_evaluator *ev, size_t which) {
     size_t seen = 0;
     for (size_t i = 0; ev && i < ev->n; ++i) {
         const lb__instr *in = &ev->ins[i];
-        if (in->code == LB__I_OP && in->op.family == LB__F_LOCAL && seen++ == which)
+        if (in->code == LB__I_OP && in->op->family == LB__F_LOCAL && seen++ == which)
             return in->curves;
     }
     return NULL;

@@ -33,7 +33,7 @@ typedef struct lb__instr {
     lb__affine A; /* world -> primitive frame (operators: -> the node's frame) */
     int identity;
     /* operators: a copy of the node (args/bounds NULL) and source registers */
-    lb__node op;
+    lb__node *op;
     uint32_t *src;  /* k argument registers, then k bounding registers (bounded) */
     uint32_t *srci; /* k argument instruction indices (bulge: prefix re-evaluation) */
     uint32_t *srcb; /* k bounding-solid instruction indices (bounded), else NULL */
