@@ -19,6 +19,7 @@ import os
 import shutil
 import subprocess
 import sys
+import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from checks import args, check, finish  # noqa: E402
@@ -55,8 +56,10 @@ for jf in jobs:
     job["output_dir"] = out
     small_job = os.path.join(WORK, jf)
     json.dump(job, open(small_job, "w"))
+    t0 = time.monotonic()
     r = subprocess.run([BLENDTOOL, "batch", small_job, "--threads", "2"], capture_output=True,
                        text=True)
+    print("%s: rendered in %.0f s" % (name, time.monotonic() - t0), flush=True)
     check(r.returncode == 0, "%s: batch at half size: %s" % (name, r.stderr[-300:]))
     fresh = sorted(f for f in os.listdir(out) if f.endswith(".png") and not f.endswith("_sheet.png"))
     committed_dir = os.path.join(GAL, name)
