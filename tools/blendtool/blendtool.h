@@ -62,6 +62,16 @@ int bt_parse_long(const char *cmd, const char *option, const char *text, long lo
  * returns -1. */
 int bt_parse_threads(const char *cmd, const char *text, int *threads);
 
+/* The folder of the running executable (from /proc/self/exe) into out;
+ * -1 when unknown or longer than n. */
+int bt_self_dir(char *out, size_t n);
+
+/* The folder holding libblend.inc into out: $LIBBLEND_POVRAY_INCLUDE, else
+ * the installed layout's share/libblend/povray relative to the executable
+ * (the build tree mirrors it). 0, or -1 after a message naming the file
+ * looked for and the fix. */
+int bt_povray_include(const char *cmd, char *out, size_t n);
+
 /* Load a scene, printing the library's message on failure. Returns the exit
  * code (0 on success). */
 int bt_load_scene(const char *cmd, const char *path, lb_scene **scene);
@@ -136,8 +146,8 @@ void bt_signals_commit(void);              /* hold the signals from here to exit
  * SIGINT / SIGTERM / SIGHUP; a folder of a killed run is removed by the
  * next render). */
 typedef struct bt_render_dir {
-    char dir[4096], pov[4200], png[4200], state[4200], log[4200];
-    int slot[4];
+    char dir[4096], pov[4200], png[4200], state[4200], log[4200], ini[4200];
+    int slot[5];
 } bt_render_dir;
 int bt_render_dir_open(bt_render_dir *r); /* exit code */
 void bt_render_dir_close(bt_render_dir *r);

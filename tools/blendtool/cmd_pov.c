@@ -13,16 +13,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#ifndef LIBBLEND_POVRAY_DIR
-#define LIBBLEND_POVRAY_DIR "/usr/local/share/libblend/povray"
-#endif
-
-/* where libblend.inc is: $LIBBLEND_POVRAY_INCLUDE, else the built-in path */
-static const char *include_dir(void) {
-    const char *e = getenv("LIBBLEND_POVRAY_INCLUDE");
-    return e && *e ? e : LIBBLEND_POVRAY_DIR;
-}
-
 static int parse_int(const char *cmd, const char *opt, const char *v, long lo, long hi, int *out) {
     long n = 0;
     if (bt_parse_long(cmd, opt, v, lo, hi, "an integer", &n)) return -1;
@@ -147,7 +137,8 @@ static const char *tmp_root(void) {
 /* what a render folder holds: the scene, the image, and the state file
  * povray writes when it is stopped mid-render */
 static const char *const RENDER_FILES[] = {"scene.pov", "image.png", "image.pov-state",
-                                           "povray.log"};
+                                           "povray.log", "render.ini"};
+#define NRENDER_FILES (sizeof RENDER_FILES / sizeof RENDER_FILES[0])
 
 static void remove_stale_renders(void) {
     DIR *d = opendir(tmp_root());
@@ -161,7 +152,7 @@ static void remove_stale_renders(void) {
         if (pid <= 0 || !end || *end != '-') continue;
         if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
         char path[4096];
-        for (int i = 0; i < 4; ++i) {
+        for (size_t i = 0; i < NRENDER_FILES; ++i) {
             snprintf(path, sizeof path, "%s/%s/%s", tmp_root(), e->d_name, RENDER_FILES[i]);
             unlink(path);
         }
@@ -173,14 +164,35 @@ static void remove_stale_renders(void) {
 
 int bt_povray(const char *scene_name, const char *pov, const char *png, int width, int height,
               int threads, int quality, int deep, const char *log) {
-    char inc[4096], outw[64], outh[64], th[64], q[32], in[4300], out[4300];
-    snprintf(inc, sizeof inc, "+L%s", include_dir());
+    char outw[64], outh[64], th[64], q[32], dir[4096], rdir[4200], ini[4300];
+    if (bt_povray_include("render", dir, sizeof dir)) return BT_EXIT_INTERNAL;
+    /* POV-Ray splits its command line at spaces, even inside one argument
+     * (+L/a b fails): the paths go into an INI file as quoted strings, and
+     * povray runs in the render folder, given the INI file by its bare name */
+    const char *slash = strrchr(pov, '/');
+    snprintf(rdir, sizeof rdir, "%.*s", slash ? (int)(slash - pov) : 1, slash ? pov : ".");
+    snprintf(ini, sizeof ini, "%s/%s", rdir, RENDER_FILES[4]);
+    const char *const paths[3] = {pov, png, dir};
+    for (int i = 0; i < 3; ++i)
+        if (strpbrk(paths[i], "\"\n\r")) {
+            bt_error("render",
+                     "%s: POV-Ray cannot take a path with a double quote or a line break; "
+                     "allowed: another folder (set TMPDIR, or LIBBLEND_POVRAY_INCLUDE)",
+                     paths[i]);
+            return BT_EXIT_INTERNAL;
+        }
+    FILE *fi = fopen(ini, "w");
+    if (!fi ||
+        fprintf(fi, "Input_File_Name=\"%s\"\nOutput_File_Name=\"%s\"\nLibrary_Path=\"%s\"\n", pov,
+                png, dir) < 0 ||
+        fclose(fi) != 0) {
+        bt_error("render", "%s: cannot write: %s", ini, strerror(errno));
+        return BT_EXIT_INTERNAL;
+    }
     snprintf(outw, sizeof outw, "+W%d", width);
     snprintf(outh, sizeof outh, "+H%d", height);
     snprintf(th, sizeof th, "+WT%d", threads > 0 ? threads : (int)sysconf(_SC_NPROCESSORS_ONLN));
     snprintf(q, sizeof q, "+Q%d", quality);
-    snprintf(in, sizeof in, "+I%s", pov);
-    snprintf(out, sizeof out, "+O%s", png);
     const pid_t pid = fork();
     if (pid == 0) {
         /* povray ends with blendtool, even when blendtool is killed */
@@ -195,11 +207,12 @@ int bt_povray(const char *scene_name, const char *pov, const char *png, int widt
                 dup2(fileno(lf), STDOUT_FILENO);
             }
         }
+        if (chdir(rdir) != 0) _exit(127);
         if (deep) /* 16-bit PNG with alpha, for the OpenImageIO writer */
-            execlp("povray", "povray", in, out, inc, outw, outh, th, q, "-D", "+FN16", "+UA", "-V",
-                   (char *)NULL);
+            execlp("povray", "povray", RENDER_FILES[4], outw, outh, th, q, "-D", "+FN16", "+UA",
+                   "-V", (char *)NULL);
         else
-            execlp("povray", "povray", in, out, inc, outw, outh, th, q, "-D", "+FN", "-V",
+            execlp("povray", "povray", RENDER_FILES[4], outw, outh, th, q, "-D", "+FN", "-V",
                    (char *)NULL);
         fprintf(stderr,
                 "blendtool render: cannot run povray (%s); allowed: install POV-Ray 3.7 (Debian "
@@ -249,11 +262,13 @@ int bt_render_dir_open(bt_render_dir *r) {
     snprintf(r->png, sizeof r->png, "%s/%s", r->dir, RENDER_FILES[1]);
     snprintf(r->state, sizeof r->state, "%s/%s", r->dir, RENDER_FILES[2]);
     snprintf(r->log, sizeof r->log, "%s/%s", r->dir, RENDER_FILES[3]);
+    snprintf(r->ini, sizeof r->ini, "%s/%s", r->dir, RENDER_FILES[4]);
     /* registered before they exist: the handler removes what is there */
     r->slot[0] = bt_signals_temp(r->pov);
     r->slot[1] = bt_signals_temp(r->png);
     r->slot[2] = bt_signals_temp(r->state);
     r->slot[3] = bt_signals_temp(r->log);
+    r->slot[4] = bt_signals_temp(r->ini);
     bt_signals_temp_dir(r->dir);
     return BT_EXIT_OK;
 }
@@ -263,8 +278,9 @@ void bt_render_dir_close(bt_render_dir *r) {
     remove(r->png);
     remove(r->state);
     remove(r->log);
+    remove(r->ini);
     rmdir(r->dir);
-    for (int i = 0; i < 4; ++i) bt_signals_untemp(r->slot[i]);
+    for (int i = 0; i < 5; ++i) bt_signals_untemp(r->slot[i]);
     bt_signals_temp_dir(NULL);
 }
 
@@ -367,7 +383,9 @@ const bt_command bt_cmd_pov = {
     "libblend.inc, one isosurface over the scene's bounds with a max_gradient\n"
     "computed by libblend, camera, lights and material from the scene's render\n"
     "section (or framing the bounds). Render it with\n"
-    "  povray +IOUT.pov +L" LIBBLEND_POVRAY_DIR "\n"
+    "  povray +IOUT.pov +LDIR\n"
+    "where DIR holds libblend.inc: $LIBBLEND_POVRAY_INCLUDE, else the copy\n"
+    "installed with blendtool (share/libblend/povray beside its bin/).\n"
     "  --include-only  only the function declarations (the field is LB_Field)\n"
     "  --silhouette    a white object on black, unshaded (for comparisons)\n"
     "  --width, --height  the image's aspect ratio for the camera (640 x 480)\n"
@@ -388,7 +406,8 @@ const bt_command bt_cmd_render = {
     "hash, libblend's version and the render settings as metadata and no time\n"
     "stamp: the same scene and options give the same bytes. OUT appears only when\n"
     "the render succeeded.\n"
-    "libblend.inc is taken from $LIBBLEND_POVRAY_INCLUDE or " LIBBLEND_POVRAY_DIR ".\n"
+    "libblend.inc is taken from the folder $LIBBLEND_POVRAY_INCLUDE, else from the\n"
+    "copy installed with blendtool (share/libblend/povray beside its bin/).\n"
     "  --width, --height  image size (640 x 480)\n"
     "  --threads N        render threads (0 = one per CPU)\n"
     "  --quality Q        POV-Ray quality 0..11 (9)\n"

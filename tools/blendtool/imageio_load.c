@@ -3,7 +3,9 @@
  * and blendtool must install its signal handlers at once (a signal in the
  * first milliseconds still gets the documented exit status). The module
  * (liblbimageio.so, tools/imageio) is looked up in $LIBBLEND_IMAGEIO, next to
- * the blendtool executable, then in the installed libdir. */
+ * the blendtool executable (the build tree), then in the installed libdir
+ * relative to it (lib/libblend beside bin/): an installed prefix works
+ * wherever it is copied. */
 #define _GNU_SOURCE
 #include "blendtool.h"
 
@@ -13,8 +15,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#ifndef LIBBLEND_IMAGEIO_DIR
-#define LIBBLEND_IMAGEIO_DIR "/usr/local/lib/libblend"
+#ifndef LIBBLEND_IMAGEIO_REL
+#define LIBBLEND_IMAGEIO_REL "../lib/libblend"
 #endif
 
 static bt_imageio api; /* one process, loaded once */
@@ -30,21 +32,12 @@ const bt_imageio *bt_imageio_get(const char *cmd) {
         h = dlopen(env, RTLD_NOW | RTLD_LOCAL);
         snprintf(tried, sizeof tried, "%s", env);
     }
-    if (!h) {
-        char self[PATH_MAX];
-        const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-        if (n > 0) {
-            self[n] = '\0';
-            char *slash = strrchr(self, '/');
-            if (slash) *slash = '\0';
-            snprintf(path, sizeof path, "%s/liblbimageio.so", self);
-            h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-            size_t l = strlen(tried);
-            snprintf(tried + l, sizeof tried - l, "%s%s", l ? ", " : "", path);
-        }
-    }
-    if (!h) {
-        snprintf(path, sizeof path, "%s/liblbimageio.so", LIBBLEND_IMAGEIO_DIR);
+    char self[PATH_MAX];
+    /* next to the executable (the build tree), then the installed layout's
+     * libdir relative to it */
+    for (int k = 0; k < 2 && !h && bt_self_dir(self, sizeof self) == 0; ++k) {
+        snprintf(path, sizeof path,
+                 k ? "%s/" LIBBLEND_IMAGEIO_REL "/liblbimageio.so" : "%s/liblbimageio.so", self);
         h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
         size_t l = strlen(tried);
         snprintf(tried + l, sizeof tried - l, "%s%s", l ? ", " : "", path);

@@ -86,6 +86,44 @@ int bt_parse_threads(const char *cmd, const char *text, int *threads) {
     return 0;
 }
 
+int bt_self_dir(char *out, size_t n) {
+    char self[4096];
+    const ssize_t l = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (l <= 0) return -1;
+    self[l] = '\0';
+    char *slash = strrchr(self, '/');
+    if (!slash) return -1;
+    *slash = '\0';
+    return (size_t)snprintf(out, n, "%s", self) < n ? 0 : -1;
+}
+
+#ifndef LIBBLEND_POVRAY_REL
+#define LIBBLEND_POVRAY_REL "../share/libblend/povray"
+#endif
+
+int bt_povray_include(const char *cmd, char *out, size_t n) {
+    const char *env = getenv("LIBBLEND_POVRAY_INCLUDE");
+    char self[4096] = "", tried[8400] = "";
+    if (env && *env) {
+        snprintf(out, n, "%s", env);
+    } else if (bt_self_dir(self, sizeof self) == 0) {
+        snprintf(out, n, "%s/%s", self, LIBBLEND_POVRAY_REL);
+    } else {
+        bt_error(cmd, "cannot find libblend.inc: the executable's folder is unknown "
+                      "(/proc/self/exe); allowed: set LIBBLEND_POVRAY_INCLUDE to the folder "
+                      "holding libblend.inc");
+        return -1;
+    }
+    snprintf(tried, sizeof tried, "%s/libblend.inc", out);
+    if (access(tried, R_OK) == 0) return 0;
+    bt_error(cmd,
+             "cannot read %s (%s); allowed: set LIBBLEND_POVRAY_INCLUDE to the folder holding "
+             "libblend.inc, or install blendtool with its share/libblend/povray folder "
+             "(cmake --install)",
+             tried, env && *env ? "from $LIBBLEND_POVRAY_INCLUDE" : "beside the executable");
+    return -1;
+}
+
 int bt_load_scene(const char *cmd, const char *path, lb_scene **scene) {
     lb_error e = {LB_OK, ""};
     lb_status s = lb_scene_load(path, scene, &e);

@@ -14,7 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#define MAX_TEMPS 8
+#define MAX_TEMPS 12
 
 static volatile sig_atomic_t child_pid = 0;
 static char temps[MAX_TEMPS][4096 + 640];
