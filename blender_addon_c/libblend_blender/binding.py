@@ -19,6 +19,7 @@ cancel a running mesh with a CancelToken from any thread.
 """
 import ctypes
 import os
+import platform
 
 try:
     import numpy as np
@@ -134,9 +135,28 @@ _SIGNATURES = {
 }
 
 
+def library_name(system=None):
+    """The library's file name on a platform (platform.system()'s name):
+    libblend.dll on Windows, libblend.dylib on macOS, else libblend.so."""
+    system = system or platform.system()
+    return {"Windows": "libblend.dll", "Darwin": "libblend.dylib"}.get(system, "libblend.so")
+
+
+def platform_tag(system=None, machine=None):
+    """This machine as Blender's extension platforms name it (linux-x64,
+    windows-x64, macos-arm64, ...), for messages."""
+    system = (system or platform.system()).lower()
+    machine = (machine or platform.machine()).lower()
+    osname = {"darwin": "macos"}.get(system, system)
+    arch = {"x86_64": "x64", "amd64": "x64", "aarch64": "arm64", "arm64": "arm64"}.get(machine,
+                                                                                     machine)
+    return "%s-%s" % (osname, arch)
+
+
 def _candidates():
     here = os.path.dirname(os.path.abspath(__file__))
-    return [os.path.join(here, "lib", "libblend.so"), os.path.join(here, "libblend.so")]
+    name = library_name()
+    return [os.path.join(here, "lib", name), os.path.join(here, name)]
 
 
 def default_path():
@@ -171,15 +191,17 @@ class Library:
             how = ("$%s points to it" % ENV_LIBRARY) if os.environ.get(ENV_LIBRARY) == path else \
                 "the add-on's lib/ folder should hold it"
             raise LibraryError(
-                "libblend library not found: %s (%s). Fix: build libblend (cmake --build BUILD) and "
-                "install the add-on zip from BUILD/blender_addon/, or set %s to the path of "
-                "libblend.so" % (path, how, ENV_LIBRARY), 6)
+                "libblend library not found for %s: %s (%s). Fix: install the add-on package "
+                "built for %s, or build libblend (cmake --build BUILD) and install the zip from "
+                "BUILD/blender_addon/, or set %s to the path of %s"
+                % (platform_tag(), path, how, platform_tag(), ENV_LIBRARY, library_name()), 6)
         try:
             self._c = ctypes.CDLL(path)
         except OSError as e:
-            raise LibraryError("libblend library %s could not be loaded: %s. Fix: rebuild libblend "
-                               "for this machine or point %s at a working libblend.so"
-                               % (path, e, ENV_LIBRARY), 6) from None
+            raise LibraryError("libblend library %s could not be loaded on %s: %s. Fix: install "
+                               "the add-on package built for %s, or point %s at a working %s"
+                               % (path, platform_tag(), e, platform_tag(), ENV_LIBRARY,
+                                  library_name()), 6) from None
         missing = [n for n in _SIGNATURES if not hasattr(self._c, n)]
         if "lb_version" in missing:
             raise LibraryError("%s is not libblend (no lb_version symbol). Fix: point %s at "

@@ -179,13 +179,23 @@ ev.close()  # twice is fine
 
 # ---- the library itself
 raises(lambda: binding.load(os.path.join(WORK, "nope", "libblend.so")), binding.LibraryError,
-       "not found", "nope")
+       "not found", "nope", "for linux-x64")
+# the file and the platform in messages, by platform (the Windows and macOS
+# packages carry libblend.dll / libblend.dylib)
+check(binding.library_name("Windows") == "libblend.dll" and
+      binding.library_name("Darwin") == "libblend.dylib" and
+      binding.library_name("Linux") == "libblend.so" and binding.library_name() == "libblend.so",
+      "the library's file name by platform")
+check(binding.platform_tag("Windows", "AMD64") == "windows-x64" and
+      binding.platform_tag("Darwin", "arm64") == "macos-arm64" and
+      binding.platform_tag("Linux", "aarch64") == "linux-arm64" and
+      binding.platform_tag() == "linux-x64", "platform tags as Blender's extensions name them")
 libm = (glob.glob("/usr/lib/x86_64-linux-gnu/libm.so.6") + glob.glob("/lib/*/libm.so.6"))[0]
 raises(lambda: binding.load(libm), binding.LibraryError, "is not libblend")
 notlib = os.path.join(WORK, "garbage.so")
 with open(notlib, "wb") as f:
     f.write(b"not an ELF file")
-raises(lambda: binding.load(notlib), binding.LibraryError, "could not be loaded")
+raises(lambda: binding.load(notlib), binding.LibraryError, "could not be loaded on linux-x64")
 # a libblend of another version: a stub library with only lb_version
 stub_dir = os.path.join(WORK, "stub")
 os.makedirs(stub_dir, exist_ok=True)
