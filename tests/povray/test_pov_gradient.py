@@ -44,9 +44,13 @@ def render(name, body):
         f.write(body)
     rc, text = 0, ""
     for side in (1, -1):
+        # the helper runs once, from the front (its N^3 samples in SDL are
+        # most of the time); the view from behind is given its value
+        mg = MG.findall(text)[:1]
         r = subprocess.run(["povray", "+I" + path, "+O" + os.path.join(WORK, name + ".png"),
                             "+W64", "+H48", "-D", "+L" + INC, "+L" + WORK,
-                            "Declare=Side=%d" % side], capture_output=True, text=True)
+                            "Declare=Side=%d" % side] + (["Declare=MG=" + mg[0]] if mg else []),
+                           capture_output=True, text=True)
         rc = rc or r.returncode
         text += " " + " ".join((r.stdout + r.stderr).split())
     return rc, text
@@ -112,8 +116,8 @@ def scene_pov(field_inc, lo, hi, soft, func="LB_Field", n=24):
     d = max(b - a for a, b in zip(lo, hi))
     return ('#version 3.7;\n#include "libblend.inc"\n%s\n'
             "#declare LBH = function(x, y, z) { %s(x, y, z)%s }\n"
-            "#declare MG = LB_MaxGradient(LBH, <%r, %r, %r>, <%r, %r, %r>, %d);\n"
-            '#debug concat("LBMG ", str(MG, 0, 6), "\\n")\n'
+            "#ifndef (MG) #declare MG = LB_MaxGradient(LBH, <%r, %r, %r>, <%r, %r, %r>, %d); "
+            '#debug concat("LBMG ", str(MG, 0, 15), "\\n") #end\n'
             "global_settings { assumed_gamma 1.0 }\nbackground { rgb 1 }\n"
             "camera { location <%r, %r, %r> + <%r, %r, %r> * <Side, 1, Side> "
             "look_at <%r, %r, %r> angle 50 }\n"
