@@ -272,7 +272,10 @@ def main():
                        capture_output=True, env=env_noinc)
     global rows
     rows += 1
-    if r.returncode != 1 or os.path.exists(out["png"]) or b"povray failed" not in r.stderr:
+    # refused before povray starts, naming the file looked for and the fix
+    nowhere = os.path.join(WORK, "nowhere", "libblend.inc").encode()
+    if r.returncode != 1 or os.path.exists(out["png"]) or nowhere not in r.stderr or \
+            b"LIBBLEND_POVRAY_INCLUDE" not in r.stderr or b"Persistence of Vision" in r.stderr:
         fail(f"render without libblend.inc: exit {r.returncode}: {r.stderr[-300:]!r}")
     if not stat.S_ISCHR(os.stat("/dev/full").st_mode):
         fail("/dev/full is no longer a character device")
