@@ -1,0 +1,122 @@
+#!/usr/bin/env bash
+# The JSON libraries libblend links statically, built from Debian's own
+# source packages, so that libblend.so (and the add-on and SDK that carry it)
+# needs no JSON library at run time:
+#
+#   third-party.sh DIR      build cJSON and jansson for linux-x64 into DIR
+#                           (DIR/include, DIR/lib/libcjson.a, libjansson.a);
+#                           a second run with the same sources does nothing
+#
+# Debian ships no PIC archive of either (libcjson-dev has no .a at all; the
+# libjansson.a of libjansson-dev is not position independent), so they are
+# built here: the source packages of the Debian release this machine runs
+# (Debian's patches applied, as in its own binary packages) are fetched with
+# `apt-get source` through a private source list and private apt state under
+# DIR/apt: the system's apt configuration is not touched and no root is
+# needed. Objects are compiled position independent with hidden visibility
+# (nothing of them is exported from libblend.so) and with
+# libblend/src/common/glibc_compat.h in front, so that they bind to the same
+# old glibc symbol versions as libblend itself (docs/portability.md).
+#
+# The result is built in DIR.tmp.PID and renamed into place when complete: an
+# interrupted run leaves nothing half made. CMake runs this script at
+# configure time when DIR has no archives (LIBBLEND_BUNDLED_JSON, default ON).
+set -euo pipefail
+[ $# -eq 1 ] || {
+  echo "usage: third-party.sh DIR" >&2
+  exit 2
+}
+DIR=$1
+HERE=$(cd "$(dirname "$0")/.." && pwd)
+COMPAT="$HERE/libblend/src/common/glibc_compat.h"
+PACKAGES=(cjson jansson)
+CC=${CC_THIRD_PARTY:-gcc}
+CFLAGS_TP="-O2 -g0 -fPIC -fvisibility=hidden -include $COMPAT -DLB_GLIBC_BASELINE=1"
+
+die() {
+  echo "third-party: $*" >&2
+  exit 1
+}
+
+# The stamp names what the archives were built from: the source versions are
+# only known after the download, so the flags and this script's own hash are
+# checked first (a changed script or compat header rebuilds).
+recipe=$(cat "$0" "$COMPAT" | sha256sum | cut -c1-16)
+if [ -f "$DIR/.stamp" ] && grep -qx "recipe $recipe" "$DIR/.stamp"; then
+  exit 0
+fi
+
+# The Debian mirror and release this machine already uses.
+mirror=""
+if [ -f /etc/apt/sources.list.d/debian.sources ]; then
+  mirror=$(awk '/^URIs:/ {print $2; exit}' /etc/apt/sources.list.d/debian.sources)
+fi
+if [ -z "$mirror" ] && [ -f /etc/apt/sources.list ]; then
+  mirror=$(awk '$1 == "deb" && $0 !~ /security/ {for (i = 2; i <= NF; i++) if ($i ~ /^https?:/) {print $i; exit}}' /etc/apt/sources.list)
+fi
+mirror=${mirror:-http://deb.debian.org/debian}
+# shellcheck disable=SC1091
+suite=$(. /etc/os-release && echo "${VERSION_CODENAME:-}")
+[ -n "$suite" ] || die "cannot tell the Debian release from /etc/os-release"
+command -v dpkg-source >/dev/null || die "dpkg-source is missing (Debian package dpkg-dev)"
+command -v cmake >/dev/null || die "cmake is missing"
+
+mkdir -p "$(dirname "$DIR")"
+TMP="$DIR.tmp.$$"
+trap 'rm -rf "$TMP"' EXIT
+trap 'exit 130' INT TERM
+rm -rf "$TMP"
+mkdir -p "$TMP"/{apt/lists/partial,apt/cache/archives/partial,src,include,lib}
+printf 'deb-src %s %s main\ndeb-src %s %s-updates main\n' "$mirror" "$suite" "$mirror" "$suite" \
+  >"$TMP/apt/sources.list"
+APT=(apt-get -q -o "Dir::Etc::SourceList=$TMP/apt/sources.list" -o Dir::Etc::SourceParts=/dev/null
+  -o "Dir::State::Lists=$TMP/apt/lists" -o "Dir::Cache=$TMP/apt/cache"
+  -o APT::Sandbox::User=root)
+echo "third-party: fetching ${PACKAGES[*]} source packages ($suite, $mirror)"
+"${APT[@]}" update >"$TMP/apt.log" 2>&1 || {
+  cat "$TMP/apt.log" >&2
+  die "apt-get update of the private source list failed"
+}
+(cd "$TMP/src" && "${APT[@]}" source --download-only "${PACKAGES[@]}") >>"$TMP/apt.log" 2>&1 || {
+  cat "$TMP/apt.log" >&2
+  die "apt-get source ${PACKAGES[*]} failed"
+}
+for dsc in "$TMP"/src/*.dsc; do
+  (cd "$TMP/src" && dpkg-source -x "$(basename "$dsc")") >>"$TMP/apt.log" 2>&1 ||
+    die "dpkg-source -x $(basename "$dsc") failed"
+done
+versions=$(cd "$TMP/src" && ls -- *.dsc | sed 's/\.dsc$//' | tr '\n' ' ')
+
+# cJSON: one source file.
+cj=$(find "$TMP/src" -maxdepth 1 -type d -name 'cjson-*' | head -1)
+[ -n "$cj" ] || die "no cjson source folder"
+# shellcheck disable=SC2086
+$CC $CFLAGS_TP -std=c89 -c "$cj/cJSON.c" -o "$TMP/cJSON.o"
+ar rcs "$TMP/lib/libcjson.a" "$TMP/cJSON.o"
+mkdir -p "$TMP/include/cjson"
+cp "$cj/cJSON.h" "$TMP/include/cjson/"
+
+# jansson: its own CMake build, static only.
+js=$(find "$TMP/src" -maxdepth 1 -type d -name 'jansson-*' | head -1)
+[ -n "$js" ] || die "no jansson source folder"
+cmake -S "$js" -B "$TMP/jansson-build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_C_COMPILER="$CC" -DCMAKE_C_FLAGS="$CFLAGS_TP" \
+  -DJANSSON_BUILD_SHARED_LIBS=OFF -DJANSSON_BUILD_DOCS=OFF -DJANSSON_WITHOUT_TESTS=ON \
+  -DJANSSON_EXAMPLES=OFF -DJANSSON_COVERAGE=OFF -DUSE_URANDOM=ON -DUSE_WINDOWS_CRYPTOAPI=OFF \
+  -DCMAKE_INSTALL_PREFIX="$TMP/jansson-install" >>"$TMP/build.log" 2>&1 ||
+  { cat "$TMP/build.log" >&2; die "jansson configure failed"; }
+cmake --build "$TMP/jansson-build" >>"$TMP/build.log" 2>&1 &&
+  cmake --install "$TMP/jansson-build" >>"$TMP/build.log" 2>&1 ||
+  { cat "$TMP/build.log" >&2; die "jansson build failed"; }
+cp "$TMP/jansson-install/lib/libjansson.a" "$TMP/lib/"
+cp "$TMP/jansson-install/include/"*.h "$TMP/include/"
+for f in "$cj/LICENSE" "$js/LICENSE"; do
+  cp "$f" "$TMP/LICENSE.$(basename "$(dirname "$f")" | cut -d- -f1)"
+done
+
+printf 'recipe %s\nsources %s\n' "$recipe" "$versions" >"$TMP/.stamp"
+rm -rf "$TMP"/{apt,src,jansson-build,jansson-install,cJSON.o,apt.log,build.log}
+rm -rf "$DIR"
+mv "$TMP" "$DIR"
+trap - EXIT
+echo "third-party: built $versions into $DIR"
