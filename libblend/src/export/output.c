@@ -14,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include "../common/glibc_compat.h"
 #include <time.h>
 #include <unistd.h>
 
@@ -55,7 +56,7 @@ static lb_status resolve(const char *path, char **target, int *exists, struct st
     char *cur = dup_str(path, strlen(path));
     if (!cur) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     for (int hops = 0;; ++hops) {
-        if (lstat(cur, st) != 0) {
+        if (lb__lstat(cur, st) != 0) {
             if (errno != ENOENT) {
                 const int e = errno;
                 lb__fail(err, LB_ERR_IO, "%s: cannot look at the output path (%s)", cur,

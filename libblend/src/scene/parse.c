@@ -6,6 +6,7 @@
  * reference for every name accepted here. */
 #define _POSIX_C_SOURCE 200809L
 #include "scene_internal.h"
+#include "../common/glibc_compat.h"
 
 #include <sys/stat.h>
 
@@ -1553,7 +1554,7 @@ lb_status lb_scene_load(const char *path, lb_scene **out, lb_error *err) {
                         "%s: cannot open the scene file (%s); allowed: a readable file", path,
                         strerror(errno));
     struct stat sb;
-    if (fstat(fileno(f), &sb) == 0) {
+    if (lb__fstat(fileno(f), &sb) == 0) {
         if (S_ISDIR(sb.st_mode)) {
             fclose(f);
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
