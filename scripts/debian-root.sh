@@ -1,33 +1,74 @@
 #!/usr/bin/env bash
-# Blender 4.x for the tests. Debian 12 ships only Blender 3.4; Debian 13
-# (trixie) ships 4.3. This script keeps a trixie root made with debootstrap
-# that has trixie's Blender in it, and runs commands inside it:
+# Debian roots for the tests, made with debootstrap, cached, and run with
+# chroot in a private mount namespace:
 #
-#   blender4-root.sh ensure            make the root if it is not there yet
-#                                      (about 3 min and 1.8 GB the first time;
-#                                      later runs only check it: cached)
-#   blender4-root.sh path              print the root's folder
-#   blender4-root.sh run DIR... -- CMD run CMD inside the root, with each DIR
-#                                      of this machine bound at the same path
+#   debian-root.sh NAME ensure             make root NAME if it is not there yet
+#                                          (cached: later runs only check it)
+#   debian-root.sh NAME path               print the root's folder
+#   debian-root.sh NAME run DIR... -- CMD  run CMD inside the root, with each DIR
+#                                          of this machine bound at the same path
 #
-# The root lives in $LIBBLEND_BLENDER4_ROOT (default
-# /var/cache/libblend/trixie-blender4). It is built in a sibling folder and
-# renamed into place when complete, so an interrupted build leaves no
-# half-made root behind (the next run starts over). Mounts are made in a
-# private mount namespace (unshare), so they vanish with the command, even
-# when it is killed. Needs root (debootstrap and chroot); the packages it
-# needs on the host (debootstrap) are installed here, apt-get idempotent.
+# The roots (NAME):
+#   trixie-blender4  Debian 13 with its Blender 4.3 (Debian 12 ships only 3.4),
+#                    numpy for the add-on, POV-Ray (the add-on's export is
+#                    rendered) and libxxhash0 (blendtool, built on the host,
+#                    runs inside). About 3 min and 1.8 GB the first time.
+#                    Folder: $LIBBLEND_BLENDER4_ROOT or
+#                    /var/cache/libblend/trixie-blender4.
+#   bullseye-base    Debian 11 (glibc 2.31, the oldest release the mirror
+#                    serves) with only the base system, Python and a C
+#                    compiler: the portable libblend.so is loaded there
+#                    (tests/portability). About 1 min the first time.
+#                    Folder: $LIBBLEND_BULLSEYE_ROOT or
+#                    /var/cache/libblend/bullseye-base.
+# Neither root has libjansson4; bullseye-base has no libcjson1 either (in
+# trixie-blender4 Blender's FFmpeg needs it through librist4), so nothing in
+# them can supply a JSON library that libblend.so forgot to carry.
+#
+# A root is built in a sibling folder and renamed into place when complete,
+# so an interrupted build leaves no half-made root behind (the next run
+# starts over). Mounts are made in a private mount namespace (unshare), so
+# they vanish with the command, even when it is killed. Needs root
+# (debootstrap and chroot); debootstrap is installed on the host here,
+# apt-get idempotent.
 set -euo pipefail
-ROOT=${LIBBLEND_BLENDER4_ROOT:-/var/cache/libblend/trixie-blender4}
-SUITE=trixie
+NAME=${1:-}
+case "$NAME" in
+trixie-blender4)
+  ROOT=${LIBBLEND_BLENDER4_ROOT:-/var/cache/libblend/trixie-blender4}
+  SUITE=trixie
+  PACKAGES=(blender python3-numpy libxxhash0 povray)
+  ABSENT=(libjansson4)
+  ;;
+bullseye-base)
+  ROOT=${LIBBLEND_BULLSEYE_ROOT:-/var/cache/libblend/bullseye-base}
+  SUITE=bullseye
+  PACKAGES=(python3 gcc libc6-dev)
+  ABSENT=(libjansson4 libcjson1)
+  ;;
+*)
+  echo "usage: debian-root.sh trixie-blender4|bullseye-base ensure | path | run DIR... -- CMD..." >&2
+  exit 2
+  ;;
+esac
+shift
 MARK="$ROOT/.libblend-root-ok"
-# What the add-on tests need in the root: Blender, numpy for the add-on, and
-# the run-time libraries of the blendtool built on the host (the tests call
-# it from inside the root) and POV-Ray (the POV-Ray export is rendered).
-PACKAGES=(blender python3-numpy libcjson1 libjansson4 libxxhash0 povray)
+
+# What proves the new root works (printed into its mark).
+root_check() {
+  case "$NAME" in
+  trixie-blender4)
+    run_in "$1" -- blender -b --factory-startup --version 2>/dev/null |
+      awk '/^Blender/ {print "blender " $2; exit}'
+    ;;
+  bullseye-base)
+    run_in "$1" -- ldd --version 2>/dev/null | awk 'NR == 1 {print "glibc " $NF}'
+    ;;
+  esac
+}
 
 die() {
-  echo "blender4-root: $*" >&2
+  echo "debian-root $NAME: $*" >&2
   exit 1
 }
 
@@ -72,12 +113,23 @@ ensure() {
     miss=$(missing_in "$ROOT")
     if [ -n "$miss" ]; then  # the list grew since the root was made
       # shellcheck disable=SC2086
-      echo "blender4-root: adding to the cached root:" $miss
+      echo "debian-root $NAME: adding to the cached root:" $miss
       # shellcheck disable=SC2086
       install_in "$ROOT" "$ROOT.log" $miss
       rm -f "$ROOT.log"
     fi
-    echo "blender4-root: cached at $ROOT ($(cat "$MARK"))"
+    local p present=()
+    for p in "${ABSENT[@]}"; do
+      chroot "$ROOT" dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" &&
+        present+=("$p")
+    done
+    if [ "${#present[@]}" -gt 0 ]; then  # made when the list still had them
+      echo "debian-root $NAME: removing from the cached root: ${present[*]}"
+      chroot "$ROOT" env DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq "${present[@]}" \
+        >"$ROOT.log" 2>&1 || { tail -20 "$ROOT.log" >&2; die "removing ${present[*]} failed"; }
+      rm -f "$ROOT.log"
+    fi
+    echo "debian-root $NAME: cached at $ROOT ($(cat "$MARK"))"
     return 0
   fi
   [ "$(id -u)" -eq 0 ] || die "making the root needs root (debootstrap, chroot)"
@@ -91,20 +143,20 @@ ensure() {
   trap 'rm -rf "$tmp"' EXIT
   trap 'exit 130' INT TERM
   local t0=$SECONDS
-  echo "blender4-root: debootstrap $SUITE into $tmp from $(mirror)"
+  echo "debian-root $NAME: debootstrap $SUITE into $tmp from $(mirror)"
   debootstrap --variant=minbase "$SUITE" "$tmp" "$(mirror)" >"$tmp.log" 2>&1 ||
     { tail -20 "$tmp.log" >&2; die "debootstrap failed (log above)"; }
-  echo "blender4-root: installing ${PACKAGES[*]} in the root"
+  echo "debian-root $NAME: installing ${PACKAGES[*]} in the root"
   install_in "$tmp" "$tmp.log" "${PACKAGES[@]}"
   local ver
-  ver=$(run_in "$tmp" -- blender -b --factory-startup --version 2>/dev/null | awk '/^Blender/ {print $2; exit}')
-  [ -n "$ver" ] || die "blender in the new root does not start"
-  echo "blender $ver, made $(date -u +%Y-%m-%dT%H:%MZ) in $((SECONDS - t0)) s" >"$tmp/.libblend-root-ok"
+  ver=$(root_check "$tmp")
+  [ -n "$ver" ] || die "the new root does not work (no version from its $NAME check)"
+  echo "$ver, made $(date -u +%Y-%m-%dT%H:%MZ) in $((SECONDS - t0)) s" >"$tmp/.libblend-root-ok"
   rm -rf "$ROOT"
   mv "$tmp" "$ROOT"
   rm -f "$tmp.log"
   trap - EXIT
-  echo "blender4-root: made $ROOT ($(cat "$MARK"))"
+  echo "debian-root $NAME: made $ROOT ($(cat "$MARK"))"
 }
 
 # run_in ROOTDIR DIR... -- CMD...
@@ -116,9 +168,9 @@ run_in() {
     binds+=("$(cd "$1" && pwd)")
     shift
   done
-  [ "${1:-}" = "--" ] || die "usage: blender4-root.sh run DIR... -- CMD..."
+  [ "${1:-}" = "--" ] || die "usage: debian-root.sh $NAME run DIR... -- CMD..."
   shift
-  [ $# -gt 0 ] || die "usage: blender4-root.sh run DIR... -- CMD..."
+  [ $# -gt 0 ] || die "usage: debian-root.sh $NAME run DIR... -- CMD..."
   unshare --mount --propagation private bash -c '
     set -e
     r=$1; n=$2; shift 2
@@ -140,11 +192,11 @@ ensure) ensure ;;
 path) echo "$ROOT" ;;
 run)
   shift
-  [ -f "$MARK" ] || die "no root at $ROOT: run 'scripts/blender4-root.sh ensure' first"
+  [ -f "$MARK" ] || die "no root at $ROOT: run 'scripts/debian-root.sh $NAME ensure' first"
   run_in "$ROOT" "$@"
   ;;
 *)
-  echo "usage: blender4-root.sh ensure | path | run DIR... -- CMD..." >&2
+  echo "usage: debian-root.sh $NAME ensure | path | run DIR... -- CMD..." >&2
   exit 2
   ;;
 esac

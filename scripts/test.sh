@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole test suite: install what is missing (and the Debian 13 root with
-# Blender 4.3, scripts/blender4-root.sh), then a Release build and a
+# Blender 4.3 and the Debian 11 root, scripts/debian-root.sh), then a Release build and a
 # sanitizer (ASan + UBSan) build, each run by ctest (the sanitizer build also
 # runs random valid scenes through every command for 60 s); the threaded
 # tests under ThreadSanitizer; then the scene parser under libFuzzer (clang,
@@ -8,7 +8,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-bash scripts/blender4-root.sh ensure   # Blender 4.3 for test_blender4 (cached after the first run)
+bash scripts/debian-root.sh trixie-blender4 ensure   # Blender 4.3 for test_blender4 (cached)
+bash scripts/debian-root.sh bullseye-base ensure     # glibc 2.31 for test_portable_so (cached)
 JOBS=$(nproc)
 for cfg in "build-release:-DCMAKE_BUILD_TYPE=Release" \
            "build-asan:-DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_SANITIZE=ON"; do

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The add-on on Blender 4.x, as a 4.2+ extension, run inside the Debian 13
-# root (scripts/blender4-root.sh run ... -- bash run_blender4.sh ...):
+# root (scripts/debian-root.sh trixie-blender4 run ... -- bash run_blender4.sh ...):
 #   run_blender4.sh ADDON_DIR BLENDTOOL SOURCE_DIR WORK_DIR
 # Blender's own tools validate and build the extension from the add-on
 # folder of the build tree (ADDON_DIR: bl_info and blender_manifest.toml side
