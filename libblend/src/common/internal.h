@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #if defined(__GNUC__)
@@ -92,6 +93,24 @@ LB_INTERNAL lb_status lb__check_blend_params(const char *fn, size_t k, const dou
 LB_INTERNAL lb_status lb__check_conic(const char *fn, const double x[2], const double r[2],
                                       double p, const double m[2], const void *value,
                                       lb_error *err);
+
+/* Grow the buffer *p (capacity *cap elements of sz bytes) to hold at least
+ * want elements: doubling from 16, contents kept. Returns 0, or -1 when the
+ * size overflows or realloc fails (then *p and *cap are unchanged). */
+static inline int lb__grow(void **p, size_t *cap, size_t want, size_t sz) {
+    if (want <= *cap) return 0;
+    size_t c = *cap ? *cap : 16;
+    while (c < want) {
+        if (c > SIZE_MAX / 2) return -1;
+        c *= 2;
+    }
+    if (sz && c > SIZE_MAX / sz) return -1;
+    void *q = realloc(*p, c * sz);
+    if (!q) return -1;
+    *p = q;
+    *cap = c;
+    return 0;
+}
 
 /* The bits of a double. For doubles >= +0 the bit patterns are ordered like
  * the values, and NaN patterns lie above +inf; negatives have the top bit. */

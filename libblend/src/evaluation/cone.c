@@ -22,18 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* grow *p to hold want elements of size sz */
-static int grow(void **p, size_t *cap, size_t want, size_t sz) {
-    if (want <= *cap) return 0;
-    size_t c = *cap ? *cap : 16;
-    while (c < want) c *= 2;
-    void *q = realloc(*p, c * sz);
-    if (!q) return -1;
-    *p = q;
-    *cap = c;
-    return 0;
-}
-
 void lb__cone_free(lb__cone *S) {
     free(S->ins);
     free(S->src);
@@ -95,14 +83,14 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
                           const double bc[3], const double br[3], lb__cone *S, lb_error *err) {
     const lb__instr *top = n ? &ev->ins[list ? list[n - 1] : n - 1] : NULL;
     const char *path = top && top->op ? top->op->path : "local_union";
-    if (grow((void **)&S->ivq, &S->cap_q, n, sizeof *S->ivq) ||
-        grow((void **)&S->alias, &S->cap_alias, n, sizeof *S->alias) ||
-        grow((void **)&S->need, &S->cap_need, n, sizeof *S->need) ||
-        grow((void **)&S->reg, &S->cap_reg, n, sizeof *S->reg) ||
-        grow((void **)&S->last, &S->cap_last, n, sizeof *S->last) ||
-        grow((void **)&S->freel, &S->cap_freel, n, sizeof *S->freel) ||
-        grow((void **)&S->prod, &S->cap_prod, ev->nregs, sizeof *S->prod) ||
-        grow((void **)&S->R, &S->cap_R, lb__ivs_len(ev), sizeof *S->R))
+    if (lb__grow((void **)&S->ivq, &S->cap_q, n, sizeof *S->ivq) ||
+        lb__grow((void **)&S->alias, &S->cap_alias, n, sizeof *S->alias) ||
+        lb__grow((void **)&S->need, &S->cap_need, n, sizeof *S->need) ||
+        lb__grow((void **)&S->reg, &S->cap_reg, n, sizeof *S->reg) ||
+        lb__grow((void **)&S->last, &S->cap_last, n, sizeof *S->last) ||
+        lb__grow((void **)&S->freel, &S->cap_freel, n, sizeof *S->freel) ||
+        lb__grow((void **)&S->prod, &S->cap_prod, ev->nregs, sizeof *S->prod) ||
+        lb__grow((void **)&S->R, &S->cap_R, lb__ivs_len(ev), sizeof *S->R))
         return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", path);
     /* the instructions' sources as positions in the list (2 per argument:
      * arguments, then bounding solids) */
@@ -116,7 +104,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
             return LB_OK;
         }
     }
-    if (grow((void **)&S->srcq, &S->cap_srcq, nsrc, sizeof *S->srcq))
+    if (lb__grow((void **)&S->srcq, &S->cap_srcq, nsrc, sizeof *S->srcq))
         return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", path);
     /* 1. the interval pass, instruction by instruction, recording each
      * instruction's interval and which instruction each source is */
@@ -167,8 +155,8 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
         ++m;
         msrc += ns;
     }
-    if (grow((void **)&S->ins, &S->cap_ins, m, sizeof *S->ins) ||
-        grow((void **)&S->src, &S->cap_src, msrc, sizeof *S->src))
+    if (lb__grow((void **)&S->ins, &S->cap_ins, m, sizeof *S->ins) ||
+        lb__grow((void **)&S->src, &S->cap_src, msrc, sizeof *S->src))
         return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", path);
     uint32_t nfree = 0, nregs = 0, *freel = S->freel; /* free registers, a stack */
     /* the register of each needed position, kept in last[] (the offsets

@@ -115,6 +115,57 @@ static void points_box(const double *x, const double *y, const double *z, size_t
     lb__box_centre(bmin, bmax, bc, br);
 }
 
+/* The tape that computes child a at a chunk of points in box (bc, br): the
+ * run, the register of the child's value and the charge per point. A long
+ * cone is reduced over the chunk's group of chunks (box (gc, gr), at its
+ * first chunk: new_group) and then over the chunk (cone.c): a group's cone
+ * that is short already runs as it is; one that kept nearly everything is
+ * reduced per chunk from the whole cone. A local union whose blending
+ * volumes reach the chunk queries its curves at every point: that costs
+ * LB_LOCAL_NEAR_WEIGHT runs more. */
+static lb_status chunk_tape(child_eval *E, int a, int new_group, const double gc[3],
+                            const double gr[3], const double bc[3], const double br[3],
+                            const lb_evaluator **run, uint32_t *reg, double *weight) {
+    const lb__instr *in = E->in;
+    const uint32_t *cone = in->cone + (a ? in->ncone[0] : 0);
+    const lb_evaluator *run_ev = E->ev;
+    uint32_t r = in->src[a];
+    double w = E->wcone[a];
+    lb_status st;
+    if (in->ncone[a] >= REDUCE_FROM) {
+        lb__cone *Gc = &E->grp[a], *S = &E->sub[a];
+        /* a reduction is an interval pass over what it reduces: charged as
+         * one run of that */
+        if (new_group && ((st = charge(E, E->wcone[a])) ||
+                          (st = lb__cone_reduce(E->ev, cone, in->ncone[a], gc, gr, Gc, E->err))))
+            return st;
+        const int grouped = Gc->reduced && Gc->copied;
+        const int chunked = Gc->reduced && (!grouped || Gc->ev.n >= REDUCE_FROM);
+        if (chunked &&
+            ((st = charge(E, grouped ? Gc->weight : E->wcone[a])) ||
+             (st = grouped ? lb__cone_reduce(&Gc->ev, NULL, Gc->ev.n, bc, br, S, E->err)
+                           : lb__cone_reduce(E->ev, cone, in->ncone[a], bc, br, S, E->err))))
+            return st;
+        if (grouped && (!chunked || !S->copied)) S = Gc;
+        if (Gc->reduced && S->reduced && S->copied) {
+            run_ev = &S->ev;
+            r = S->out;
+            w = S->weight;
+        }
+    }
+    const size_t nr = run_ev != E->ev ? run_ev->n : in->ncone[a];
+    size_t near = 0;
+    for (size_t q = 0; q < nr; ++q) {
+        const lb__instr *c = run_ev != E->ev ? &run_ev->ins[q] : &E->ev->ins[cone[q]];
+        near += c->code == LB__I_OP && c->op->family == LB__F_LOCAL &&
+                lb__local_reaches(c->curves, bc, br);
+    }
+    *run = run_ev;
+    *reg = r;
+    *weight = w + (double)near * LB_LOCAL_NEAR_WEIGHT;
+    return LB_OK;
+}
+
 /* g (soft form) of both children and their gradients at n points. A long
  * cone is reduced over each chunk's bounding box (cone.c): the points come
  * in spatial order (cell by cell, or along a curve), so a chunk's box is
@@ -127,66 +178,25 @@ static lb_status children_at(child_eval *E, size_t n, const double *x, const dou
         const size_t m = n - s < LB__CHUNK ? n - s : LB__CHUNK;
         double bc[3], br[3];
         /* a group of REDUCE_GROUP chunks is reduced from the whole cone,
-         * each chunk from its group's cone */
-        if (s % (REDUCE_GROUP * LB__CHUNK) == 0) {
+         * each chunk from its group's cone (chunk_tape) */
+        const int new_group = s % (REDUCE_GROUP * LB__CHUNK) == 0;
+        if (new_group) {
             const size_t gm = n - s < REDUCE_GROUP * LB__CHUNK ? n - s : REDUCE_GROUP * LB__CHUNK;
             points_box(x + s, y + s, z + s, gm, gc, gr);
         }
         points_box(x + s, y + s, z + s, m, bc, br);
         for (int a = 0; a < 2; ++a) {
             const uint32_t *cone = in->cone + (a ? in->ncone[0] : 0);
-            const lb_evaluator *run_ev = E->ev;
-            uint32_t r = in->src[a];
-            double w = E->wcone[a];
-            lb_status st;
-            if (in->ncone[a] >= REDUCE_FROM) {
-                lb__cone *Gc = &E->grp[a], *S = &E->sub[a];
-                /* a reduction is an interval pass over what it reduces:
-                 * charged as one run of that */
-                if (s % (REDUCE_GROUP * LB__CHUNK) == 0 &&
-                    ((st = charge(E, E->wcone[a])) ||
-                     (st = lb__cone_reduce(E->ev, cone, in->ncone[a], gc, gr, Gc, E->err))))
-                    return st;
-                /* a group's cone that is short already runs as it is; one
-                 * that kept nearly everything is reduced per chunk from the
-                 * whole cone */
-                const int grouped = Gc->reduced && Gc->copied;
-                const int chunked = Gc->reduced && (!grouped || Gc->ev.n >= REDUCE_FROM);
-                if (chunked &&
-                    ((st = charge(E, grouped ? Gc->weight : E->wcone[a])) ||
-                     (st = grouped
-                               ? lb__cone_reduce(&Gc->ev, NULL, Gc->ev.n, bc, br, S, E->err)
-                               : lb__cone_reduce(E->ev, cone, in->ncone[a], bc, br, S, E->err))))
-                    return st;
-                if (grouped && (!chunked || !S->copied)) S = Gc;
-                if (Gc->reduced && S->reduced && S->copied) {
-                    run_ev = &S->ev;
-                    r = S->out;
-                    w = S->weight;
-                }
-            }
-            /* a local union whose blending volumes reach the chunk queries
-             * its curves at every point: LB_LOCAL_NEAR_WEIGHT runs more */
-            {
-                const size_t nr = run_ev != E->ev ? run_ev->n : in->ncone[a];
-                size_t near = 0;
-                for (size_t q = 0; q < nr; ++q) {
-                    const lb__instr *c = run_ev != E->ev ? &run_ev->ins[q] : &E->ev->ins[cone[q]];
-                    near += c->code == LB__I_OP && c->op->family == LB__F_LOCAL &&
-                            lb__local_reaches(c->curves, bc, br);
-                }
-                w += (double)near * LB_LOCAL_NEAR_WEIGHT;
-            }
+            const lb_evaluator *run_ev;
+            uint32_t r;
+            double w;
+            lb_status st = chunk_tape(E, a, new_group, gc, gr, bc, br, &run_ev, &r, &w);
+            if (st) return st;
             if ((st = charge(E, (double)m * w))) return st;
             if (run_ev != E->ev) {
-                if (lb__regs_len(run_ev) > E->nsubregs) {
-                    double *q = realloc(E->subregs, lb__regs_len(run_ev) * sizeof *q);
-                    if (!q)
-                        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory",
-                                        in->op->path);
-                    E->subregs = q;
-                    E->nsubregs = lb__regs_len(run_ev);
-                }
+                if (lb__grow((void **)&E->subregs, &E->nsubregs, lb__regs_len(run_ev),
+                             sizeof *E->subregs))
+                    return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
                 st = lb__tape_run_counted(run_ev, m, x + s, y + s, z + s, E->subregs, NULL, E->err);
             } else {
                 st = lb__tape_run_list(E->ev, cone, in->ncone[a], m, x + s, y + s, z + s, E->regs,
@@ -301,13 +311,8 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
         if (done) {
         } else if (P) { /* short enough: its interval pass as it stands */
             if ((cs = charge(E, P->weight))) return cs;
-            if (lb__ivs_len(&P->ev) > E->nivs) {
-                lb__iv *q = realloc(E->ivs, lb__ivs_len(&P->ev) * sizeof *q);
-                if (!q)
-                    return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
-                E->ivs = q;
-                E->nivs = lb__ivs_len(&P->ev);
-            }
+            if (lb__grow((void **)&E->ivs, &E->nivs, lb__ivs_len(&P->ev), sizeof *E->ivs))
+                return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
             lb__bounds_pass(&P->ev, bc, br, E->ivs, NULL);
             f = E->ivs[P->out];
         } else {
@@ -328,13 +333,8 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
             axis = d;
         }
     if (axis < 0) {
-        if (S->n == S->cap) {
-            const size_t nc = S->cap ? 2 * S->cap : 256;
-            uint32_t *q = realloc(S->c, 3 * nc * sizeof *q);
-            if (!q) return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
-            S->c = q;
-            S->cap = nc;
-        }
+        if (lb__grow((void **)&S->c, &S->cap, S->n + 1, 3 * sizeof *S->c))
+            return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
         memcpy(S->c + 3 * S->n++, lo, 3 * sizeof *lo);
         return LB_OK;
     }
@@ -411,13 +411,7 @@ static int face_point(builder *B, const uint64_t v[3], uint32_t *out) {
         B->faces.val[slot] = UINT32_MAX - 1; /* no point on this face */
         return 0;
     }
-    if (B->nf == B->fcap) {
-        const size_t nc = B->fcap ? 2 * B->fcap : 256;
-        double *q = realloc(B->fpts, 3 * nc * sizeof *q);
-        if (!q) return -1;
-        B->fpts = q;
-        B->fcap = nc;
-    }
+    if (lb__grow((void **)&B->fpts, &B->fcap, B->nf + 1, 3 * sizeof *B->fpts)) return -1;
     const double sum = l[0] + l[1] + l[2];
     for (int d = 0; d < 3; ++d)
         B->fpts[3 * B->nf + d] = (l[0] * P[0][d] + l[1] * P[1][d] + l[2] * P[2][d]) / sum;
@@ -440,13 +434,7 @@ static int tet_segments(builder *B, const uint64_t corner[8]) {
             if (r) ends[ne++] = idx;
         }
         if (ne != 2) continue; /* 0 generically; 1, 3 or 4 only on degenerate ties */
-        if (B->ns == B->scap) {
-            const size_t nc = B->scap ? 2 * B->scap : 256;
-            uint32_t *q = realloc(B->seg, 2 * nc * sizeof *q);
-            if (!q) return -1;
-            B->seg = q;
-            B->scap = nc;
-        }
+        if (lb__grow((void **)&B->seg, &B->scap, B->ns + 1, 2 * sizeof *B->seg)) return -1;
         B->seg[2 * B->ns] = ends[0];
         B->seg[2 * B->ns + 1] = ends[1];
         B->ns++;
