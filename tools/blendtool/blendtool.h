@@ -145,19 +145,22 @@ void bt_signals_commit(void);              /* hold the signals from here to exit
  * and its state file, all registered with the signal handler (removed on
  * SIGINT / SIGTERM / SIGHUP; a folder of a killed run is removed by the
  * next render). */
+enum { BT_RENDER_FILES = 5 };
 typedef struct bt_render_dir {
-    char dir[4096], pov[4200], png[4200], state[4200], log[4200], ini[4200];
-    int slot[5];
+    char dir[4096];
+    /* the folder's files (cmd_pov.c's RENDER_FILES, in that order) */
+    char pov[4200], png[4200], state[4200], log[4200], ini[4200];
+    int slot[BT_RENDER_FILES];
 } bt_render_dir;
 int bt_render_dir_open(bt_render_dir *r); /* exit code */
 void bt_render_dir_close(bt_render_dir *r);
 
-/* povray on pov into png (deep: a 16-bit PNG with alpha); its messages
- * stream to stderr, or go to log (not NULL) and are shown only when it
- * fails. Returns an exit code, after printing a message naming scene_name
- * on failure. */
-int bt_povray(const char *scene_name, const char *pov, const char *png, int width, int height,
-              int threads, int quality, int deep, const char *log);
+/* povray on R's scene into R's image (deep: a 16-bit PNG with alpha),
+ * through R's INI file; its messages stream to stderr, or (quiet) go to R's
+ * log and are shown only when it fails. Returns an exit code, after printing
+ * a message naming scene_name on failure. */
+int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int height, int threads,
+              int quality, int deep, int quiet);
 
 /* The lbi_format for an image name (.png: --bits 8|16, .exr: --pixel
  * half|float; 0 / NULL: the defaults), or -1 after printing why. */

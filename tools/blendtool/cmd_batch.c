@@ -1113,8 +1113,8 @@ static int run_task(const job *J, const task *T, const char *ident, const uint64
             if ((s = lb_scene_write_pov(sc, ev, &o, R.pov, NULL, &e)))
                 rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
             if (!rc)
-                rc = bt_povray(J->scenes[T->scene], R.pov, R.png, J->img_w, J->img_h,
-                               threads ? threads : 1, J->img_quality, 1, R.log);
+                rc = bt_povray(J->scenes[T->scene], &R, J->img_w, J->img_h, threads ? threads : 1,
+                               J->img_quality, 1, 1);
             if (!rc) {
                 char hex[33], settings[128],
                     err[1024] = "the image writer is not available (above)";

@@ -136,9 +136,8 @@ static const char *tmp_root(void) {
 
 /* what a render folder holds: the scene, the image, and the state file
  * povray writes when it is stopped mid-render */
-static const char *const RENDER_FILES[] = {"scene.pov", "image.png", "image.pov-state",
-                                           "povray.log", "render.ini"};
-#define NRENDER_FILES (sizeof RENDER_FILES / sizeof RENDER_FILES[0])
+static const char *const RENDER_FILES[BT_RENDER_FILES] = {
+    "scene.pov", "image.png", "image.pov-state", "povray.log", "render.ini"};
 
 static void remove_stale_renders(void) {
     DIR *d = opendir(tmp_root());
@@ -152,7 +151,7 @@ static void remove_stale_renders(void) {
         if (pid <= 0 || !end || *end != '-') continue;
         if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
         char path[4096];
-        for (size_t i = 0; i < NRENDER_FILES; ++i) {
+        for (size_t i = 0; i < BT_RENDER_FILES; ++i) {
             snprintf(path, sizeof path, "%s/%s/%s", tmp_root(), e->d_name, RENDER_FILES[i]);
             unlink(path);
         }
@@ -162,17 +161,15 @@ static void remove_stale_renders(void) {
     closedir(d);
 }
 
-int bt_povray(const char *scene_name, const char *pov, const char *png, int width, int height,
-              int threads, int quality, int deep, const char *log) {
-    char outw[64], outh[64], th[64], q[32], dir[4096], rdir[4200], ini[4300];
+int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int height, int threads,
+              int quality, int deep, int quiet) {
+    char outw[64], outh[64], th[64], q[32], dir[4096];
     if (bt_povray_include("render", dir, sizeof dir)) return BT_EXIT_INTERNAL;
     /* POV-Ray splits its command line at spaces, even inside one argument
      * (+L/a b fails): the paths go into an INI file as quoted strings, and
      * povray runs in the render folder, given the INI file by its bare name */
-    const char *slash = strrchr(pov, '/');
-    snprintf(rdir, sizeof rdir, "%.*s", slash ? (int)(slash - pov) : 1, slash ? pov : ".");
-    snprintf(ini, sizeof ini, "%s/%s", rdir, RENDER_FILES[4]);
-    const char *const paths[3] = {pov, png, dir};
+    const char *const log = quiet ? R->log : NULL;
+    const char *const paths[3] = {R->pov, R->png, dir};
     for (int i = 0; i < 3; ++i)
         if (strpbrk(paths[i], "\"\n\r")) {
             bt_error("render",
@@ -181,18 +178,19 @@ int bt_povray(const char *scene_name, const char *pov, const char *png, int widt
                      paths[i]);
             return BT_EXIT_INTERNAL;
         }
-    FILE *fi = fopen(ini, "w");
+    FILE *fi = fopen(R->ini, "w");
     if (!fi ||
-        fprintf(fi, "Input_File_Name=\"%s\"\nOutput_File_Name=\"%s\"\nLibrary_Path=\"%s\"\n", pov,
-                png, dir) < 0 ||
+        fprintf(fi, "Input_File_Name=\"%s\"\nOutput_File_Name=\"%s\"\nLibrary_Path=\"%s\"\n",
+                R->pov, R->png, dir) < 0 ||
         fclose(fi) != 0) {
-        bt_error("render", "%s: cannot write: %s", ini, strerror(errno));
+        bt_error("render", "%s: cannot write: %s", R->ini, strerror(errno));
         return BT_EXIT_INTERNAL;
     }
     snprintf(outw, sizeof outw, "+W%d", width);
     snprintf(outh, sizeof outh, "+H%d", height);
     snprintf(th, sizeof th, "+WT%d", threads > 0 ? threads : (int)sysconf(_SC_NPROCESSORS_ONLN));
     snprintf(q, sizeof q, "+Q%d", quality);
+    const char *const ini_name = R->ini + strlen(R->dir) + 1; /* run in R->dir */
     const pid_t pid = fork();
     if (pid == 0) {
         /* povray ends with blendtool, even when blendtool is killed */
@@ -207,12 +205,12 @@ int bt_povray(const char *scene_name, const char *pov, const char *png, int widt
                 dup2(fileno(lf), STDOUT_FILENO);
             }
         }
-        if (chdir(rdir) != 0) _exit(127);
+        if (chdir(R->dir) != 0) _exit(127);
         if (deep) /* 16-bit PNG with alpha, for the OpenImageIO writer */
-            execlp("povray", "povray", RENDER_FILES[4], outw, outh, th, q, "-D", "+FN16", "+UA",
-                   "-V", (char *)NULL);
+            execlp("povray", "povray", ini_name, outw, outh, th, q, "-D", "+FN16", "+UA", "-V",
+                   (char *)NULL);
         else
-            execlp("povray", "povray", RENDER_FILES[4], outw, outh, th, q, "-D", "+FN", "-V",
+            execlp("povray", "povray", ini_name, outw, outh, th, q, "-D", "+FN", "-V",
                    (char *)NULL);
         fprintf(stderr,
                 "blendtool render: cannot run povray (%s); allowed: install POV-Ray 3.7 (Debian "
@@ -258,29 +256,21 @@ int bt_render_dir_open(bt_render_dir *r) {
         bt_error("render", "%s: cannot create a temporary folder: %s", tmp_root(), strerror(errno));
         return BT_EXIT_INTERNAL;
     }
-    snprintf(r->pov, sizeof r->pov, "%s/%s", r->dir, RENDER_FILES[0]);
-    snprintf(r->png, sizeof r->png, "%s/%s", r->dir, RENDER_FILES[1]);
-    snprintf(r->state, sizeof r->state, "%s/%s", r->dir, RENDER_FILES[2]);
-    snprintf(r->log, sizeof r->log, "%s/%s", r->dir, RENDER_FILES[3]);
-    snprintf(r->ini, sizeof r->ini, "%s/%s", r->dir, RENDER_FILES[4]);
     /* registered before they exist: the handler removes what is there */
-    r->slot[0] = bt_signals_temp(r->pov);
-    r->slot[1] = bt_signals_temp(r->png);
-    r->slot[2] = bt_signals_temp(r->state);
-    r->slot[3] = bt_signals_temp(r->log);
-    r->slot[4] = bt_signals_temp(r->ini);
+    char *const files[BT_RENDER_FILES] = {r->pov, r->png, r->state, r->log, r->ini};
+    for (size_t i = 0; i < BT_RENDER_FILES; ++i) {
+        snprintf(files[i], sizeof r->pov, "%s/%s", r->dir, RENDER_FILES[i]);
+        r->slot[i] = bt_signals_temp(files[i]);
+    }
     bt_signals_temp_dir(r->dir);
     return BT_EXIT_OK;
 }
 
 void bt_render_dir_close(bt_render_dir *r) {
-    remove(r->pov);
-    remove(r->png);
-    remove(r->state);
-    remove(r->log);
-    remove(r->ini);
+    const char *const files[BT_RENDER_FILES] = {r->pov, r->png, r->state, r->log, r->ini};
+    for (size_t i = 0; i < BT_RENDER_FILES; ++i) remove(files[i]);
     rmdir(r->dir);
-    for (int i = 0; i < 5; ++i) bt_signals_untemp(r->slot[i]);
+    for (size_t i = 0; i < BT_RENDER_FILES; ++i) bt_signals_untemp(r->slot[i]);
     bt_signals_temp_dir(NULL);
 }
 
@@ -334,8 +324,7 @@ static int run_render(int argc, char **argv) {
             }
         }
     }
-    if (!rc)
-        rc = bt_povray(a.scene, R.pov, R.png, a.width, a.height, a.threads, a.quality, 1, NULL);
+    if (!rc) rc = bt_povray(a.scene, &R, a.width, a.height, a.threads, a.quality, 1, 0);
     unsigned char *img = NULL;
     size_t len = 0;
     if (!rc) {

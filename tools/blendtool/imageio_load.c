@@ -35,7 +35,8 @@ const bt_imageio *bt_imageio_get(const char *cmd) {
     char self[PATH_MAX];
     /* next to the executable (the build tree), then the installed layout's
      * libdir relative to it */
-    for (int k = 0; k < 2 && !h && bt_self_dir(self, sizeof self) == 0; ++k) {
+    const int have_self = !h && bt_self_dir(self, sizeof self) == 0;
+    for (int k = 0; k < 2 && !h && have_self; ++k) {
         snprintf(path, sizeof path,
                  k ? "%s/" LIBBLEND_IMAGEIO_REL "/liblbimageio.so" : "%s/liblbimageio.so", self);
         h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
