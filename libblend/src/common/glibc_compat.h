@@ -5,8 +5,8 @@
  * newer Debian. Linking against a newer glibc binds some functions to
  * versions that older ones do not have: hypot@GLIBC_2.35,
  * pthread_create/join/mutex_trylock@GLIBC_2.34 (moved from libpthread into
- * libc), fstat/lstat@GLIBC_2.33 (before it, inline wrappers of __fxstat and
- * __lxstat), exp/log/pow@GLIBC_2.29 (new implementations without the SVID
+ * libc), stat/fstat/lstat@GLIBC_2.33 (before it, inline wrappers of __xstat,
+ * __fxstat and __lxstat), exp/log/pow@GLIBC_2.29 (new implementations without the SVID
  * error wrapper). Every one of them still exists under its x86-64 base
  * version GLIBC_2.2.5 in today's glibc, with the same results for the
  * arguments libblend passes (libblend never reads errno), so the build binds
@@ -39,12 +39,15 @@ __asm__(".symver pthread_mutex_trylock,pthread_mutex_trylock@GLIBC_2.2.5");
 struct stat;
 extern int __fxstat(int ver, int fd, struct stat *st);
 extern int __lxstat(int ver, const char *path, struct stat *st);
+extern int __xstat(int ver, const char *path, struct stat *st);
 #define lb__fstat(fd, st) __fxstat(1, (fd), (st))
+#define lb__stat(path, st) __xstat(1, (path), (st))
 #define lb__lstat(path, st) __lxstat(1, (path), (st))
 
 #else
 
 #define lb__fstat(fd, st) fstat((fd), (st))
+#define lb__stat(path, st) stat((path), (st))
 #define lb__lstat(path, st) lstat((path), (st))
 
 #endif

@@ -12,7 +12,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#if defined(__GNUC__)
+#if defined(__GNUC__) && defined(_WIN32)
+/* a DLL exports only what is marked dllexport (LB_API); printf is mingw-w64's
+ * own C99 one (__USE_MINGW_ANSI_STDIO, set by the build), hence gnu_printf */
+#define LB_INTERNAL
+#define LB_PRINTF(a, b) __attribute__((format(gnu_printf, a, b)))
+#define LB_NOINLINE __attribute__((noinline))
+#elif defined(__GNUC__)
 #define LB_INTERNAL __attribute__((visibility("hidden")))
 #define LB_PRINTF(a, b) __attribute__((format(printf, a, b)))
 #define LB_NOINLINE __attribute__((noinline))

@@ -11,7 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
+#include "../common/platform.h"
 
 /* ---- primitives ---- */
 
@@ -729,7 +729,7 @@ lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const double *x, c
     atomic_init(&J.next, 0);
     J.err_block = SIZE_MAX;
     pthread_mutex_init(&J.lock, NULL);
-    size_t nt = threads == 0 ? (size_t)sysconf(_SC_NPROCESSORS_ONLN) : (size_t)threads;
+    size_t nt = threads == 0 ? lb__cpu_count() : (size_t)threads;
     const size_t nblocks = (n + BLOCK_CHUNKS * LB__CHUNK - 1) / (BLOCK_CHUNKS * LB__CHUNK);
     if (nt < 1) nt = 1;
     if (nt > nblocks) nt = nblocks;

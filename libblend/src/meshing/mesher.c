@@ -33,7 +33,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
+#include "../common/platform.h"
 
 static const char FN[] = "lb_mesh_create";
 
@@ -1067,7 +1067,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     R.nblocks = L.n;
     pthread_mutex_init(&R.lock, NULL);
     pthread_mutex_init(&R.mlock, NULL);
-    size_t nt = opt->threads == 0 ? (size_t)sysconf(_SC_NPROCESSORS_ONLN) : (size_t)opt->threads;
+    size_t nt = opt->threads == 0 ? lb__cpu_count() : (size_t)opt->threads;
     if (nt < 1) nt = 1;
     if (nt > R.nblocks) nt = R.nblocks ? R.nblocks : 1;
     if (P.fn && P.fn(0.05, P.user)) P.cancelled = 1;

@@ -7,6 +7,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "scene_internal.h"
 #include "../common/glibc_compat.h"
+#include "../common/platform.h"
 
 #include <sys/stat.h>
 
@@ -1548,7 +1549,10 @@ lb_status lb_scene_load(const char *path, lb_scene **out, lb_error *err) {
     if (!out) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "lb_scene_load: out is NULL");
     *out = NULL;
     if (!path) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "lb_scene_load: path is NULL");
-    FILE *f = fopen(path, "rb");
+    FILE *f = lb__fopen(path, "rb");
+    if (!f && lb__is_directory(path)) /* Windows opens no folder */
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: is a directory; allowed: a scene file",
+                        path);
     if (!f)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: cannot open the scene file (%s); allowed: a readable file", path,

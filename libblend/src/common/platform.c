@@ -1,0 +1,66 @@
+/* The two calls of platform.h, per system. */
+#include "platform.h"
+
+#include <errno.h>
+#include <stdlib.h>
+
+#ifdef _WIN32
+#include <windows.h>
+
+wchar_t *lb__wide(const char *s) {
+    const int n = MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, s, -1, NULL, 0);
+    if (n <= 0) {
+        errno = EILSEQ;
+        return NULL;
+    }
+    wchar_t *w = malloc((size_t)n * sizeof *w);
+    if (!w) {
+        errno = ENOMEM;
+        return NULL;
+    }
+    MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, s, -1, w, n);
+    return w;
+}
+
+size_t lb__cpu_count(void) {
+    const DWORD n = GetActiveProcessorCount(ALL_PROCESSOR_GROUPS);
+    return n > 0 ? (size_t)n : 1;
+}
+
+FILE *lb__fopen(const char *path, const char *mode) {
+    wchar_t *wp = lb__wide(path), *wm = lb__wide(mode);
+    FILE *f = wp && wm ? _wfopen(wp, wm) : NULL;
+    const int e = errno;
+    free(wp);
+    free(wm);
+    errno = e;
+    return f;
+}
+
+int lb__is_directory(const char *path) {
+    wchar_t *wp = lb__wide(path);
+    const DWORD a = wp ? GetFileAttributesW(wp) : INVALID_FILE_ATTRIBUTES;
+    free(wp);
+    return a != INVALID_FILE_ATTRIBUTES && (a & FILE_ATTRIBUTE_DIRECTORY);
+}
+
+#else
+#include "glibc_compat.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+int lb__is_directory(const char *path) {
+    struct stat st;
+    return lb__stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+size_t lb__cpu_count(void) {
+    const long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (size_t)n : 1;
+}
+
+FILE *lb__fopen(const char *path, const char *mode) {
+    return fopen(path, mode);
+}
+#endif

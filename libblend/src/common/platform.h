@@ -1,0 +1,31 @@
+/* What differs between the systems libblend runs on (POSIX, Windows), behind
+ * two calls; the rest of the library is ISO C plus pthreads (on Windows,
+ * mingw-w64's winpthreads, linked in statically). Output files have their
+ * own implementation per system (export/output_posix.c, output_win32.c). */
+#ifndef LIBBLEND_PLATFORM_H
+#define LIBBLEND_PLATFORM_H
+
+#include "internal.h"
+
+#include <stddef.h>
+#include <stdio.h>
+
+/* The number of CPUs online (at least 1): the thread count 0 means. */
+LB_INTERNAL size_t lb__cpu_count(void);
+
+/* fopen for a UTF-8 path: on Windows through the wide API, so that a path
+ * with non-ASCII letters works whatever the code page; elsewhere fopen.
+ * NULL with errno set on failure (EILSEQ: not UTF-8). */
+LB_INTERNAL FILE *lb__fopen(const char *path, const char *mode);
+
+/* Whether a UTF-8 path names a folder. */
+LB_INTERNAL int lb__is_directory(const char *path);
+
+#ifdef _WIN32
+#include <wchar.h>
+/* UTF-8 to a new UTF-16 string (free it), or NULL with errno set (EILSEQ:
+ * not UTF-8). */
+LB_INTERNAL wchar_t *lb__wide(const char *s);
+#endif
+
+#endif
