@@ -3,9 +3,11 @@
 # source packages, so that libblend.so (and the add-on and SDK that carry it)
 # needs no JSON library at run time:
 #
-#   third-party.sh DIR      build cJSON and jansson for linux-x64 into DIR
-#                           (DIR/include, DIR/lib/libcjson.a, libjansson.a);
-#                           a second run with the same sources does nothing
+#   third-party.sh DIR [PLATFORM]
+#       build cJSON and jansson for PLATFORM (linux-x64, the default, or
+#       windows-x64) into DIR (DIR/include, DIR/lib/libcjson.a, libjansson.a;
+#       for windows-x64 also cmocka, which the cross-compiled tests use); a
+#       second run with the same recipe does nothing
 #
 # Debian ships no PIC archive of either (libcjson-dev has no .a at all; the
 # libjansson.a of libjansson-dev is not position independent), so they are
@@ -22,16 +24,39 @@
 # interrupted run leaves nothing half made. CMake runs this script at
 # configure time when DIR has no archives (LIBBLEND_BUNDLED_JSON, default ON).
 set -euo pipefail
-[ $# -eq 1 ] || {
-  echo "usage: third-party.sh DIR" >&2
+[ $# -eq 1 ] || [ $# -eq 2 ] || {
+  echo "usage: third-party.sh DIR [linux-x64|windows-x64]" >&2
   exit 2
 }
 DIR=$1
+PLATFORM=${2:-linux-x64}
 HERE=$(cd "$(dirname "$0")/.." && pwd)
 COMPAT="$HERE/libblend/src/common/glibc_compat.h"
-PACKAGES=(cjson jansson)
-CC=${CC_THIRD_PARTY:-gcc}
-CFLAGS_TP="-O2 -g0 -fPIC -fvisibility=hidden -include $COMPAT -DLB_GLIBC_BASELINE=1"
+case "$PLATFORM" in
+linux-x64)
+  PACKAGES=(cjson jansson)
+  CC=gcc
+  AR=ar
+  CFLAGS_TP="-O2 -g0 -fPIC -fvisibility=hidden -include $COMPAT -DLB_GLIBC_BASELINE=1"
+  CMAKE_CROSS=()
+  ;;
+windows-x64)
+  PACKAGES=(cjson jansson cmocka)
+  CC=x86_64-w64-mingw32-gcc-posix
+  AR=x86_64-w64-mingw32-ar
+  # cJSON marks its functions dllexport on Windows unless told otherwise
+  CFLAGS_TP="-O2 -g0 -DCJSON_HIDE_SYMBOLS"
+  CMAKE_CROSS=(-DCMAKE_TOOLCHAIN_FILE="$HERE/cmake/mingw-w64-x86_64.cmake")
+  command -v "$CC" >/dev/null || {
+    echo "third-party: $CC is missing (Debian package gcc-mingw-w64-x86-64)" >&2
+    exit 1
+  }
+  ;;
+*)
+  echo "third-party: unknown platform $PLATFORM; allowed: linux-x64, windows-x64" >&2
+  exit 2
+  ;;
+esac
 
 die() {
   echo "third-party: $*" >&2
@@ -41,7 +66,7 @@ die() {
 # The stamp names what the archives were built from: the source versions are
 # only known after the download, so the flags and this script's own hash are
 # checked first (a changed script or compat header rebuilds).
-recipe=$(cat "$0" "$COMPAT" | sha256sum | cut -c1-16)
+recipe=$( (cat "$0" "$COMPAT" "$HERE/cmake/mingw-w64-x86_64.cmake"; echo "$PLATFORM") | sha256sum | cut -c1-16)
 if [ -f "$DIR/.stamp" ] && grep -qx "recipe $recipe" "$DIR/.stamp"; then
   exit 0
 fi
@@ -92,14 +117,14 @@ cj=$(find "$TMP/src" -maxdepth 1 -type d -name 'cjson-*' | head -1)
 [ -n "$cj" ] || die "no cjson source folder"
 # shellcheck disable=SC2086
 $CC $CFLAGS_TP -std=c89 -c "$cj/cJSON.c" -o "$TMP/cJSON.o"
-ar rcs "$TMP/lib/libcjson.a" "$TMP/cJSON.o"
+"$AR" rcs "$TMP/lib/libcjson.a" "$TMP/cJSON.o"
 mkdir -p "$TMP/include/cjson"
 cp "$cj/cJSON.h" "$TMP/include/cjson/"
 
 # jansson: its own CMake build, static only.
 js=$(find "$TMP/src" -maxdepth 1 -type d -name 'jansson-*' | head -1)
 [ -n "$js" ] || die "no jansson source folder"
-cmake -S "$js" -B "$TMP/jansson-build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+cmake -S "$js" -B "$TMP/jansson-build" -G Ninja -DCMAKE_BUILD_TYPE=Release "${CMAKE_CROSS[@]}" \
   -DCMAKE_C_COMPILER="$CC" -DCMAKE_C_FLAGS="$CFLAGS_TP" \
   -DJANSSON_BUILD_SHARED_LIBS=OFF -DJANSSON_BUILD_DOCS=OFF -DJANSSON_WITHOUT_TESTS=ON \
   -DJANSSON_EXAMPLES=OFF -DJANSSON_COVERAGE=OFF -DUSE_URANDOM=ON -DUSE_WINDOWS_CRYPTOAPI=OFF \
@@ -114,8 +139,25 @@ for f in "$cj/LICENSE" "$js/LICENSE"; do
   cp "$f" "$TMP/LICENSE.$(basename "$(dirname "$f")" | cut -d- -f1)"
 done
 
+# cmocka (windows-x64 only: the tests' framework; Linux uses Debian's).
+if [[ " ${PACKAGES[*]} " == *" cmocka "* ]]; then
+  cm=$(find "$TMP/src" -maxdepth 1 -type d -name 'cmocka-*' | head -1)
+  [ -n "$cm" ] || die "no cmocka source folder"
+  cmake -S "$cm" -B "$TMP/cmocka-build" -G Ninja -DCMAKE_BUILD_TYPE=Release "${CMAKE_CROSS[@]}" \
+    -DCMAKE_C_FLAGS="$CFLAGS_TP" -DBUILD_SHARED_LIBS=OFF -DWITH_STATIC_LIB=ON \
+    -DWITH_EXAMPLES=OFF -DUNIT_TESTING=OFF -DPICKY_DEVELOPER=OFF \
+    -DCMAKE_INSTALL_PREFIX="$TMP/cmocka-install" >>"$TMP/build.log" 2>&1 ||
+    { cat "$TMP/build.log" >&2; die "cmocka configure failed"; }
+  cmake --build "$TMP/cmocka-build" >>"$TMP/build.log" 2>&1 &&
+    cmake --install "$TMP/cmocka-build" >>"$TMP/build.log" 2>&1 ||
+    { cat "$TMP/build.log" >&2; die "cmocka build failed"; }
+  cp "$(find "$TMP/cmocka-install" -name 'libcmocka-static.a' | head -1)" "$TMP/lib/libcmocka.a"
+  cp "$TMP/cmocka-install/include/"cmocka*.h "$TMP/include/"
+  cp "$cm/COPYING" "$TMP/LICENSE.cmocka"
+fi
+
 printf 'recipe %s\nsources %s\n' "$recipe" "$versions" >"$TMP/.stamp"
-rm -rf "$TMP"/{apt,src,jansson-build,jansson-install,cJSON.o,apt.log,build.log}
+rm -rf "$TMP"/{apt,src,jansson-build,jansson-install,cmocka-build,cmocka-install,cJSON.o,apt.log,build.log}
 rm -rf "$DIR"
 mv "$TMP" "$DIR"
 trap - EXIT

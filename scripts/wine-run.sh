@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Runs a Windows program under Wine (Debian's wine64), in libblend's own Wine
+# prefix: $LIBBLEND_WINEPREFIX, default ~/.cache/libblend/wine (made on the
+# first run, about 10 s; later starts take under a second). ctest uses this
+# as the cross-compiling emulator of the Windows build
+# (cmake/mingw-w64-x86_64.cmake).
+#   wine-run.sh PROGRAM.exe ARGS...
+set -euo pipefail
+WINE=${LIBBLEND_WINE:-/usr/lib/wine/wine64}
+[ -x "$WINE" ] || {
+  echo "wine-run: $WINE is missing: install Debian's wine64 (scripts/install-deps.sh does)" >&2
+  exit 127
+}
+export WINEPREFIX=${LIBBLEND_WINEPREFIX:-${XDG_CACHE_HOME:-$HOME/.cache}/libblend/wine}
+export WINEDEBUG=${WINEDEBUG:--all} WINEDLLOVERRIDES=${WINEDLLOVERRIDES:-"mscoree,mshtml="}
+if [ ! -f "$WINEPREFIX/.libblend-ok" ]; then
+  # the first start makes the prefix: one process at a time (ctest runs
+  # tests in parallel)
+  mkdir -p "$(dirname "$WINEPREFIX")"
+  exec 9>"$WINEPREFIX.lock"
+  flock 9
+  if [ ! -f "$WINEPREFIX/.libblend-ok" ]; then
+    "$WINE" cmd /c exit >/dev/null 2>&1 || true
+    "$(dirname "$WINE")/wineserver" -w 2>/dev/null || true
+    [ -f "$WINEPREFIX/system.reg" ] || {
+      echo "wine-run: could not make the Wine prefix $WINEPREFIX" >&2
+      exit 1
+    }
+    touch "$WINEPREFIX/.libblend-ok"
+  fi
+  flock -u 9
+  exec 9>&-
+fi
+exec "$WINE" "$@"
