@@ -2,8 +2,9 @@
 # The whole test suite: install what is missing (and the Debian 13 root with
 # Blender 4.3 and the Debian 11 root, scripts/debian-root.sh), then a Release build and a
 # sanitizer (ASan + UBSan) build, each run by ctest (the sanitizer build also
-# runs random valid scenes through every command for 60 s); the threaded
-# tests under ThreadSanitizer; then the scene parser under libFuzzer (clang,
+# runs random valid scenes through every command for 60 s); the Windows
+# build (mingw-w64) with its C test programs under Wine; the threaded tests
+# under ThreadSanitizer; then the scene parser under libFuzzer (clang,
 # ASan + UBSan) for LIBBLEND_FUZZ_SECONDS (60).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +23,12 @@ for cfg in "build-release:-DCMAKE_BUILD_TYPE=Release" \
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir "$dir" --output-on-failure -j "$JOBS"
 done
+
+echo "== build-windows (mingw-w64 cross build; the C test programs under Wine)"
+cmake -S . -B build-windows -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_TOOLCHAIN_FILE=cmake/mingw-w64-x86_64.cmake -DLIBBLEND_BENCH=OFF
+cmake --build build-windows -j "$JOBS"
+ctest --test-dir build-windows --output-on-failure -j "$JOBS"
 
 echo "== build-tsan (ThreadSanitizer: the tests that run threads)"
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_TSAN=ON \

@@ -229,7 +229,8 @@ static void test_random_trees(void **state) {
                   checked);
     assert_int_equal(misses, 0);
     for (size_t i = 0; i < NOPS; ++i) {
-        if (per_op[i] < 30) print_error("%s: only %zu scenes compiled\n", OPS[i], per_op[i]);
+        if (per_op[i] < 30)
+            print_error("%s: only %lu scenes compiled\n", OPS[i], (unsigned long)per_op[i]);
         assert_true(per_op[i] >= 30);
     }
 }

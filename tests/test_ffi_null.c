@@ -8,9 +8,9 @@
  * mask per pointer argument. */
 #define _POSIX_C_SOURCE 200809L
 #include "testlib.h"
+#include "testfs.h"
 
 #include <stdlib.h>
-#include <unistd.h>
 
 #define NARGS_MAX 10
 
@@ -494,8 +494,7 @@ static int setup(void **state) {
     lb_mesh_options o;
     small_options(&o);
     if (lb_mesh_create(C.ev, &o, &C.mesh, &e)) return -1;
-    snprintf(C.tmpdir, sizeof C.tmpdir, "/tmp/libblend-ffi-XXXXXX");
-    return mkdtemp(C.tmpdir) ? 0 : -1;
+    return test_mkdtemp(C.tmpdir, sizeof C.tmpdir, "libblend-ffi");
 }
 
 static int teardown(void **state) {
@@ -503,7 +502,7 @@ static int teardown(void **state) {
     lb_mesh_free(C.mesh);
     lb_evaluator_free(C.ev);
     lb_scene_free(C.scene);
-    rmdir(C.tmpdir);
+    test_rmdir(C.tmpdir);
     return 0;
 }
 

@@ -4,6 +4,7 @@
  * the substrings its message must contain. */
 #define _POSIX_C_SOURCE 200809L
 #include "testlib.h"
+#include "testfs.h"
 
 #include <stdlib.h>
 #include <unistd.h>
@@ -520,21 +521,33 @@ static void test_files(void **state) {
     assert_int_equal(lb_scene_load("/nonexistent/scene.json", &sc, &e), LB_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(e.message, "/nonexistent/scene.json: cannot open the scene file (No "
                                       "such file or directory)"));
-    assert_int_equal(lb_scene_load("/tmp", &sc, &e), LB_ERR_INVALID_ARGUMENT);
-    assert_non_null(strstr(e.message, "/tmp: is a directory"));
-    char path[] = "/tmp/libblend-big-XXXXXX";
-    const int fd = mkstemp(path);
-    assert_true(fd >= 0);
-    assert_int_equal(ftruncate(fd, (off_t)LB_SCENE_MAX_BYTES + 10), 0);
-    close(fd);
+    char dir[512], path[600];
+    assert_int_equal(test_mkdtemp(dir, sizeof dir, "libblend-files"), 0);
+    assert_int_equal(lb_scene_load(dir, &sc, &e), LB_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(e.message, ": is a directory"));
+    assert_non_null(strstr(e.message, dir));
+    /* a file over the size limit (sparse where the file system can) */
+    snprintf(path, sizeof path, "%s/big.json", dir);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+#ifdef _WIN32
+    assert_int_equal(_chsize_s(_fileno(f), (long long)LB_SCENE_MAX_BYTES + 10), 0);
+#else
+    assert_int_equal(ftruncate(fileno(f), (off_t)LB_SCENE_MAX_BYTES + 10), 0);
+#endif
+    fclose(f);
     assert_int_equal(lb_scene_load(path, &sc, &e), LB_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(e.message, "the scene file is 67108874 bytes"));
-    unlink(path);
-    /* endless devices: read to the size limit, then bad input (not memory) */
+    remove(path);
+    test_rmdir(dir);
+#ifndef _WIN32
+    /* endless devices: read to the size limit, then bad input (not memory);
+     * POSIX only (Windows has no such files) */
     assert_int_equal(lb_scene_load("/dev/zero", &sc, &e), LB_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(e.message, "/dev/zero: the scene file is larger than 67108864 bytes"));
     assert_int_equal(lb_scene_load("/dev/urandom", &sc, &e), LB_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(e.message, "/dev/urandom: the scene file is larger than"));
+#endif
     assert_null(sc);
 }
 
