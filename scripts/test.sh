@@ -3,7 +3,8 @@
 # Blender 4.3 and the Debian 11 root, scripts/debian-root.sh), then a Release build and a
 # sanitizer (ASan + UBSan) build, each run by ctest (the sanitizer build also
 # runs random valid scenes through every command for 60 s); the Windows
-# build (mingw-w64) with its C test programs under Wine; the threaded tests
+# build (mingw-w64) with its C test programs under Wine; the five packages
+# (scripts/package.sh), each opened as a user would; the threaded tests
 # under ThreadSanitizer; then the scene parser under libFuzzer (clang,
 # ASan + UBSan) for LIBBLEND_FUZZ_SECONDS (60).
 set -euo pipefail
@@ -29,6 +30,10 @@ cmake -S . -B build-windows -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_TOOLCHAIN_FILE=cmake/mingw-w64-x86_64.cmake -DLIBBLEND_BENCH=OFF
 cmake --build build-windows -j "$JOBS"
 ctest --test-dir build-windows --output-on-failure -j "$JOBS"
+
+echo "== packages (scripts/package.sh from the two builds, each opened as a user would)"
+LIBBLEND_DIST="$PWD/build-dist" bash scripts/package.sh --builds build-release build-windows
+bash tests/packaging/test_packages.sh build-dist .
 
 echo "== build-tsan (ThreadSanitizer: the tests that run threads)"
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_TSAN=ON \

@@ -5,24 +5,39 @@ redo restore settings and meshes; settings survive saving and reopening the
 
     BLENDER_USER_SCRIPTS=DIR blender -b --factory-startup --python-exit-code 1 \
         --python test_install_zip.py -- ZIP
+
+A Blender 4.2+ extension, installed beforehand with `blender --command
+extension install-file` (tests/packaging/test_packages.sh), goes through the
+same checks when its module is named instead (BLENDER_USER_RESOURCES set):
+
+    ... --python test_install_zip.py -- EXTENSION.zip bl_ext.user_default.libblend
 """
+import importlib
 import os
 import sys
 
 import addon_utils
 import bpy
 
-zip_path = sys.argv[sys.argv.index("--") + 1]
-scripts = os.environ["BLENDER_USER_SCRIPTS"]
+args = sys.argv[sys.argv.index("--") + 1:]
+zip_path = args[0]
+module = args[1] if len(args) > 1 else "libblend_blender"
 os.environ.pop("LIBBLEND_LIBRARY", None)
-res = bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
-assert res == {"FINISHED"}, res
-installed = os.path.join(scripts, "addons", "libblend_blender")
+if module == "libblend_blender":  # the legacy add-on: Preferences > Add-ons > Install
+    scripts = os.environ["BLENDER_USER_SCRIPTS"]
+    res = bpy.ops.preferences.addon_install(filepath=zip_path, overwrite=True)
+    assert res == {"FINISHED"}, res
+    installed = os.path.join(scripts, "addons", "libblend_blender")
+else:  # an extension, installed by `extension install-file`
+    scripts = os.path.join(os.environ["BLENDER_USER_RESOURCES"], "scripts")
+    os.makedirs(scripts, exist_ok=True)
+    installed = os.path.join(os.environ["BLENDER_USER_RESOURCES"], "extensions",
+                             module.split(".")[1], module.split(".")[2])
 assert os.path.isfile(os.path.join(installed, "lib", "libblend.so")), "library installed with it"
 assert os.path.isfile(os.path.join(installed, "povray", "libblend.inc")), "libblend.inc installed"
-mod = addon_utils.enable("libblend_blender", default_set=True)
+mod = addon_utils.enable(module, default_set=True)
 assert mod is not None and os.path.dirname(mod.__file__) == installed, mod
-from libblend_blender import live  # noqa: E402
+live = importlib.import_module(module + ".live")
 
 ok, msg = live.library_status()
 assert ok and live.library().path.startswith(installed), msg
@@ -30,7 +45,7 @@ assert bpy.ops.libblend.add_field() == {"FINISHED"}
 out = bpy.context.view_layer.objects.active
 assert len(out.data.polygons) > 1000, "the default sphere is meshed"
 n_sphere = len(out.data.polygons)
-from libblend_blender import tree  # noqa: E402
+tree = importlib.import_module(module + ".tree")
 
 # undo / redo: an edit of a setting, then of the tree
 bpy.ops.ed.undo_push(message="field added")
@@ -77,7 +92,12 @@ out.libblend.render_resolution = 96
 seen = []
 bpy.app.handlers.render_post.append(lambda *a: seen.append(len(out.data.polygons)))
 scene = bpy.context.scene
-scene.render.engine = "BLENDER_WORKBENCH"
+# Cycles on the CPU: Workbench and EEVEE need an OpenGL/EGL context, which
+# Blender 4.x in background mode has not without a GPU
+scene.render.engine = "CYCLES"
+scene.cycles.samples = 1
+scene.cycles.device = "CPU"
+scene.cycles.use_denoising = False
 scene.render.resolution_x, scene.render.resolution_y = 32, 24
 scene.render.filepath = os.path.join(os.path.dirname(scripts), "render.png")
 cam = bpy.data.objects.new("cam", bpy.data.cameras.new("cam"))
@@ -88,6 +108,6 @@ scene.camera = cam
 bpy.ops.render.render(write_still=True)
 assert seen and seen[0] > 2 * n_preview, "rendered at render resolution: %r vs %d" % (seen, n_preview)
 assert len(out.data.polygons) == n_preview, "preview mesh restored after the render"
-addon_utils.disable("libblend_blender")
+addon_utils.disable(module)
 print("test_install_zip: installed from %s; undo, redo, save and reopen hold"
       % os.path.basename(zip_path))
