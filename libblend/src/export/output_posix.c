@@ -2,9 +2,7 @@
  * a hidden named one as the fallback, symlinks followed, devices and FIFOs
  * written directly, modes like any Unix tool. Shared by every writer. */
 #define _GNU_SOURCE /* O_TMPFILE, AT_EMPTY_PATH */
-#include "libblend/output.h"
-
-#include "../common/internal.h"
+#include "output_internal.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -23,10 +21,9 @@ static const char FN[] = "lb_output";
 enum { OUT_UNNAMED = 0, OUT_NAMED, OUT_DIRECT };
 
 struct lb_output {
-    FILE *f;
+    lb__output_head h; /* h.temp: OUT_NAMED's hidden temporary file */
     int how;
     char *path; /* the target, symbolic links resolved */
-    char *temp; /* OUT_NAMED: the hidden temporary file */
     char *dir;  /* the target's folder */
     char *base; /* the target's name in it */
 };
@@ -43,7 +40,7 @@ static char *dup_str(const char *s, size_t n) {
 static void output_free(lb_output *o) {
     if (!o) return;
     free(o->path);
-    free(o->temp);
+    free(o->h.temp);
     free(o->dir);
     free(o->base);
     free(o);
@@ -156,8 +153,8 @@ static int open_named(lb_output *o) {
         }
         const int fd = open(name, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         if (fd >= 0) {
-            o->temp = dup_str(name, strlen(name));
-            if (!o->temp) {
+            o->h.temp = dup_str(name, strlen(name));
+            if (!o->h.temp) {
                 close(fd);
                 unlink(name);
                 errno = ENOMEM;
@@ -222,7 +219,7 @@ lb_status lb_output_open(const char *path, lb_output **out, lb_error *err) {
         if (fd >= 0 && exists && fchmod(fd, st.st_mode & 07777) != 0) {
             const int e = errno;
             close(fd);
-            if (o->temp) unlink(o->temp);
+            if (o->h.temp) unlink(o->h.temp);
             errno = e;
             fd = -1;
         }
@@ -231,41 +228,29 @@ lb_status lb_output_open(const char *path, lb_output **out, lb_error *err) {
     if (!f) {
         const int e = errno;
         if (fd >= 0) close(fd);
-        if (o->temp) unlink(o->temp);
-        lb__fail(err, LB_ERR_IO,
-                 "%s: cannot create the output file there (%s); allowed: a path "
-                 "in a writable folder",
-                 path, strerror(e));
+        if (o->h.temp) unlink(o->h.temp);
         output_free(o);
-        return LB_ERR_IO;
+        return lb__output_open_failed(err, path, strerror(e));
     }
-    o->f = f;
+    o->h.f = f;
     *out = o;
     return LB_OK;
-}
-
-FILE *lb_output_stream(lb_output *o) {
-    return o ? o->f : NULL;
-}
-
-const char *lb_output_temp_name(const lb_output *o) {
-    return o ? o->temp : NULL;
 }
 
 /* Link the unnamed file into place: directly when nothing is there, else
  * through a hidden name renamed over the target (atomic replacement). */
 static int link_unnamed(lb_output *o) {
     char proc[64];
-    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fileno(o->f));
+    snprintf(proc, sizeof proc, "/proc/self/fd/%d", fileno(o->h.f));
     if (linkat(AT_FDCWD, proc, AT_FDCWD, o->path, AT_SYMLINK_FOLLOW) == 0) return 1;
-    if (errno == ENOENT && linkat(fileno(o->f), "", AT_FDCWD, o->path, AT_EMPTY_PATH) == 0)
+    if (errno == ENOENT && linkat(fileno(o->h.f), "", AT_FDCWD, o->path, AT_EMPTY_PATH) == 0)
         return 1;
     if (errno != EEXIST) return 0;
     char name[4096 + 600];
     for (unsigned attempt = 0; attempt < 64; ++attempt) {
         if (!temp_name(o, attempt, name, sizeof name)) return 0;
         if (linkat(AT_FDCWD, proc, AT_FDCWD, name, AT_SYMLINK_FOLLOW) != 0 &&
-            !(errno == ENOENT && linkat(fileno(o->f), "", AT_FDCWD, name, AT_EMPTY_PATH) == 0)) {
+            !(errno == ENOENT && linkat(fileno(o->h.f), "", AT_FDCWD, name, AT_EMPTY_PATH) == 0)) {
             if (errno == EEXIST) continue;
             return 0;
         }
@@ -281,35 +266,33 @@ static int link_unnamed(lb_output *o) {
 lb_status lb_output_commit(lb_output *o, lb_error *err) {
     if (!o) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s_commit: output is NULL", FN);
     errno = 0;
-    int ok = fflush(o->f) == 0 && !ferror(o->f);
+    int ok = fflush(o->h.f) == 0 && !ferror(o->h.f);
     int e = errno;
     if (ok && o->how == OUT_UNNAMED) {
         ok = link_unnamed(o);
         e = errno;
     }
     errno = 0;
-    if (fclose(o->f) != 0 && ok) {
+    if (fclose(o->h.f) != 0 && ok) {
         ok = 0;
         e = errno;
     }
     if (ok && o->how == OUT_NAMED) {
-        ok = rename(o->temp, o->path) == 0;
+        ok = rename(o->h.temp, o->path) == 0;
         e = errno;
     }
-    if (!ok && o->temp) unlink(o->temp);
+    if (!ok && o->h.temp) unlink(o->h.temp);
     lb_status s = LB_OK;
     if (!ok)
-        s = lb__fail(err, LB_ERR_IO, "%s: writing the output failed (%s); %s", o->path,
-                     e ? strerror(e) : "short write",
-                     o->how == OUT_DIRECT ? "what was written before stays on the device"
-                                          : "nothing was written");
+        s = lb__output_write_failed(err, o->path, e ? strerror(e) : "short write",
+                                    o->how == OUT_DIRECT);
     output_free(o);
     return s;
 }
 
 void lb_output_discard(lb_output *o) {
     if (!o) return;
-    fclose(o->f);
-    if (o->temp) unlink(o->temp);
+    fclose(o->h.f);
+    if (o->h.temp) unlink(o->h.temp);
     output_free(o);
 }

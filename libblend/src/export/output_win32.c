@@ -9,9 +9,7 @@
  * a COM port) or a pipe is written directly; a folder is refused. Temporary
  * files whose process is gone are removed by the next open of the same
  * path, as on POSIX. New files get the folder's inherited permissions. */
-#include "libblend/output.h"
-
-#include "../common/internal.h"
+#include "output_internal.h"
 #include "../common/platform.h"
 
 #include <windows.h>
@@ -30,11 +28,10 @@ static const char FN[] = "lb_output";
 enum { OUT_NAMED = 1, OUT_DIRECT };
 
 struct lb_output {
-    FILE *f;
+    lb__output_head h; /* h.temp: wtemp in UTF-8 */
     int how;
     wchar_t *wpath; /* the target, links resolved */
     wchar_t *wtemp; /* OUT_NAMED: the temporary file */
-    char *temp;     /* the same, UTF-8 (lb_output_temp_name) */
     char *path;     /* the path as given, for messages */
 };
 
@@ -42,7 +39,7 @@ static void output_free(lb_output *o) {
     if (!o) return;
     free(o->wpath);
     free(o->wtemp);
-    free(o->temp);
+    free(o->h.temp);
     free(o->path);
     free(o);
 }
@@ -228,8 +225,8 @@ lb_status lb_output_open(const char *path, lb_output **out, lb_error *err) {
                             FILE_ATTRIBUTE_HIDDEN, NULL);
             if (h != INVALID_HANDLE_VALUE) {
                 o->wtemp = wdup(name, wcslen(name));
-                o->temp = narrow(name);
-                if (!o->wtemp || !o->temp) {
+                o->h.temp = narrow(name);
+                if (!o->wtemp || !o->h.temp) {
                     CloseHandle(h);
                     DeleteFileW(name);
                     h = INVALID_HANDLE_VALUE;
@@ -257,31 +254,19 @@ lb_status lb_output_open(const char *path, lb_output **out, lb_error *err) {
     }
     if (!f) {
         if (o->wtemp) DeleteFileW(o->wtemp);
-        lb__fail(err, LB_ERR_IO,
-                 "%s: cannot create the output file there (%s); allowed: a path in a writable "
-                 "folder",
-                 path, win_message(e, msg, sizeof msg));
         output_free(o);
-        return LB_ERR_IO;
+        return lb__output_open_failed(err, path, win_message(e, msg, sizeof msg));
     }
-    o->f = f;
+    o->h.f = f;
     *out = o;
     return LB_OK;
 }
 
-FILE *lb_output_stream(lb_output *o) {
-    return o ? o->f : NULL;
-}
-
-const char *lb_output_temp_name(const lb_output *o) {
-    return o ? o->temp : NULL;
-}
-
 lb_status lb_output_commit(lb_output *o, lb_error *err) {
     if (!o) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s_commit: output is NULL", FN);
-    int ok = fflush(o->f) == 0 && !ferror(o->f);
+    int ok = fflush(o->h.f) == 0 && !ferror(o->h.f);
     DWORD e = ok ? 0 : ERROR_WRITE_FAULT;
-    if (fclose(o->f) != 0 && ok) {
+    if (fclose(o->h.f) != 0 && ok) {
         ok = 0;
         e = ERROR_WRITE_FAULT;
     }
@@ -295,10 +280,8 @@ lb_status lb_output_commit(lb_output *o, lb_error *err) {
     lb_status s = LB_OK;
     if (!ok) {
         char msg[256];
-        s = lb__fail(err, LB_ERR_IO, "%s: writing the output failed (%s); %s", o->path,
-                     win_message(e, msg, sizeof msg),
-                     o->how == OUT_DIRECT ? "what was written before stays on the device"
-                                          : "nothing was written");
+        s = lb__output_write_failed(err, o->path, win_message(e, msg, sizeof msg),
+                                    o->how == OUT_DIRECT);
     }
     output_free(o);
     return s;
@@ -306,7 +289,7 @@ lb_status lb_output_commit(lb_output *o, lb_error *err) {
 
 void lb_output_discard(lb_output *o) {
     if (!o) return;
-    fclose(o->f);
+    fclose(o->h.f);
     if (o->wtemp) DeleteFileW(o->wtemp);
     output_free(o);
 }
