@@ -72,16 +72,9 @@ die() {
   exit 1
 }
 
-# The Debian mirror this machine already uses (deb822 or one-line sources).
+# The Debian mirror this machine already uses.
 mirror() {
-  local m=""
-  if [ -f /etc/apt/sources.list.d/debian.sources ]; then
-    m=$(awk '/^URIs:/ {print $2; exit}' /etc/apt/sources.list.d/debian.sources)
-  fi
-  if [ -z "$m" ] && [ -f /etc/apt/sources.list ]; then
-    m=$(awk '$1 == "deb" && $0 !~ /security/ {for (i = 2; i <= NF; i++) if ($i ~ /^https?:/) {print $i; exit}}' /etc/apt/sources.list)
-  fi
-  echo "${m:-http://deb.debian.org/debian}"
+  bash "$(dirname "$0")/debian-mirror.sh"
 }
 
 # Packages of PACKAGES missing in root $1 (none: prints nothing).
