@@ -155,12 +155,13 @@ typedef struct bt_render_dir {
 int bt_render_dir_open(bt_render_dir *r); /* exit code */
 void bt_render_dir_close(bt_render_dir *r);
 
-/* povray on R's scene into R's image (deep: a 16-bit PNG with alpha),
- * through R's INI file; its messages stream to stderr, or (quiet) go to R's
- * log and are shown only when it fails. Returns an exit code, after printing
- * a message naming scene_name on failure. */
+/* povray on R's scene into R's image, a PNG of 16 bits per channel (else 8)
+ * with an alpha channel (else RGB) as bits16 and alpha say, through R's INI
+ * file; its messages stream to stderr, or (quiet) go to R's log and are
+ * shown only when it fails. Returns an exit code, after printing a message
+ * naming scene_name on failure. */
 int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int height, int threads,
-              int quality, int deep, int quiet);
+              int quality, int bits16, int alpha, int quiet);
 
 /* The lbi_format for an image name (.png: --bits 8|16, .exr: --pixel
  * half|float; 0 / NULL: the defaults), or -1 after printing why. */
@@ -185,6 +186,32 @@ typedef struct bt_imageio {
 
 /* The image functions, or NULL after printing why they cannot be loaded. */
 const bt_imageio *bt_imageio_get(const char *cmd);
+/* The same, silently: NULL with the reason in why. */
+const bt_imageio *bt_imageio_try(char *why, size_t whylen);
+
+/* How a rendered image becomes OUT. With the image module (OpenImageIO),
+ * POV-Ray writes a 16-bit RGBA PNG and the module converts it to any
+ * format. Without it (a farm node that has POV-Ray but not OpenImageIO),
+ * POV-Ray writes the final PNG itself, at the asked depth and channels, and
+ * bt_png_direct finishes it; OpenEXR then fails. */
+typedef struct bt_image_plan {
+    const bt_imageio *io; /* NULL: POV-Ray's own PNG */
+    int bits16, alpha;    /* what POV-Ray writes */
+    int out_alpha;        /* OUT has an alpha channel */
+} bt_image_plan;
+/* Plan OUT (format fmt, alpha channel or not); an exit code, after printing
+ * why when OUT cannot be written on this machine. Without the module, a note
+ * says so once per process. */
+int bt_image_plan_for(const char *cmd, const char *out, int fmt, int alpha, bt_image_plan *p);
+/* OUT's bytes from POV-Ray's png, with meta (0, or -1 with err) */
+int bt_image_finish(const bt_image_plan *p, const char *png, int fmt, const lbi_meta *meta,
+                    size_t nmeta, unsigned char **data, size_t *size, char *err, size_t errlen);
+/* png_direct.c: POV-Ray's PNG at in, its time stamp and text chunks
+ * replaced by meta (text chunks before the image data), every chunk's CRC
+ * checked; the bytes in a malloc'd buffer the caller frees. 0, or -1 with a
+ * message in err. */
+int bt_png_direct(const char *in, const lbi_meta *meta, size_t nmeta, unsigned char **data,
+                  size_t *size, char *err, size_t errlen);
 
 /* Is help requested anywhere in argv? */
 int bt_wants_help(int argc, char **argv);

@@ -57,6 +57,7 @@ typedef struct job {
     int pov, pov_w, pov_h;
     int image, img_w, img_h, img_quality, img_alpha, img_fmt;
     int sheet, sheet_cols, sheet_w, sheet_h;
+    bt_image_plan img_plan; /* how the images are made on this machine */
     int threads;
     uint64_t spec_hash[2]; /* of the outputs section: a change redoes every task */
 } job;
@@ -1114,11 +1115,9 @@ static int run_task(const job *J, const task *T, const char *ident, const uint64
                 rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
             if (!rc)
                 rc = bt_povray(J->scenes[T->scene], &R, J->img_w, J->img_h, threads ? threads : 1,
-                               J->img_quality, 1, 1);
+                               J->img_quality, J->img_plan.bits16, J->img_plan.alpha, 1);
             if (!rc) {
-                char hex[33], settings[128],
-                    err[1024] = "the image writer is not available (above)";
-                const bt_imageio *io = NULL;
+                char hex[33], settings[128], err[1024] = "";
                 bt_hash_hex(scene_hash, hex);
                 snprintf(settings, sizeof settings, "%dx%d quality %d", J->img_w, J->img_h,
                          J->img_quality);
@@ -1129,9 +1128,8 @@ static int run_task(const job *J, const task *T, const char *ident, const uint64
                                           {"libblend:task", T->name}};
                 unsigned char *img = NULL;
                 size_t len = 0;
-                if (!(io = bt_imageio_get(CMD)) ||
-                    io->convert(R.png, (lbi_format)J->img_fmt, J->img_alpha, meta, 5, &img, &len,
-                                err, sizeof err)) {
+                if (bt_image_finish(&J->img_plan, R.png, J->img_fmt, meta, 5, &img, &len, err,
+                                    sizeof err)) {
                     bt_error(CMD, "%s: writing the image failed: %s", full, err);
                     rc = BT_EXIT_INTERNAL;
                 } else {
@@ -1665,6 +1663,21 @@ static int run(int argc, char **argv) {
             job_free(&J);
             return rc;
         }
+    }
+    /* the images can be made here (else nothing is created) */
+    if (J.image && !sheet_only &&
+        (rc = bt_image_plan_for(CMD, J.file, J.img_fmt, J.img_alpha, &J.img_plan)) == 0 &&
+        J.sheet && !J.img_plan.io) {
+        bt_error(CMD,
+                 "%s: the contact sheet needs the image module (above); allowed: install "
+                 "OpenImageIO 2.4 (Debian package libopenimageio2.4), or drop "
+                 "outputs.contact_sheet and make the sheet elsewhere with --sheet",
+                 J.file);
+        rc = BT_EXIT_INTERNAL;
+    }
+    if (rc) {
+        job_free(&J);
+        return rc;
     }
     if (mkdirs(J.outdir)) {
         bt_error(CMD, "%s: cannot create the output folder (%s)", J.outdir, strerror(errno));

@@ -87,7 +87,7 @@ const bt_command bt_cmd_compare = {
     "usage: blendtool compare A B [--fail T] [--fail-percent P]\n\n"
     "Compares two images of the same size channel by channel (OpenImageIO): a pixel\n"
     "fails when a channel differs by more than T (default 0.004, about one step of\n"
-    "an 8-bit image); the images match when at most P %% of the pixels fail\n"
+    "an 8-bit image); the images match when at most P % of the pixels fail\n"
     "(default 0). Prints MATCH or DIFFER with the largest and mean differences.\n"
     "The headers are read first: sizes are compared, and an image of more than\n"
     "67108864 pixels (8192 x 8192) or 16 channels refused, before any pixel is\n"

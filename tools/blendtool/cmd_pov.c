@@ -162,7 +162,7 @@ static void remove_stale_renders(void) {
 }
 
 int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int height, int threads,
-              int quality, int deep, int quiet) {
+              int quality, int bits16, int alpha, int quiet) {
     char outw[64], outh[64], th[64], q[32], dir[4096];
     if (bt_povray_include("render", dir, sizeof dir)) return BT_EXIT_INTERNAL;
     /* POV-Ray splits its command line at spaces, even inside one argument
@@ -206,12 +206,8 @@ int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int hei
             }
         }
         if (chdir(R->dir) != 0) _exit(127);
-        if (deep) /* 16-bit PNG with alpha, for the OpenImageIO writer */
-            execlp("povray", "povray", ini_name, outw, outh, th, q, "-D", "+FN16", "+UA", "-V",
-                   (char *)NULL);
-        else
-            execlp("povray", "povray", ini_name, outw, outh, th, q, "-D", "+FN", "-V",
-                   (char *)NULL);
+        execlp("povray", "povray", ini_name, outw, outh, th, q, "-D", bits16 ? "+FN16" : "+FN8",
+               alpha ? "+UA" : "-UA", "-V", (char *)NULL);
         fprintf(stderr,
                 "blendtool render: cannot run povray (%s); allowed: install POV-Ray 3.7 (Debian "
                 "package povray)\n",
@@ -306,6 +302,8 @@ static int run_render(int argc, char **argv) {
     if (parse("render", argc, argv, &a, 1)) return BT_EXIT_BAD_INPUT;
     const int fmt = bt_image_format("render", a.out, a.bits, a.pixel);
     if (fmt < 0) return BT_EXIT_BAD_INPUT;
+    bt_image_plan plan;
+    if (bt_image_plan_for("render", a.out, fmt, a.alpha, &plan)) return BT_EXIT_INTERNAL;
     bt_render_dir R;
     if (bt_render_dir_open(&R)) return BT_EXIT_INTERNAL;
     bt_out w;
@@ -324,13 +322,13 @@ static int run_render(int argc, char **argv) {
             }
         }
     }
-    if (!rc) rc = bt_povray(a.scene, &R, a.width, a.height, a.threads, a.quality, 1, 0);
+    if (!rc)
+        rc = bt_povray(a.scene, &R, a.width, a.height, a.threads, a.quality, plan.bits16,
+                       plan.alpha, 0);
     unsigned char *img = NULL;
     size_t len = 0;
     if (!rc) {
-        char hex[33], settings[128], params[4096],
-            err[1024] = "the image writer is not available (above)";
-        const bt_imageio *io = NULL;
+        char hex[33], settings[128], params[4096], err[1024] = "";
         bt_hash_hex(hash, hex);
         snprintf(settings, sizeof settings, "%dx%d quality %d%s", a.width, a.height, a.quality,
                  a.silhouette ? " silhouette" : "");
@@ -345,8 +343,7 @@ static int run_render(int argc, char **argv) {
                                   {"libblend:version", BT_VERSION},
                                   {"libblend:render", settings},
                                   {"libblend:parameters", params}};
-        if (!(io = bt_imageio_get("render")) ||
-            io->convert(R.png, (lbi_format)fmt, a.alpha, meta, 4, &img, &len, err, sizeof err)) {
+        if (bt_image_finish(&plan, R.png, fmt, meta, 4, &img, &len, err, sizeof err)) {
             bt_error("render", "%s: writing the image failed: %s", a.out, err);
             rc = BT_EXIT_INTERNAL;
         }
@@ -393,8 +390,10 @@ const bt_command bt_cmd_render = {
     "streams to standard error. The image is written by OpenImageIO: PNG (8 or 16\n"
     "bits) or OpenEXR (half or float), RGB or with --alpha RGBA, with the scene's\n"
     "hash, libblend's version and the render settings as metadata and no time\n"
-    "stamp: the same scene and options give the same bytes. OUT appears only when\n"
-    "the render succeeded.\n"
+    "stamp: the same scene and options give the same bytes at --threads 1 (POV-Ray's\n"
+    "threads share out the area light's jitter differently from run to run). OUT\n"
+    "appears only when the render succeeded. Without OpenImageIO (its module cannot be loaded),\n"
+    "POV-Ray writes the PNG itself, with the same metadata; EXR then fails.\n"
     "libblend.inc is taken from the folder $LIBBLEND_POVRAY_INCLUDE, else from the\n"
     "copy installed with blendtool (share/libblend/povray beside its bin/).\n"
     "  --width, --height  image size (640 x 480)\n"

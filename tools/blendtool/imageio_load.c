@@ -11,6 +11,7 @@
 
 #include <dlfcn.h>
 #include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -22,7 +23,7 @@
 static bt_imageio api; /* one process, loaded once */
 static int loaded;
 
-const bt_imageio *bt_imageio_get(const char *cmd) {
+const bt_imageio *bt_imageio_try(char *why, size_t whylen) {
     if (loaded) return &api;
     char path[PATH_MAX + 64];
     const char *env = getenv("LIBBLEND_IMAGEIO");
@@ -44,10 +45,7 @@ const bt_imageio *bt_imageio_get(const char *cmd) {
         snprintf(tried + l, sizeof tried - l, "%s%s", l ? ", " : "", path);
     }
     if (!h) {
-        bt_error(cmd,
-                 "cannot load the image writer (tried %s): %s; allowed: build blendtool with "
-                 "OpenImageIO (Debian package libopenimageio-dev) or set LIBBLEND_IMAGEIO",
-                 tried, dlerror());
+        snprintf(why, whylen, "cannot load the image module (tried %s): %s", tried, dlerror());
         return NULL;
     }
     api.convert = (int (*)(const char *, lbi_format, int, const lbi_meta *, size_t,
@@ -58,12 +56,57 @@ const bt_imageio *bt_imageio_get(const char *cmd) {
     api.compare = (int (*)(const char *, const char *, double, double *, double *, double *, char *,
                            size_t))dlsym(h, "lbi_compare");
     if (!api.convert || !api.contact_sheet || !api.compare) {
-        bt_error(cmd,
-                 "the image writer %s lacks its functions; allowed: the liblbimageio.so "
-                 "built with this blendtool",
+        snprintf(why, whylen,
+                 "the image module %s lacks its functions (not the one built "
+                 "with this blendtool)",
                  tried);
+        dlclose(h);
         return NULL;
     }
     loaded = 1;
     return &api;
+}
+
+const bt_imageio *bt_imageio_get(const char *cmd) {
+    char why[3 * (PATH_MAX + 64) + 512];
+    const bt_imageio *io = bt_imageio_try(why, sizeof why);
+    if (!io)
+        bt_error(cmd,
+                 "%s; allowed: install OpenImageIO 2.4 (Debian package libopenimageio2.4, "
+                 "or libopenimageio-dev to build blendtool) or set LIBBLEND_IMAGEIO",
+                 why);
+    return io;
+}
+
+int bt_image_plan_for(const char *cmd, const char *out, int fmt, int alpha, bt_image_plan *p) {
+    static int noted; /* one note per process, not one per batch task */
+    char why[3 * (PATH_MAX + 64) + 512];
+    p->io = bt_imageio_try(why, sizeof why);
+    p->out_alpha = alpha;
+    p->alpha = p->io ? 1 : alpha;
+    p->bits16 = p->io ? 1 : fmt == LBI_PNG16;
+    if (!p->io && fmt != LBI_PNG8 && fmt != LBI_PNG16) {
+        bt_error(cmd,
+                 "%s: OpenEXR needs the image module: %s; allowed: a .png output, or install "
+                 "OpenImageIO 2.4 (Debian package libopenimageio2.4)",
+                 out, why);
+        return BT_EXIT_INTERNAL;
+    }
+    if (!p->io && !noted) {
+        fprintf(stderr,
+                "blendtool %s: note: %s; POV-Ray writes the PNG itself (its own %d-bit "
+                "quantisation, the same metadata; OpenEXR, contact sheets and compare need "
+                "OpenImageIO 2.4)\n",
+                cmd, why, p->bits16 ? 16 : 8);
+        noted = 1;
+    }
+    return BT_EXIT_OK;
+}
+
+int bt_image_finish(const bt_image_plan *p, const char *png, int fmt, const lbi_meta *meta,
+                    size_t nmeta, unsigned char **data, size_t *size, char *err, size_t errlen) {
+    if (p->io)
+        return p->io->convert(png, (lbi_format)fmt, p->out_alpha, meta, nmeta, data, size, err,
+                              errlen);
+    return bt_png_direct(png, meta, nmeta, data, size, err, errlen);
 }
