@@ -20,8 +20,15 @@
 #                    compiler: the portable libblend.so is loaded there
 #                    (tests/portability). About 1 min the first time.
 #                    Folder: $LIBBLEND_BULLSEYE_ROOT or
-#                    /var/cache/libblend/bullseye-base.
-# Neither root has libjansson4; bullseye-base has no libcjson1 either (in
+#                    /var/cache/libblend/bullseye-base. The test command's
+#                    Release build links blendtool against its C library
+#                    (tools/CMakeLists.txt, LIBBLEND_TOOLS_SYSROOT).
+#   bullseye-povray  Debian 11 with only the base system and POV-Ray: a bare
+#                    farm node, where the Linux SDK's blendtool validates,
+#                    meshes and renders (tests/packaging). About 1.5 min the
+#                    first time. Folder: $LIBBLEND_BULLSEYE_POVRAY_ROOT or
+#                    /var/cache/libblend/bullseye-povray.
+# No root has libjansson4; the bullseye ones have no libcjson1 either (in
 # trixie-blender4 Blender's FFmpeg needs it through librist4), so nothing in
 # them can supply a JSON library that libblend.so forgot to carry.
 #
@@ -46,8 +53,14 @@ bullseye-base)
   PACKAGES=(python3 gcc libc6-dev)
   ABSENT=(libjansson4 libcjson1)
   ;;
+bullseye-povray)
+  ROOT=${LIBBLEND_BULLSEYE_POVRAY_ROOT:-/var/cache/libblend/bullseye-povray}
+  SUITE=bullseye
+  PACKAGES=(povray)
+  ABSENT=(libjansson4 libcjson1 libopenimageio2.2)
+  ;;
 *)
-  echo "usage: debian-root.sh trixie-blender4|bullseye-base ensure | path | run DIR... -- CMD..." >&2
+  echo "usage: debian-root.sh trixie-blender4|bullseye-base|bullseye-povray ensure | path | run DIR... -- CMD..." >&2
   exit 2
   ;;
 esac
@@ -63,6 +76,9 @@ root_check() {
     ;;
   bullseye-base)
     run_in "$1" -- ldd --version 2>/dev/null | awk 'NR == 1 {print "glibc " $NF}'
+    ;;
+  bullseye-povray)
+    run_in "$1" -- povray --version 2>&1 | awk '/^POV-Ray/ {print "POV-Ray " $2; exit}'
     ;;
   esac
 }

@@ -49,7 +49,10 @@ else
   [ $# -eq 0 ] || die "usage: package.sh [--builds LINUX_BUILD WINDOWS_BUILD]"
   lin=$SRC/build-package-linux
   win=$SRC/build-package-windows
-  cmake -S . -B "$lin" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIBBLEND_TESTS=OFF -DLIBBLEND_BENCH=OFF
+  # blendtool is linked against Debian 11's C library (runs on glibc 2.28+)
+  bash scripts/debian-root.sh bullseye-base ensure >/dev/null
+  cmake -S . -B "$lin" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIBBLEND_TESTS=OFF -DLIBBLEND_BENCH=OFF \
+    -DLIBBLEND_TOOLS_SYSROOT="$(bash scripts/debian-root.sh bullseye-base path)"
   cmake --build "$lin"
   cmake -S . -B "$win" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIBBLEND_TESTS=OFF \
     -DLIBBLEND_BENCH=OFF -DCMAKE_TOOLCHAIN_FILE=cmake/mingw-w64-x86_64.cmake
@@ -62,6 +65,8 @@ legacy=$lin/blender_addon/libblend_blender-$VERSION.zip
 for f in "$so" "$dll" "$addon/__init__.py" "$legacy"; do
   [ -e "$f" ] || die "$f is missing: build both systems first (Release)"
 done
+grep -q '^LIBBLEND_TOOLS_SYSROOT:PATH=.' "$lin/CMakeCache.txt" ||
+  die "$lin links blendtool against this machine's C library (no LIBBLEND_TOOLS_SYSROOT): the SDK's blendtool would not run on an older Linux"
 grep -q 'LIBBLEND_BUNDLED_JSON:BOOL=ON' "$lin/CMakeCache.txt" ||
   die "$lin links the shared JSON libraries (LIBBLEND_BUNDLED_JSON=OFF): its libblend.so is not portable"
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole test suite: install what is missing (and the Debian 13 root with
-# Blender 4.3 and the Debian 11 root, scripts/debian-root.sh), then a Release build and a
+# Blender 4.3 and the two Debian 11 roots, scripts/debian-root.sh), then a Release build and a
 # sanitizer (ASan + UBSan) build, each run by ctest (the sanitizer build also
 # runs random valid scenes through every command for 60 s); the Windows
 # build (mingw-w64) with its C test programs under Wine; the five packages
@@ -12,8 +12,11 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/debian-root.sh trixie-blender4 ensure   # Blender 4.3 for test_blender4 (cached)
 bash scripts/debian-root.sh bullseye-base ensure     # glibc 2.31 for test_portable_so (cached)
+bash scripts/debian-root.sh bullseye-povray ensure   # a bare farm node for the SDK (cached)
 JOBS=$(nproc)
-for cfg in "build-release:-DCMAKE_BUILD_TYPE=Release" \
+# the Release build's blendtool is the SDK's: linked against Debian 11's C library
+OLD_GLIBC=$(bash scripts/debian-root.sh bullseye-base path)
+for cfg in "build-release:-DCMAKE_BUILD_TYPE=Release -DLIBBLEND_TOOLS_SYSROOT=$OLD_GLIBC" \
            "build-asan:-DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_SANITIZE=ON"; do
   dir=${cfg%%:*}
   flags=${cfg#*:}

@@ -12,7 +12,10 @@
 #  - the Linux SDK tarball: unpacked into a folder whose name has a space,
 #    a program built against it with CMake's find_package runs (shared and
 #    static), and its blendtool
-#    validates, meshes and renders the default scene;
+#    validates, meshes and renders the default scene; the same tarball
+#    unpacked on a bare Debian 11 node (base system and POV-Ray only)
+#    validates, meshes (the same bytes) and renders (POV-Ray's own PNG with
+#    the libblend metadata, the same pixels);
 #  - the Windows SDK zip: unpacked, a program cross-compiled against its
 #    headers and import library runs under Wine with the DLL beside it.
 #   test_packages.sh DIST SRC
@@ -89,6 +92,57 @@ env -u LIBBLEND_POVRAY_INCLUDE -u LIBBLEND_IMAGEIO "$bt" render "$src/scenes/def
   { cat "$tmp/render.log" >&2; fail "blendtool render from the SDK failed"; }
 [ -s "$tmp/default.ply" ] && [ -s "$tmp/default.png" ] || fail "the SDK's blendtool wrote no mesh or image"
 echo "linux sdk: consumer, blendtool validate/mesh/render from '$l'"
+
+# The SDK's blendtool on a bare farm node: Debian 11 (glibc 2.31) with only
+# the base system and POV-Ray (scripts/debian-root.sh bullseye-povray), no
+# OpenImageIO, no libxxhash, no JSON library. First what it links: nothing
+# beyond the C runtime, zlib and libblend.so, no symbol newer than glibc 2.28.
+needed=$(objdump -p "$bt" | awk '/NEEDED/ {print $2}' | sort | tr '\n' ' ')
+[ "$needed" = "libblend.so.0 libc.so.6 libdl.so.2 libm.so.6 libz.so.1 " ] ||
+  fail "the SDK's blendtool needs: $needed"
+newest=$(objdump -T "$bt" | grep -o 'GLIBC_2\.[0-9.]*' | sort -V | tail -1)
+[ "$(printf '%s\nGLIBC_2.28\n' "$newest" | sort -V | tail -1)" = GLIBC_2.28 ] ||
+  fail "the SDK's blendtool needs $newest (allowed: GLIBC_2.28 or older)"
+node=$(bash "$src/scripts/debian-root.sh" bullseye-povray path)
+mkdir -p "$tmp/farm node"
+tar -C "$tmp/farm node" -xzf "$lsdk"
+cp "$src/scenes/default.json" "$tmp/farm node/"
+nb="$tmp/farm node/libblend-sdk-$version-linux-x64/bin/blendtool"
+on_node() {
+  bash "$src/scripts/debian-root.sh" bullseye-povray run "$tmp" -- env -C "$tmp/farm node" "$@"
+}
+on_node "$nb" validate default.json >"$tmp/node-validate.log" 2>&1 ||
+  { cat "$tmp/node-validate.log" >&2; fail "blendtool validate on the Debian 11 node failed"; }
+on_node "$nb" mesh default.json -o node.ply --resolution 32 >/dev/null 2>"$tmp/node-mesh.log" ||
+  { cat "$tmp/node-mesh.log" >&2; fail "blendtool mesh on the Debian 11 node failed"; }
+# the same mesh, byte for byte, as the same blendtool makes on this machine
+env -u LIBBLEND_POVRAY_INCLUDE -u LIBBLEND_IMAGEIO "$bt" mesh "$src/scenes/default.json" \
+  -o "$tmp/here.ply" --resolution 32 >/dev/null
+cmp "$tmp/farm node/node.ply" "$tmp/here.ply" || fail "the node's mesh differs from this machine's"
+# one render thread: POV-Ray's threads share out the area light's jitter
+# differently from run to run
+on_node "$nb" render default.json -o node.png --width 80 --height 60 --threads 1 \
+  >/dev/null 2>"$tmp/node-render.log" ||
+  { cat "$tmp/node-render.log" >&2; fail "blendtool render on the Debian 11 node failed"; }
+grep -q "note: cannot load the image module" "$tmp/node-render.log" ||
+  fail "the node's render does not say that it wrote POV-Ray's own PNG"
+on_node "$nb" render default.json -o node.exr --width 8 --height 6 >/dev/null \
+  2>"$tmp/node-exr.log" && fail "an EXR render without OpenImageIO succeeded"
+grep -q "OpenEXR needs the image module" "$tmp/node-exr.log" || fail "no clear message for EXR on the node"
+[ ! -e "$tmp/farm node/node.exr" ] || fail "the refused EXR render left a file"
+# what the node wrote, read here by OpenImageIO: the libblend metadata, no
+# time stamp, and the pixels of this machine's render (through the image
+# module) within a small threshold (Debian 11 has POV-Ray 3.7.0.8, here 3.7.0.10)
+env -u LIBBLEND_POVRAY_INCLUDE -u LIBBLEND_IMAGEIO "$bt" render "$src/scenes/default.json" \
+  -o "$tmp/here.png" --width 80 --height 60 --threads 1 2>/dev/null
+info=$(oiiotool --info -v "$tmp/farm node/node.png")
+for k in scene_hash version render parameters; do
+  grep -q "libblend:$k" <<<"$info" || fail "the node's PNG lacks libblend:$k"
+done
+grep -qi "DateTime\|Render Date\|Software" <<<"$info" && fail "the node's PNG keeps POV-Ray's time stamp"
+"$bt" compare "$tmp/here.png" "$tmp/farm node/node.png" --fail 0.02 --fail-percent 0.5 ||
+  fail "the node's image differs from this machine's"
+echo "linux sdk on a bare Debian 11 node (glibc 2.31, POV-Ray, no OpenImageIO): validate, the same mesh, render ($newest)"
 
 # the legacy zip in Blender 3.4, as a user installs it
 env BLENDER_USER_SCRIPTS="$tmp/b3-user" PYTHONDONTWRITEBYTECODE=1 blender -b --factory-startup \
