@@ -16,7 +16,8 @@ PACKAGES=(
   openimageio-tools          # tests: idiff compares POV-Ray renders with libblend silhouettes
   blender                    # tests: the add-on in headless Blender (blender_addon_c/)
   libopenimageio-dev         # blendtool's image writer (tools/imageio, C++): PNG, EXR, contact sheets
-  libxxhash-dev              # content hashes of batch tasks (resume manifests)
+  libxxhash-dev              # content hashes of batch tasks (resume manifests), compiled in from the header
+  zlib1g-dev                 # blendtool: the CRCs of PNG chunks when POV-Ray writes the final PNG
   fonts-dejavu-core          # the contact sheets' labels
   slurm-wlm munge            # tests: batch jobs on a single-node Slurm cluster (scripts/slurm-cluster.sh)
   parallel                   # tests: batch task lists through GNU parallel
