@@ -29,6 +29,7 @@
  * with q = v1 / C, p = v2 / C, and U = (1 - v^n) UC + v^n UB. Outside every
  * volume U = UC exactly. */
 #include "tape.h"
+#include "../common/kuhn.h"
 
 #include <float.h>
 #include <stdio.h>
@@ -361,10 +362,6 @@ static void node_pos(const grid *G, uint64_t id, double p[3]) {
     p[2] = G->origin[2] + G->h * (double)(id / nx / ny);
 }
 
-/* the six tetrahedra of a cell: corner bit paths 0 -> e_a -> e_a + e_b -> 7 */
-static const int KUHN[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
-                               {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-
 typedef struct builder {
     const grid *G;
     hmap nodes;   /* node id -> index into nv (values) */
@@ -426,8 +423,9 @@ static int tet_segments(builder *B, const uint64_t corner[8]) {
         uint32_t ends[4];
         int ne = 0;
         for (int f = 0; f < 4; ++f) {
-            const uint64_t v[3] = {corner[KUHN[t][FACES[f][0]]], corner[KUHN[t][FACES[f][1]]],
-                                   corner[KUHN[t][FACES[f][2]]]};
+            const uint64_t v[3] = {corner[LB__KUHN[t][FACES[f][0]]],
+                                   corner[LB__KUHN[t][FACES[f][1]]],
+                                   corner[LB__KUHN[t][FACES[f][2]]]};
             uint32_t idx;
             const int r = face_point(B, v, &idx);
             if (r < 0) return -1;

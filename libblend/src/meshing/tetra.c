@@ -18,9 +18,7 @@
  * ones. Moving a vertex along its edge never flips a one-apart triangle
  * (its volume with the apart corner scales by the three edge fractions). */
 #include "mesh_internal.h"
-
-static const uint8_t KUHN[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7},
-                                   {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+#include "../common/kuhn.h"
 
 /* Doubled lattice midpoint of corners p, q. */
 static void mid2(int p, int q, int m[3]) {
@@ -53,7 +51,7 @@ static int reverse(const int ep[], const int eq[], const uint8_t *tv, const int 
 
 int lb__tetra_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double *c, int cfg) {
     for (int t = 0; t < 6; ++t) {
-        const uint8_t *tv = KUHN[t];
+        const uint8_t *tv = LB__KUHN[t];
         int in[4], nin = 0;
         for (int q = 0; q < 4; ++q) nin += in[q] = (cfg >> tv[q]) & 1;
         if (nin == 0 || nin == 4) continue;
