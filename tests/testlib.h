@@ -19,18 +19,15 @@
 
 #include <libblend/libblend.h>
 
-typedef struct {
-    uint64_t s;
-} rng_t;
+#include "../libblend/src/common/splitmix.h"
+
+typedef lb__splitmix rng_t;
 
 static inline uint64_t rng_u64(rng_t *r) {
-    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
+    return lb__splitmix_next(r);
 }
 static inline double rng_unit(rng_t *r) {
-    return (double)(rng_u64(r) >> 11) * 0x1.0p-53;
+    return lb__splitmix_unit(r);
 }
 static inline double rng_range(rng_t *r, double a, double b) {
     return a + (b - a) * rng_unit(r);

@@ -9,20 +9,17 @@
 #define _POSIX_C_SOURCE 200809L
 #include <libblend/libblend.h>
 
+#include "../../libblend/src/common/splitmix.h"
+
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct {
-    uint64_t s;
-} rng;
+typedef lb__splitmix rng;
 static double unit(rng *r) {
-    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+    return lb__splitmix_unit(r);
 }
 static double range(rng *r, double a, double b) {
     return a + (b - a) * unit(r);

@@ -14,6 +14,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include <libblend/libblend.h>
 
+#include "../../libblend/src/common/splitmix.h"
+
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -30,14 +32,9 @@
 
 /* ---- the documented ranges, checked against the C library ---- */
 
-typedef struct rng {
-    uint64_t s;
-} rng;
+typedef lb__splitmix rng;
 static double unit(rng *r) {
-    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+    return lb__splitmix_unit(r);
 }
 static double logu(rng *r, double a, double b) {
     return exp(log(a) + (log(b) - log(a)) * unit(r));
