@@ -898,6 +898,23 @@ static lb_status check_bound_contains(pctx *c, const lb__node *n, size_t i) {
     return LB_OK;
 }
 
+/* the conic's shape "p" of n (default 0, the quarter ellipse): below r1 r2,
+ * n->r already read (conic and soft_conic) */
+static lb_status get_conic_shape(pctx *c, const cJSON *j, lb__node *n) {
+    char ok[96];
+    snprintf(ok, sizeof ok, "a number below r1 r2 = %.17g (0 = quarter ellipse)",
+             n->r[0] * n->r[1]);
+    n->shape = 0.0;
+    lb_status s = get_number(c, j, "p", 0, -1e18, 1e18, ok, &n->shape);
+    if (!s && !(n->shape < n->r[0] * n->r[1])) {
+        const size_t old = push_key(c, "p");
+        s = perr(c, LB_ERR_INVALID_ARGUMENT, "p = %.17g is not below r1 r2; allowed: %s", n->shape,
+                 ok);
+        pop(c, old);
+    }
+    return s;
+}
+
 static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **out) {
     lb_status s;
     if (!cJSON_IsObject(j))
@@ -969,19 +986,7 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
         if ((s = get_param(c, j, "r", k, 1, 0, 0, 1e-9, 1e9, r_ok, &n->r)) ||
             (s = get_param(c, j, "m", k, 0, 1, 1.0, 1e-6, 1e6, m_ok, &n->m)))
             return s;
-        n->shape = 0.0;
-        char ok[96];
-        snprintf(ok, sizeof ok, "a number below r1 r2 = %.17g (0 = quarter ellipse)",
-                 n->r[0] * n->r[1]);
-        if ((s = get_number(c, j, "p", 0, -1e18, 1e18, ok, &n->shape))) return s;
-        if (!(n->shape < n->r[0] * n->r[1])) {
-            const size_t old = push_key(c, "p");
-            s = perr(c, LB_ERR_INVALID_ARGUMENT, "p = %.17g is not below r1 r2; allowed: %s",
-                     n->shape, ok);
-            pop(c, old);
-            return s;
-        }
-        if ((s = parse_bulge(c, j, n))) return s;
+        if ((s = get_conic_shape(c, j, n)) || (s = parse_bulge(c, j, n))) return s;
         break;
     }
     case LB__F_SCALE: {
@@ -1033,18 +1038,8 @@ static lb_status parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **ou
         if (t->family == LB__F_SOFT_HYPER) {
             if ((s = get_param(c, j, "p", k, 0, 1, 2.0, 1.0 + 1e-12, 1000.0, p_ok, &n->p)))
                 return s;
-        } else {
-            char ok[96];
-            snprintf(ok, sizeof ok, "a number below r1 r2 = %.17g (0 = quarter ellipse)",
-                     n->r[0] * n->r[1]);
-            if ((s = get_number(c, j, "p", 0, -1e18, 1e18, ok, &n->shape))) return s;
-            if (!(n->shape < n->r[0] * n->r[1])) {
-                const size_t old = push_key(c, "p");
-                s = perr(c, LB_ERR_INVALID_ARGUMENT, "p = %.17g is not below r1 r2; allowed: %s",
-                         n->shape, ok);
-                pop(c, old);
-                return s;
-            }
+        } else if ((s = get_conic_shape(c, j, n))) {
+            return s;
         }
         break;
     }
