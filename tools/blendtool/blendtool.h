@@ -129,6 +129,9 @@ int bt_write_file(const char *cmd, const char *path, const char *data, size_t le
  * is printed with the scene's path in front unless it already starts with
  * it; LB_ERR_INVALID_ARGUMENT and LB_ERR_NOT_FINITE give 2, the rest 1. */
 int bt_fail(const char *cmd, const char *scene_path, lb_status s, const lb_error *e);
+/* Compile a loaded scene into *ev: an exit code, after the message naming
+ * scene_path when the scene cannot be compiled (*ev is then NULL). */
+int bt_compile(const char *cmd, const char *scene_path, const lb_scene *sc, lb_evaluator **ev);
 
 /* signals.c: SIGINT / SIGTERM / SIGHUP end the command with 128 + N, after
  * ending the child, removing the registered temporary files and folder. */

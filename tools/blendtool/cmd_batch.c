@@ -1057,8 +1057,9 @@ static int run_task(const job *J, const task *T, const char *ident, const uint64
                     lb_scene *sc, logger *L, int threads) {
     lb_error e = {LB_OK, ""};
     lb_evaluator *ev = NULL;
-    lb_status s = lb_evaluator_create(sc, &ev, &e);
-    if (s) return bt_fail(CMD, J->scenes[T->scene], s, &e);
+    lb_status s = LB_OK;
+    const int crc = bt_compile(CMD, J->scenes[T->scene], sc, &ev);
+    if (crc) return crc;
     char names[3][600], hexes[3][33];
     const size_t n = outputs_of(J, T, names);
     cJSON *manifest = cJSON_CreateObject();

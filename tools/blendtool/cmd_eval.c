@@ -168,13 +168,9 @@ static int run_eval(int argc, char **argv) {
     double *val = NULL, *gx = NULL, *gy = NULL, *gz = NULL;
     char *out = NULL;
     int rc = bt_load_scene(cmd, scene_path, &sc);
-    if (rc) goto done;
+    if (rc || (rc = bt_compile(cmd, scene_path, sc, &ev))) goto done;
     lb_error e = {LB_OK, ""};
-    lb_status s = lb_evaluator_create(sc, &ev, &e);
-    if (s) {
-        rc = bt_fail(cmd, scene_path, s, &e);
-        goto done;
-    }
+    lb_status s = LB_OK;
     if (points_path) {
         FILE *f = fopen(points_path, "rb");
         if (!f) {

@@ -156,11 +156,8 @@ static int run(int argc, char **argv) {
     lb_evaluator *ev = NULL;
     lb_mesh *mesh = NULL;
     bt_out w = {0};
-    lb_status s = lb_evaluator_create(scene, &ev, &e);
-    if (s) {
-        rc = bt_fail(CMD, scene_path, s, &e);
-        goto done;
-    }
+    lb_status s = LB_OK;
+    if ((rc = bt_compile(CMD, scene_path, scene, &ev))) goto done;
     /* the output path is checked before the work: a folder or a missing
      * folder is reported at once, not after minutes of meshing */
     if ((rc = bt_output_open(CMD, out, &w))) goto done;

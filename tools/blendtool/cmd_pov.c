@@ -96,14 +96,15 @@ static int export(const char *cmd, const povargs *a, FILE *f, const char *out_na
     lb_scene *sc = NULL;
     int rc = bt_load_scene_set(cmd, a->scene, a->sets, a->nsets, &sc, hash);
     if (rc) return rc;
-    lb_error e = {LB_OK, ""};
     lb_evaluator *ev = NULL;
-    lb_status s = lb_evaluator_create(sc, &ev, &e);
-    if (!s) {
-        lb_pov_options o = {a->include_only, a->silhouette, (double)a->width / (double)a->height,
-                            0.0, a->threads};
-        s = lb_scene_write_pov_stream(sc, ev, &o, f, NULL, &e);
+    if ((rc = bt_compile(cmd, a->scene, sc, &ev))) {
+        lb_scene_free(sc);
+        return rc;
     }
+    lb_error e = {LB_OK, ""};
+    const lb_pov_options o = {a->include_only, a->silhouette, (double)a->width / (double)a->height,
+                              0.0, a->threads};
+    const lb_status s = lb_scene_write_pov_stream(sc, ev, &o, f, NULL, &e);
     if (s == LB_ERR_IO) {
         bt_error(cmd, "%s: writing the POV-Ray scene failed (%s); nothing was written", out_name,
                  strerror(errno));

@@ -8,16 +8,11 @@
 /* Parse, validate and compile: what every later command needs to succeed. */
 static int load_and_compile(const char *cmd, const char *path, lb_scene **sc, lb_evaluator **ev) {
     int rc = bt_load_scene(cmd, path, sc);
-    if (rc) return rc;
-    lb_error e = {LB_OK, ""};
-    lb_status s = lb_evaluator_create(*sc, ev, &e);
-    if (s) {
-        bt_error(cmd, "%s: %s", path, e.message);
+    if (!rc && (rc = bt_compile(cmd, path, *sc, ev))) {
         lb_scene_free(*sc);
         *sc = NULL;
-        return bt_exit_for(s);
     }
-    return 0;
+    return rc;
 }
 
 static int unknown_option(const char *cmd, const char *a) {

@@ -209,6 +209,12 @@ int bt_fail(const char *cmd, const char *scene_path, lb_status s, const lb_error
     return bt_exit_for(s);
 }
 
+int bt_compile(const char *cmd, const char *scene_path, const lb_scene *sc, lb_evaluator **ev) {
+    lb_error e = {LB_OK, ""};
+    const lb_status s = lb_evaluator_create(sc, ev, &e);
+    return s ? bt_fail(cmd, scene_path, s, &e) : BT_EXIT_OK;
+}
+
 int bt_wants_help(int argc, char **argv) {
     for (int i = 1; i < argc; ++i)
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) return 1;
