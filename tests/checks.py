@@ -1,6 +1,8 @@
 """The little harness the Python tests outside Blender share: the command
-line (BLENDTOOL SOURCE_DIR WORK_DIR), check() that records a failure and
-goes on, and finish() that prints the summary and sets the exit status."""
+line (BLENDTOOL SOURCE_DIR WORK_DIR), fail() and check() that record a
+failure and go on (the list is `failures`), and finish() that prints the
+summary and sets the exit status. A test in a folder below tests/ puts
+tests/ on sys.path first."""
 import os
 import sys
 
@@ -14,10 +16,16 @@ def args():
     return blendtool, src, work
 
 
+def fail(what):
+    failures.append(what)
+    print("FAIL: " + what)
+
+
 def check(cond, what):
+    """records what as a failure unless cond; returns cond"""
     if not cond:
-        failures.append(what)
-        print("FAIL: " + what)
+        fail(what)
+    return cond
 
 
 def finish(name, ok_message):

@@ -8,7 +8,8 @@ import shutil
 import subprocess
 import sys
 
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import check, fail, failures  # noqa: E402,F401
 BT = None
 
 
@@ -21,17 +22,6 @@ def setup(clean=True):
         shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work, exist_ok=True)
     return BT, src, work
-
-
-def fail(msg):
-    failures.append(msg)
-    print("FAIL:", msg)
-
-
-def check(cond, msg):
-    if not cond:
-        fail(msg)
-    return cond
 
 
 def bt(*args, cwd=None, timeout=600):

@@ -20,13 +20,9 @@ os.makedirs(WORK)
 S1 = os.path.join(SRC, "scenes", "bench-s1-three-spheres.json")
 S2 = os.path.join(SRC, "scenes", "bench-s2-64-spheres.json")
 ENV = dict(os.environ, LIBBLEND_POVRAY_INCLUDE=os.path.join(SRC, "povray_include"))
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import fail, failures  # noqa: E402
 rows = 0
-
-
-def fail(msg):
-    failures.append(msg)
-    print("FAIL:", msg)
 
 
 def bt(*args, stdin=None, stdout=subprocess.PIPE):

@@ -26,12 +26,8 @@ shutil.copy2(BT, BARE)  # libblend.so through its absolute build-tree RUNPATH
 SCENE = os.path.join(SRC, "scenes", "default.json")
 ENV = dict(os.environ, LIBBLEND_POVRAY_INCLUDE=os.path.join(SRC, "povray_include"))
 ENV.pop("LIBBLEND_IMAGEIO", None)
-failures = []
-
-
-def fail(msg):
-    failures.append(msg)
-    print("FAIL:", msg)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import fail, failures  # noqa: E402
 
 
 def run(exe, *args):

@@ -24,13 +24,9 @@ BLENDTOOL, SRC, WORK = sys.argv[1:4]
 S1 = os.path.join(SRC, "scenes", "bench-s1-three-spheres.json")
 S2 = os.path.join(SRC, "scenes", "bench-s2-64-spheres.json")
 rng = random.Random(20261201)
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import fail, failures  # noqa: E402
 checked = 0
-
-
-def fail(msg):
-    failures.append(msg)
-    print("FAIL:", msg)
 
 
 def povray_pids(tmp):

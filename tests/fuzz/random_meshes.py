@@ -30,12 +30,8 @@ import meshcheck  # noqa: E402
 import random_scenes  # noqa: E402
 
 lib = binding.load()  # the add-on's own copy of the library (lib/)
-failures = []
-
-
-def fail(msg):
-    failures.append(msg)
-    print("FAIL:", msg)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import fail, failures  # noqa: E402
 
 
 def closed(text, name, runs):

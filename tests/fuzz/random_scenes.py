@@ -28,12 +28,8 @@ if __name__ == "__main__":
     import meshcheck  # noqa: E402
 
 PER_COMMAND_TIMEOUT = 60  # seconds; sanitizer builds are ~3x slower
-failures = []
-
-
-def fail(msg):
-    failures.append(msg)
-    print("FAIL:", msg)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import fail, failures  # noqa: E402
 
 
 def vec(r, lo=-1.0, hi=1.0):

@@ -18,16 +18,12 @@ import meshcheck  # noqa: E402
 blendtool, src, work = sys.argv[1:4]
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
-failures = []
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import fail, failures  # noqa: E402
 
 
 def run(*args):
     return subprocess.run([blendtool, "mesh", *args], capture_output=True, text=True)
-
-
-def fail(msg):
-    failures.append(msg)
-    print("FAIL:", msg)
 
 
 # every scene, two resolutions, through the PLY reader
