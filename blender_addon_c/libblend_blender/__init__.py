@@ -23,7 +23,7 @@ if "bpy" in locals():  # F8 / script reload
 
 import bpy  # noqa: E402
 
-from . import bake, binding, compat, live, ops, props, render_section, tree, ui  # noqa: E402,F401
+from . import bake, binding, compat, libhandle, live, ops, props, render_section, tree, ui  # noqa: E402,F401
 
 
 def register():

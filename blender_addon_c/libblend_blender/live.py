@@ -27,7 +27,7 @@ import time
 
 import bpy
 
-from . import bake, binding, compat, tree
+from . import bake, binding, compat, libhandle, tree
 
 TICK = 0.005          # longest timer period while work is pending
 MIN_TICK = 0.0005     # shortest: while a run is expected to end any moment
@@ -37,8 +37,6 @@ CANCEL_AFTER = 0.2    # a run this old is cancelled when newer edits wait
 NORMALS_IDLE = 0.3    # seconds without edits before analytic normals are set
 AUTO_ANALYTIC = 250000  # "Auto" normals: analytic below this many triangles
 
-_lib = None
-_lib_error = None
 _states = {}   # output name -> _State
 _timer_on = False
 
@@ -97,49 +95,6 @@ class _Job:
             self.error = "internal error: %r" % (e,)
         self.seconds = time.perf_counter() - t0
         self.done.set()
-
-
-# --------------------------------------------------------------------------- library
-
-def prefs():
-    addon = bpy.context.preferences.addons.get(__package__)
-    return addon.preferences if addon else None
-
-
-def library():
-    """The loaded library; raises binding.LibraryError with the reason (kept
-    until reload_library() so every panel and operator can show it)."""
-    global _lib, _lib_error
-    if _lib is None and _lib_error is None:
-        p = prefs()
-        path = (p.library_path if p and p.library_path else None)
-        try:
-            _lib = binding.load(bpy.path.abspath(path) if path else None)
-        except binding.LibraryError as e:
-            _lib_error = e
-    if _lib is None:
-        raise _lib_error
-    return _lib
-
-
-def library_status():
-    """(ok, text) for the UI."""
-    try:
-        lib = library()
-        return True, "libblend %d.%d.%d (%s)" % (lib.version + (os.path.basename(lib.path),))
-    except binding.LibraryError as e:
-        return False, str(e)
-
-
-def reload_library():
-    global _lib, _lib_error
-    _lib, _lib_error = None, None
-    return library_status()
-
-
-def threads():
-    p = prefs()
-    return p.threads if p else 0
 
 
 # --------------------------------------------------------------------------- mesh data
@@ -242,11 +197,11 @@ def prepare(output, resolution, depsgraph=None):
     """Read the tree (main thread) into a _Job; raises tree.TreeError or
     binding.LibraryError. With a depsgraph the values are that depsgraph's
     (a render's frame), else the objects' own."""
-    lib = library()
+    lib = libhandle.library()
     text, paths = tree.to_json(output, depsgraph, render=False, compact=True)
     bmin, bmax = _region(output)
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
-                output.libblend.open_boundary, threads(), paths)
+                output.libblend.open_boundary, libhandle.threads(), paths)
 
 
 def _finish(output, st, job, t_start, defer_normals=False):

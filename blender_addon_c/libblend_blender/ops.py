@@ -9,7 +9,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatVectorProperty, IntProper
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 from mathutils import Matrix
 
-from . import atomic, bake, binding, compat, live, props, render_section, tree
+from . import atomic, bake, binding, compat, libhandle, live, props, render_section, tree
 
 
 def _active(context):
@@ -305,7 +305,7 @@ class LIBBLEND_OT_reload_library(bpy.types.Operator):
     bl_label = "Reload libblend Library"
 
     def execute(self, context):
-        ok, msg = live.reload_library()
+        ok, msg = libhandle.reload_library()
         self.report({"INFO"} if ok else {"ERROR"}, msg)
         return {"FINISHED"} if ok else {"CANCELLED"}
 
@@ -335,7 +335,7 @@ class LIBBLEND_OT_import_scene(bpy.types.Operator, ImportHelper):
 
     def execute(self, context):
         try:
-            lib = live.library()
+            lib = libhandle.library()
             # libblend validates first: the same messages as blendtool (file:line:col, JSON path)
             lib.load_scene(self.filepath).close()
             with open(self.filepath, encoding="utf-8") as f:
@@ -366,7 +366,7 @@ class LIBBLEND_OT_export_scene(bpy.types.Operator, ExportHelper):
             return {"CANCELLED"}
         try:
             text, paths = tree.to_json(out)
-            live.library().parse_scene(text, os.path.basename(self.filepath)).close()
+            libhandle.library().parse_scene(text, os.path.basename(self.filepath)).close()
             _atomic_write(self.filepath, text + "\n")
         except (tree.TreeError, binding.LibblendError) as e:
             return _refused(self, e, paths)
@@ -511,10 +511,10 @@ class LIBBLEND_OT_export_pov(bpy.types.Operator, ExportHelper):
         paths = {}
         try:
             text, paths = tree.to_json(out)
-            lib = live.library()
+            lib = libhandle.library()
             with lib.parse_scene(text, out.name) as scene, scene.compile() as ev:
                 g = scene.write_pov(ev, self.filepath, include_only=self.include_only,
-                                    threads=live.threads())
+                                    threads=libhandle.threads())
             inc = include_file()
             dst = os.path.join(os.path.dirname(os.path.abspath(self.filepath)), "libblend.inc")
             if inc and os.path.abspath(inc) != dst:  # render with: povray +I<file> (no +L needed)

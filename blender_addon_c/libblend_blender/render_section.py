@@ -30,7 +30,7 @@ import math
 import bpy
 from mathutils import Matrix, Vector
 
-from . import compat, tree
+from . import compat, libhandle, tree
 
 SUN_STRENGTH = 3.0  # W/m^2 of a sun lamp for a POV-Ray light of colour 1
 
@@ -139,9 +139,8 @@ def _three_point(output, cam, collection):
     lb_render_three_point, the POV-Ray writer's too), as suns aimed at the
     camera's target; the key's 5 degree disc gives soft shadows. They are
     not the section's lights: export leaves "lights" out, as read."""
-    from . import live
     at = cam.get("look_at", [0, 0, 0])
-    lights = live.library().three_point(cam["location"], at, cam.get("up", [0, 0, 1]))
+    lights = libhandle.library().three_point(cam["location"], at, cam.get("up", [0, 0, 1]))
     for i, (location, strength, shadows) in enumerate(lights):
         data = bpy.data.lights.new("%s %s light" % (output.name, ("key", "fill", "rim")[i]), "SUN")
         data.energy = SUN_STRENGTH * strength
@@ -157,7 +156,6 @@ def floor_height(output, up):
     """The floor's height along up (world): libblend's lb_render_floor_height
     (as the POV-Ray writer) over the field's region, with up taken into the
     field's frame, or the region's lowest corner when the tree is broken."""
-    from . import live
     s = output.libblend
     M = output.matrix_world
     corners = [Vector((x, y, z)) for x in (s.bounds_min[0], s.bounds_max[0])
@@ -167,8 +165,8 @@ def floor_height(output, up):
     local_up = M.to_3x3().transposed() @ Vector(up)
     try:
         text, _ = tree.to_json(output, render=False)
-        with live.library().parse_scene(text, output.name + ".json") as sc, sc.compile() as ev:
-            return ev.floor_height(s.bounds_min, s.bounds_max, local_up, live.threads()) + \
+        with libhandle.library().parse_scene(text, output.name + ".json") as sc, sc.compile() as ev:
+            return ev.floor_height(s.bounds_min, s.bounds_max, local_up, libhandle.threads()) + \
                 M.translation.dot(Vector(up))
     except Exception:  # no library or a tree error: the region's corner, as documented
         return h

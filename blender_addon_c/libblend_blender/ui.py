@@ -2,7 +2,7 @@
 import bpy
 from bpy.props import IntProperty, StringProperty
 
-from . import live, tree
+from . import libhandle, live, tree
 
 
 class LIBBLEND_AP_preferences(bpy.types.AddonPreferences):
@@ -22,7 +22,7 @@ class LIBBLEND_AP_preferences(bpy.types.AddonPreferences):
 
 
 def _library_box(layout):
-    ok, msg = live.library_status()
+    ok, msg = libhandle.library_status()
     if ok:
         layout.label(text=msg, icon="CHECKMARK")
         return True

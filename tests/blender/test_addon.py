@@ -38,13 +38,13 @@ import addon_env  # noqa: E402
 
 os.environ.pop("LIBBLEND_LIBRARY", None)  # the add-on's own lib/libblend.so
 lbb, ADDON_NAME = addon_env.enable(ADDON)
-binding, compat, live, tree = lbb.binding, lbb.compat, lbb.live, lbb.tree
+binding, compat, libhandle, live, tree = lbb.binding, lbb.compat, lbb.libhandle, lbb.live, lbb.tree
 print("Blender %s, add-on %s" % (bpy.app.version_string, ADDON_NAME))
 
-ok, msg = live.library_status()
+ok, msg = libhandle.library_status()
 assert ok, msg
 print("library:", msg)
-lib = live.library()
+lib = libhandle.library()
 check, active, activate = addon_env.check, addon_env.active, addon_env.activate
 
 
@@ -319,7 +319,7 @@ check(live.update_now(out)[0], "the wheel meshes again once the bad node is gone
 
 # a broken library path: reported by the UI status and the operators, no crash
 os.environ["LIBBLEND_LIBRARY"] = os.path.join(WORK, "no-such", "libblend.so")
-ok, msg = live.reload_library()
+ok, msg = libhandle.reload_library()
 print("missing library:", msg)
 check(not ok and "not found" in msg and "no-such" in msg and "LIBBLEND_LIBRARY" in msg,
       "missing library message")
@@ -330,11 +330,11 @@ except RuntimeError as e:
     check("not found" in str(e), "update_mesh reports the missing library")
 libm = [p for p in glob.glob("/usr/lib/x86_64-linux-gnu/libm.so.6") + glob.glob("/lib/*/libm.so.6")][0]
 os.environ["LIBBLEND_LIBRARY"] = libm
-ok, msg = live.reload_library()
+ok, msg = libhandle.reload_library()
 print("wrong library:", msg)
 check(not ok and "is not libblend" in msg, "a library that is not libblend is named")
 del os.environ["LIBBLEND_LIBRARY"]
-check(live.reload_library()[0], "the library loads again")
+check(libhandle.reload_library()[0], "the library loads again")
 
 # live path: mark dirty + the timer function, as Blender's main loop would run it
 b1.libblend.r = 0.25  # the update callback marks the field dirty
@@ -459,14 +459,14 @@ for obj in (None, out2, bb, sp, bound, cap, out, cx, b1):
         draw(cls, obj)
 b2.libblend.bulge = True
 draw(lbb.ui.LIBBLEND_PT_panel, b2)
-fake = type("Prefs", (), {"layout": Recorder(), "bl_rna": live.prefs().bl_rna})()
+fake = type("Prefs", (), {"layout": Recorder(), "bl_rna": libhandle.prefs().bl_rna})()
 lbb.ui.LIBBLEND_AP_preferences.draw(fake, bpy.context)
 check({"bounds_min", "preview_resolution", "radius", "arg_r", "bulge_omega",
        "libblend.update_mesh", "libblend.export_pov"} <= set(Recorder.drawn), "the panel shows them")
 
 # without a library the panel shows the reason and the reload button, nothing else
 os.environ["LIBBLEND_LIBRARY"] = os.path.join(WORK, "gone", "libblend.so")
-live.reload_library()
+libhandle.reload_library()
 Recorder.drawn = []
 draw(lbb.ui.LIBBLEND_PT_panel, out)
 text = " ".join(d for d in Recorder.drawn if d.startswith("label:"))
@@ -474,7 +474,7 @@ check("libblend.reload_library" in Recorder.drawn and "not found" in text and "g
       "the panel explains a missing library: " + text[:200])
 check("libblend.update_mesh" not in Recorder.drawn, "no meshing buttons without a library")
 del os.environ["LIBBLEND_LIBRARY"]
-check(live.reload_library()[0], "library back")
+check(libhandle.reload_library()[0], "library back")
 
 # ---------------------------------------------------------------- Blend Selected
 def new_field(name):

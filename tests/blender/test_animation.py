@@ -49,7 +49,7 @@ import addon_env  # noqa: E402
 
 os.environ.pop("LIBBLEND_LIBRARY", None)
 lbb, ADDON_NAME = addon_env.enable(ADDON)
-live, tree, bake = lbb.live, lbb.tree, lbb.bake
+libhandle, live, tree, bake = lbb.libhandle, lbb.live, lbb.tree, lbb.bake
 print("Blender %s, add-on %s" % (bpy.app.version_string, ADDON_NAME))
 check, active, activate = addon_env.check, addon_env.active, addon_env.activate
 
@@ -339,7 +339,7 @@ check(live.state_of(out).dirty, "a frame change marks the live field dirty")
 while live.tick() is not None:
     time.sleep(0.002)
 text2, _ = tree.to_json(out, bpy.context.evaluated_depsgraph_get())
-with live.library().parse_scene(text2) as scn, scn.compile() as ev:
+with libhandle.library().parse_scene(text2) as scn, scn.compile() as ev:
     ref2 = ev.mesh(tuple(s.bounds_min), tuple(s.bounds_max), resolution=s.preview_resolution)
 check(len(out.data.vertices) == len(ref2.positions) != n_before and
       abs(json.loads(text2)["root"]["args"][0]["args"][0]["r"] - expected(3)["r"]) < 2e-6,
@@ -362,7 +362,7 @@ st = live.state_of(out)
 check(not st.error and not st.dirty, st.status)
 text, _ = tree.to_json(out)
 check(abs(json.loads(text)["root"]["args"][0]["args"][0]["m"] - 0.55) < 1e-6, "exported m follows")
-with live.library().parse_scene(text) as scn, scn.compile() as ev:
+with libhandle.library().parse_scene(text) as scn, scn.compile() as ev:
     ref = ev.mesh(tuple(s.bounds_min), tuple(s.bounds_max), resolution=s.preview_resolution)
 check(len(out.data.vertices) == len(ref.positions), "the live mesh is the driven state's")
 # an update that changes nothing is not meshed again

@@ -38,9 +38,10 @@ assert os.path.isfile(os.path.join(installed, "povray", "libblend.inc")), "libbl
 mod = addon_utils.enable(module, default_set=True)
 assert mod is not None and os.path.dirname(mod.__file__) == installed, mod
 live = importlib.import_module(module + ".live")
+libhandle = importlib.import_module(module + ".libhandle")
 
-ok, msg = live.library_status()
-assert ok and live.library().path.startswith(installed), msg
+ok, msg = libhandle.library_status()
+assert ok and libhandle.library().path.startswith(installed), msg
 assert bpy.ops.libblend.add_field() == {"FINISHED"}
 out = bpy.context.view_layer.objects.active
 assert len(out.data.polygons) > 1000, "the default sphere is meshed"
