@@ -51,100 +51,120 @@ static int parse_bounds(const char *text, double bmin[3], double bmax[3]) {
     return 0;
 }
 
-static int run(int argc, char **argv) {
-    const char *out = NULL, *scene_path = NULL, *val = NULL;
+/* blendtool mesh's command line */
+typedef struct mesh_args {
+    const char *out, *scene_path;
     lb_mesh_options o;
-    lb_mesh_options_init(&o);
-    int have_bounds = 0, quiet = 0, have_res = 0;
-    lb_mesh_format format = LB_MESH_FORMAT_AUTO;
+    int have_bounds, quiet;
+    lb_mesh_format format;
     bt_set sets[BT_MAX_SETS];
-    size_t nsets = 0;
+    size_t nsets;
+} mesh_args;
+
+static int parse_args(int argc, char **argv, mesh_args *A) {
+    const char *val = NULL;
+    memset(A, 0, sizeof *A);
+    lb_mesh_options_init(&A->o);
+    A->format = LB_MESH_FORMAT_AUTO;
+    int have_res = 0;
     for (int i = 1; i < argc; ++i) {
         int r;
         if ((r = bt_option(CMD, argc, argv, &i, "-o", &val)) ||
             (r = bt_option(CMD, argc, argv, &i, "--output", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
-            out = val;
+            A->out = val;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--resolution", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
             long n = 0;
             if (bt_parse_long(CMD, "--resolution", val, 1, LB_MESH_MAX_CELLS_PER_AXIS,
                               "cells along the longest side", &n))
                 return BT_EXIT_BAD_INPUT;
-            o.resolution = (unsigned)n;
+            A->o.resolution = (unsigned)n;
             have_res = 1;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--cell-size", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
             char *end = NULL;
-            o.cell_size = strtod(val, &end);
-            if (!end || *end || end == val || !(o.cell_size > 0.0) || !isfinite(o.cell_size)) {
+            A->o.cell_size = strtod(val, &end);
+            if (!end || *end || end == val || !(A->o.cell_size > 0.0) ||
+                !isfinite(A->o.cell_size)) {
                 bt_error(CMD, "--cell-size %s: expected a positive number", val);
                 return BT_EXIT_BAD_INPUT;
             }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--bounds", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
-            if (parse_bounds(val, o.bmin, o.bmax)) {
+            if (parse_bounds(val, A->o.bmin, A->o.bmax)) {
                 bt_error(CMD, "--bounds %s: expected six numbers \"x0,y0,z0,x1,y1,z1\"", val);
                 return BT_EXIT_BAD_INPUT;
             }
-            have_bounds = 1;
+            A->have_bounds = 1;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--threads", &val))) {
-            if (r < 0 || bt_parse_threads(CMD, val, &o.threads)) return BT_EXIT_BAD_INPUT;
+            if (r < 0 || bt_parse_threads(CMD, val, &A->o.threads)) return BT_EXIT_BAD_INPUT;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--format", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
             static const char *const names[] = {"ply", "obj", "stl", "glb"};
-            format = LB_MESH_FORMAT_AUTO;
+            A->format = LB_MESH_FORMAT_AUTO;
             for (int f = 0; f < 4; ++f)
-                if (strcmp(val, names[f]) == 0) format = (lb_mesh_format)(LB_MESH_FORMAT_PLY + f);
-            if (format == LB_MESH_FORMAT_AUTO) {
+                if (strcmp(val, names[f]) == 0)
+                    A->format = (lb_mesh_format)(LB_MESH_FORMAT_PLY + f);
+            if (A->format == LB_MESH_FORMAT_AUTO) {
                 bt_error(CMD, "--format %s; allowed: ply, obj, stl or glb", val);
                 return BT_EXIT_BAD_INPUT;
             }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--set", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
-            if (nsets == BT_MAX_SETS) {
+            if (A->nsets == BT_MAX_SETS) {
                 bt_error(CMD, "more than %d --set overrides", BT_MAX_SETS);
                 return BT_EXIT_BAD_INPUT;
             }
-            if (bt_set_parse(CMD, val, &sets[nsets++])) return BT_EXIT_BAD_INPUT;
+            if (bt_set_parse(CMD, val, &A->sets[A->nsets++])) return BT_EXIT_BAD_INPUT;
         } else if (strcmp(argv[i], "--open") == 0) {
-            o.flags |= LB_MESH_OPEN_BOUNDARY;
+            A->o.flags |= LB_MESH_OPEN_BOUNDARY;
         } else if (strcmp(argv[i], "--tetrahedra") == 0) {
-            o.flags |= LB_MESH_TETRAHEDRA;
+            A->o.flags |= LB_MESH_TETRAHEDRA;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
-            quiet = 1;
+            A->quiet = 1;
         } else if (argv[i][0] == '-' && argv[i][1]) {
             bt_error(CMD, "unknown option %s; see blendtool mesh --help", argv[i]);
             return BT_EXIT_BAD_INPUT;
-        } else if (!scene_path) {
-            scene_path = argv[i];
+        } else if (!A->scene_path) {
+            A->scene_path = argv[i];
         } else {
-            bt_error(CMD, "more than one scene (%s, %s); allowed: one", scene_path, argv[i]);
+            bt_error(CMD, "more than one scene (%s, %s); allowed: one", A->scene_path, argv[i]);
             return BT_EXIT_BAD_INPUT;
         }
     }
-    if (have_res && o.cell_size > 0.0) {
+    if (have_res && A->o.cell_size > 0.0) {
         bt_error(CMD, "--resolution and --cell-size both given; allowed: one of them (the cell "
                       "size, or the cells along the longest side)");
         return BT_EXIT_BAD_INPUT;
     }
-    if (!scene_path || !out) {
+    if (!A->scene_path || !A->out) {
         bt_error(CMD, "%s; usage: blendtool mesh SCENE -o OUT.{ply,obj,stl,glb}",
-                 !scene_path ? "no scene given" : "no output given (-o OUT)");
+                 !A->scene_path ? "no scene given" : "no output given (-o OUT)");
         return BT_EXIT_BAD_INPUT;
     }
-    if (format == LB_MESH_FORMAT_AUTO) format = lb_mesh_format_of(out);
-    if (format == LB_MESH_FORMAT_AUTO) {
+    if (A->format == LB_MESH_FORMAT_AUTO) A->format = lb_mesh_format_of(A->out);
+    if (A->format == LB_MESH_FORMAT_AUTO) {
         bt_error(CMD,
                  "%s: unknown mesh format; allowed: a name ending in .ply, .obj, .stl or "
                  ".glb, or --format ply|obj|stl|glb",
-                 out);
+                 A->out);
         return BT_EXIT_BAD_INPUT;
     }
-    lb_scene *scene = NULL;
-    int rc = bt_load_scene_set(CMD, scene_path, sets, nsets, &scene, NULL);
+    return BT_EXIT_OK;
+}
+
+static int run(int argc, char **argv) {
+    mesh_args A;
+    int rc = parse_args(argc, argv, &A);
     if (rc) return rc;
-    if (!have_bounds && !lb_scene_bounds(scene, o.bmin, o.bmax)) {
+    const char *const out = A.out, *const scene_path = A.scene_path;
+    lb_mesh_options o = A.o;
+    const int quiet = A.quiet;
+    lb_scene *scene = NULL;
+    rc = bt_load_scene_set(CMD, scene_path, A.sets, A.nsets, &scene, NULL);
+    if (rc) return rc;
+    if (!A.have_bounds && !lb_scene_bounds(scene, o.bmin, o.bmax)) {
         bt_error(CMD,
                  "%s: the scene has no bounds; allowed: add \"bounds\" to the scene or give "
                  "--bounds x0,y0,z0,x1,y1,z1",
@@ -175,7 +195,7 @@ static int run(int argc, char **argv) {
         rc = bt_fail(CMD, scene_path, s, &e);
         goto done;
     }
-    s = lb_mesh_write_stream(mesh, w.f, format, &e);
+    s = lb_mesh_write_stream(mesh, w.f, A.format, &e);
     if (s) {
         bt_error(CMD, "%s: writing the mesh failed (%s); nothing was written", out,
                  strerror(errno));
