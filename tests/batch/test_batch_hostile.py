@@ -110,6 +110,21 @@ check(r.returncode == 0 and "#SBATCH --partition=debug,gpu-a.1\n" in open(r.stdo
       "a valid partition list goes into the script")
 check(not markers(), "no partition ran: %s" % markers())
 
+# paths longer than blendtool's buffers are refused by name, never cut short
+# (a cut output_dir would write somewhere else)
+dl = os.path.join(WORK, "longpath")
+for key, value in (("output_dir", "o" * 200 + "/" + "d" * 250 + ("/" + "e" * 250) * 16),
+                   ("scene", "s" * 250 + ("/" + "t" * 250) * 33 + ".json")):
+    jl = job_in(dl, TINY)
+    doc = json.load(open(jl))
+    doc[key] = value
+    with open(jl, "w") as f:
+        json.dump(doc, f)
+    rl = bt("batch", jl)
+    check(rl.returncode == 2 and "$.%s" % key in rl.stderr and "too long" in rl.stderr,
+          "a %d-byte %s: exit 2 naming it: %d %s" % (len(value), key, rl.returncode, rl.stderr))
+    check(not os.path.exists(os.path.join(dl, "o" * 200)), "%s too long: nothing created" % key)
+
 # ---- 2. --time and --mem
 text = open(r.stdout.strip()).read()
 check("#SBATCH --time=30\n" in text and "#SBATCH --mem=4096M\n" in text,
