@@ -122,8 +122,6 @@ static int run_pov(int argc, char **argv) {
     return rc;
 }
 
-/* Render folders are "blendtool-render-PID-XXXXXX" in $TMPDIR (or /tmp);
- * those of processes that are gone (killed with SIGKILL) are removed. */
 static int run_render(int argc, char **argv) {
     povargs a = {.width = 640, .height = 480, .quality = 9};
     if (parse("render", argc, argv, &a, 1)) return BT_EXIT_BAD_INPUT;

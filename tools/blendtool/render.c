@@ -15,6 +15,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+/* Render folders are "blendtool-render-PID-XXXXXX" in $TMPDIR (or /tmp);
+ * those of processes that are gone (killed with SIGKILL) are removed. */
 static const char *tmp_root(void) {
     const char *t = getenv("TMPDIR");
     return t && *t ? t : "/tmp";
