@@ -54,6 +54,9 @@ extern "C" {
 /* Largest |coordinate| anywhere in a scene (centres, translations, bounds)
  * and of evaluation points. */
 #define LB_SCENE_MAX_COORD 1e9
+/* A soft level node's level lies in (margin, 1 - margin): soft fields lie in
+ * [0, 1], and a level at either end has no surface. */
+#define LB_SOFT_LEVEL_MARGIN 1e-6
 /* Compile-time work of local unions (their intersection curves are found
  * by evaluating both children on a grid and along the curves): counted in
  * instruction runs as it is done; lb_evaluator_create stops and refuses
@@ -165,6 +168,18 @@ LB_API lb_status lb_scene_material_index(const lb_scene *scene, const lb_evaluat
  * truncated to size. Returns the length the whole text needs (without the
  * NUL), like snprintf. A NULL buf (with any size) only measures. */
 LB_API size_t lb_scene_describe(const lb_scene *scene, char *buf, size_t size);
+
+/* The node types a scene can name, as one JSON object (the family
+ * registry, docs/design.md "Adding a family"): for every primitive its
+ * keys; for every operator its conventions, set operations, arity, keys,
+ * per-argument parameters and scalar parameter with their ranges and
+ * defaults, whether it takes bulge elimination and bounding solids, and
+ * its POV-Ray macros. Tools generate or check their own lists against it
+ * (the JSON Schema, the Blender add-on, the fuzz dictionary). Written into
+ * buf like lb_scene_describe (NUL-terminated, truncated to size; returns
+ * the length the whole text needs; a NULL buf only measures); 0 when
+ * memory is short. Thread-safe: it reads constant tables only. */
+LB_API size_t lb_scene_families_json(char *buf, size_t size);
 
 /* Reference evaluator: a plain recursive walk over the scene tree, one
  * point, calling the public per-family functions. Slow on purpose; tests and

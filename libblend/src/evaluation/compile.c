@@ -132,19 +132,19 @@ static double rho_lipschitz(const lb_primitive *P) {
  * and lb_evaluator_free releases them with the instruction. */
 static lb_status precompute_op(cctx *c, lb__instr *in, const lb__node *n, const lb__affine *A) {
     (void)A;
-    if (!n->bulge && n->family == LB__F_DISPLACEMENT) {
+    if (!n->o.bulge && n->o.family == LB__F_DISPLACEMENT) {
         in->fast = LB__FAST_DISPLACEMENT;
-        in->mode = lb__exponent_mode(n->k, n->p);
-    } else if (!n->bulge && n->family == LB__F_CONIC) {
+        in->mode = lb__exponent_mode(n->o.k, n->o.p);
+    } else if (!n->o.bulge && n->o.family == LB__F_CONIC) {
         in->fast = LB__FAST_CONIC;
-    } else if (!n->bulge && n->family == LB__F_SCALE) {
+    } else if (!n->o.bulge && n->o.family == LB__F_SCALE) {
         in->fast = LB__FAST_SCALE;
-        in->mode = lb__exponent_mode(n->k, n->p);
-    } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
+        in->mode = lb__exponent_mode(n->o.k, n->o.p);
+    } else if (n->o.family == LB__F_MIN || n->o.family == LB__F_MAX) {
         in->fast = LB__FAST_MINMAX;
     }
-    if (n->k >= 2 && (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC ||
-                      in->fast == LB__FAST_MINMAX))
+    if (n->o.k >= 2 && (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC ||
+                        in->fast == LB__FAST_MINMAX))
         c->ev->cullable = 1;
     return LB_OK;
 }
@@ -210,7 +210,7 @@ static lb_status charge(cctx *c, uint32_t idx) {
     lb_evaluator *ev = c->ev;
     lb__instr *in = &ev->ins[idx];
     in->cost = 1.0;
-    const int local = in->code == LB__I_OP && in->op->family == LB__F_LOCAL;
+    const int local = in->code == LB__I_OP && (lb__op_flags(in->op) & LB__R_CURVES);
     if (in->code == LB__I_OP && (in->op->bulge || local)) {
         size_t len = 0, cap = 0;
         uint32_t *list = NULL;
@@ -237,7 +237,7 @@ static lb_status charge(cctx *c, uint32_t idx) {
 static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, uint32_t *out) {
     lb__affine A = *Ap;
     if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
-    if (n->family == LB__F_GROUP) return compile_node(c, n->args[0], &A, out);
+    if (n->o.family == LB__F_GROUP) return compile_node(c, n->args[0], &A, out);
     lb_status s;
     if ((s = memo_grow(c))) return s;
     memo_entry *e = memo_find(c, n, &A);
@@ -246,23 +246,23 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         return LB_OK;
     }
     uint32_t *src = NULL, *srci = NULL, *srcb = NULL;
-    if (n->family != LB__F_PRIMITIVE) {
-        const size_t ns = n->k * (n->bounds ? 2 : 1);
+    if (n->o.family != LB__F_PRIMITIVE) {
+        const size_t ns = n->o.k * (n->bounds ? 2 : 1);
         src = malloc(ns * sizeof *src);
-        srci = malloc(n->k * sizeof *srci);
-        srcb = n->bounds ? malloc(n->k * sizeof *srcb) : NULL;
+        srci = malloc(n->o.k * sizeof *srci);
+        srcb = n->bounds ? malloc(n->o.k * sizeof *srcb) : NULL;
         if (!src || !srci || (n->bounds && !srcb)) {
             free(src);
             free(srci);
             free(srcb);
             return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
         }
-        for (size_t i = 0; i < n->k && !s; ++i) {
+        for (size_t i = 0; i < n->o.k && !s; ++i) {
             s = compile_node(c, n->args[i], &A, &srci[i]);
             src[i] = srci[i];
             if (!s && n->bounds) {
                 s = compile_node(c, n->bounds[i], &A, &srcb[i]);
-                src[n->k + i] = srcb[i];
+                src[n->o.k + i] = srcb[i];
             }
         }
         if (s) {
@@ -280,7 +280,7 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         return s;
     }
     const uint32_t idx = (uint32_t)(c->ev->n - 1);
-    if (n->family == LB__F_PRIMITIVE) {
+    if (n->o.family == LB__F_PRIMITIVE) {
         in->prim = n->prim;
         in->A = A;
         in->lip = rho_lipschitz(&n->prim);
@@ -301,17 +301,15 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         in->code = LB__I_OP;
         in->A = A; /* world -> this node's frame (the POV-Ray export of local blends) */
         in->node = n;
-        /* operators only carry a copy of their node (a primitive's
+        /* operators carry their own copy of the operator (a primitive's
          * instruction stays small: large scenes are mostly primitives) */
         in->op = malloc(sizeof *in->op);
         if (!in->op)
             return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
-        *in->op = *n;
-        in->op->args = in->op->bounds = NULL;
-        in->op->r = dup_array(n->r, n->k, &fail);
-        in->op->p = dup_array(n->p, n->k, &fail);
-        in->op->m = dup_array(n->m, n->k, &fail);
-        in->op->def_name = NULL;
+        *in->op = n->o;
+        in->op->r = dup_array(n->o.r, n->o.k, &fail);
+        in->op->p = dup_array(n->o.p, n->o.k, &fail);
+        in->op->m = dup_array(n->o.m, n->o.k, &fail);
         in->op->path = malloc(strlen(n->path) + 1);
         if (in->op->path)
             strcpy(in->op->path, n->path);
@@ -350,7 +348,7 @@ static lb_status allocate_registers(lb_evaluator *ev, uint32_t root, lb_error *e
     for (size_t i = 0; i < n; ++i) {
         const lb__instr *in = &ev->ins[i];
         if (in->code != LB__I_OP) continue;
-        const size_t ns = in->op->k * (in->op->bounds || in->op->family == LB__F_BOUNDED ? 2 : 1);
+        const size_t ns = in->op->k * (lb__op_flags(in->op) & LB__R_BOUNDING ? 2 : 1);
         for (size_t j = 0; j < ns; ++j)
             if (last[in->src[j]] != UINT32_MAX) last[in->src[j]] = (uint32_t)i;
     }
@@ -369,7 +367,7 @@ static lb_status allocate_registers(lb_evaluator *ev, uint32_t root, lb_error *e
         if (in->code == LB__I_OP) ev->total_k += in->op->k;
         if (in->code == LB__I_OP && in->op->k > ev->kmax) ev->kmax = in->op->k;
         if (in->code == LB__I_OP) {
-            const size_t ns = in->op->k * (in->op->family == LB__F_BOUNDED ? 2 : 1);
+            const size_t ns = in->op->k * (lb__op_flags(in->op) & LB__R_BOUNDING ? 2 : 1);
             for (size_t j = 0; j < ns; ++j) {
                 const uint32_t a = in->src[j];
                 /* an argument used twice (a def as two arguments of one

@@ -41,7 +41,7 @@ void lb__cone_free(lb__cone *S) {
  * bounding solids */
 static size_t nsrc_of(const lb__instr *in) {
     if (in->code != LB__I_OP) return 0;
-    return in->op->family == LB__F_BOUNDED ? 2 * in->op->k : in->op->k;
+    return (lb__op_flags(in->op) & LB__R_BOUNDING) ? 2 * in->op->k : in->op->k;
 }
 
 /* the soft-form interval of a child interval f (zero: g = C (1 - f / s)) */
@@ -56,10 +56,9 @@ static lb__iv soft_iv(const lb__instr *in, lb_convention conv, lb__iv f) {
  * box, or -1 (see the head of the file) */
 static int passes(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
                   const double bc[3], const double br[3]) {
-    if (in->code != LB__I_OP || (in->op->family != LB__F_LOCAL && in->op->family != LB__F_CLEAN))
-        return -1;
+    if (in->code != LB__I_OP || (!(lb__op_flags(in->op) & LB__R_CLEAN_UNION))) return -1;
     if (in->op->lp.alpha[0] != 0.0 || in->op->lp.alpha[1] != 0.0) return -1;
-    if (in->op->family == LB__F_LOCAL && lb__local_reaches(in->curves, bc, br)) return -1;
+    if ((lb__op_flags(in->op) & LB__R_CURVES) && lb__local_reaches(in->curves, bc, br)) return -1;
     const lb__iv g[2] = {soft_iv(in, ev->conv, fa), soft_iv(in, ev->conv, fb)};
     for (int a = 0; a < 2; ++a)
         if (!(g[a].lo >= -LB_MAX_ABS_ARG && g[a].hi <= LB_MAX_ABS_ARG)) return -1;
@@ -99,7 +98,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
         const lb__instr *in = &ev->ins[list ? list[q] : q];
         nsrc += nsrc_of(in);
         /* bulge elimination re-runs its cone by the evaluator's indices: no reduction */
-        if (in->code == LB__I_OP && in->cone && in->op->family != LB__F_LOCAL) {
+        if (in->code == LB__I_OP && in->cone && !(lb__op_flags(in->op) & LB__R_CURVES)) {
             S->reduced = 0;
             return LB_OK;
         }
@@ -184,7 +183,9 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
                 freel[nfree++] = c->src[a];
             }
         }
-        weight += in->code == LB__I_OP && in->op->family == LB__F_LOCAL ? LB_LOCAL_RUN_WEIGHT : 1.0;
+        weight += in->code == LB__I_OP && (lb__op_flags(in->op) & LB__R_CURVES)
+                      ? LB_LOCAL_RUN_WEIGHT
+                      : 1.0;
         ko += ns;
         ++k;
     }

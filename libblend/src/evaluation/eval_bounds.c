@@ -123,125 +123,6 @@ static inline void store_iv(iv *r, iv o) {
     r->hi = !(o.hi <= BIG) ? INFINITY : o.hi < -BIG ? -BIG : o.hi;
 }
 
-static int finite_all(const double *v, size_t n) {
-    for (size_t i = 0; i < n; ++i)
-        if (!isfinite(v[i])) return 0;
-    return 1;
-}
-
-/* dual (union-form) argument interval: intersection -x, difference -x_0 */
-static iv dual_iv(lb_setop op, size_t i, iv x) {
-    const int neg = op == LB_INTERSECTION || (op == LB_DIFFERENCE && i == 0);
-    if (!neg) return x;
-    iv o = {-x.hi, -x.lo};
-    return o;
-}
-
-static void bulge_bounds(const lb__node *n, const iv *x, iv *out) {
-    const lb_bulge_params *bp = &n->bp;
-    const int range = (bp->flags & LB_BULGE_RANGE) != 0, slope = (bp->flags & LB_BULGE_SLOPE) != 0;
-    double L = INFINITY, H = INFINITY;
-    int unknown_lo = 0;
-    for (size_t i = 0; i < 2; ++i) {
-        const iv u = dual_iv(n->op, i, x[i]);
-        const double rhi = range ? bp->r[i] * (2.0 + bp->omega) : bp->r[i];
-        if (n->family == LB__F_SCALE) {
-            const double ylo = u.lo + 1.0;
-            if (ylo > 0.0) {
-                const double t = ylo / (1.0 + rhi) - 1.0;
-                if (t < L) L = t;
-            } else {
-                unknown_lo = 1;
-            }
-            if (u.hi < H) H = u.hi;
-        } else {
-            const double m = bp->m[i];
-            const double num = u.lo - rhi;
-            const double gl = num < 0.0 ? num / m : (slope ? 0.0 : num / m);
-            const double gh = u.hi >= 0.0 ? u.hi / m : (slope ? 0.0 : u.hi / m);
-            if (gl < L) L = gl;
-            if (gh < H) H = gh;
-        }
-    }
-    if (unknown_lo) L = -INFINITY;
-    if (n->op == LB_UNION) {
-        out->lo = L;
-        out->hi = H;
-    } else {
-        out->lo = -H;
-        out->hi = -L;
-    }
-}
-
-static void bounded_bounds(const lb__node *n, const iv *x, const iv *c, iv *out) {
-    const size_t k = n->k;
-    const double om = LB_BOUNDED_OMEGA;
-    if (n->op == LB_UNION) {
-        double L = INFINITY, H = INFINITY;
-        int unknown = 0;
-        for (size_t i = 0; i < k; ++i) {
-            const double ylo = x[i].lo + 1.0, yclo = c[i].lo + 1.0;
-            if (x[i].hi < H) H = x[i].hi;
-            if (!(ylo > 0.0)) {
-                unknown = 1;
-                continue;
-            }
-            double t = ylo / (1.0 + om);
-            const double tc = yclo > 0.0 ? yclo : 0.0;
-            if (tc < t) t = tc;
-            if (t - 1.0 < L) L = t - 1.0;
-        }
-        out->lo = unknown ? -INFINITY : L;
-        out->hi = H;
-        /* Where every bounding value stays above -1 the union is monotone
-         * (non-decreasing) in each x_i and each c_i: with y = x + 1 and
-         * y_c = c + 1, R_i = y_i / y_ci - 1 turns argument i's term into
-         * [y_i (h - y_ci) / (h (y_i - y_ci))]+^p_i, which falls as y_i or
-         * y_ci grows (h <= y_i), so the root h rises; where R_i is floored
-         * at omega it no longer depends on c_i. The corners then bound it
-         * exactly; the brackets above stay as a safeguard. */
-        int mono = 1;
-        double xl[LB_MAX_ARITY], xh[LB_MAX_ARITY], cl[LB_MAX_ARITY], ch[LB_MAX_ARITY];
-        for (size_t i = 0; i < k && mono; ++i) {
-            mono = c[i].lo > -1.0;
-            xl[i] = x[i].lo;
-            xh[i] = x[i].hi;
-            cl[i] = c[i].lo;
-            ch[i] = c[i].hi;
-        }
-        double v1, v2;
-        if (mono && finite_all(xl, k) && finite_all(xh, k) && finite_all(cl, k) &&
-            finite_all(ch, k) &&
-            !lb__node_apply(n, LB_CONVENTION_ZERO, xl, cl, NULL, &v1, NULL, NULL, NULL, NULL) &&
-            !lb__node_apply(n, LB_CONVENTION_ZERO, xh, ch, NULL, &v2, NULL, NULL, NULL, NULL)) {
-            if (v1 > out->lo) out->lo = v1;
-            if (v2 < out->hi) out->hi = v2;
-        }
-        return;
-    }
-    double pmin = n->p[0];
-    for (size_t i = 1; i < k; ++i)
-        if (n->p[i] < pmin) pmin = n->p[i];
-    const double grow = pow((double)k, 1.0 / pmin);
-    double L = -INFINITY, Y = -INFINITY;
-    for (size_t i = 0; i < k; ++i) {
-        iv a = x[i];
-        if (n->op == LB_DIFFERENCE && i > 0) {
-            a.lo = -x[i].hi;
-            a.hi = -x[i].lo;
-        }
-        if (a.lo > L) L = a.lo;
-        if (a.hi + 1.0 > Y) Y = a.hi + 1.0;
-    }
-    out->lo = L;
-    out->hi = (Y > 0.0 ? grow * Y : 0.0) - 1.0;
-}
-
-static int is_difference_family(lb__family f) {
-    return f == LB__F_DISPLACEMENT || f == LB__F_CONIC || f == LB__F_SCALE ||
-           f == LB__F_SOFT_HYPER || f == LB__F_SOFT_CONIC || f == LB__F_PERLIN;
-}
-
 /* Per-argument scratch of the passes, after the interval registers
  * (tape.h, LB__IV_SCRATCH doubles per argument of the widest operator):
  * the arguments' and bounding values' intervals, the culled list,
@@ -274,12 +155,12 @@ static double blend_finite(const lb__instr *in, const double *u, const double *r
  * doubles of scratch. */
 static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, size_t na, iv *out,
                         double *ws) {
-    const lb__node *n = in->op;
+    const lb__op *n = in->op;
     const size_t K = n->k;
     double *lo = ws, *hi = lo + K, *r = hi + K, *p = r + K, *m = p + K;
     ws = m + K;
     for (size_t j = 0; j < na; ++j) {
-        const iv u = dual_iv(n->op, act[j], x[act[j]]);
+        const iv u = lb__dual_iv(n->op, act[j], x[act[j]]);
         lo[j] = u.lo;
         hi[j] = u.hi;
         r[j] = n->r[act[j]];
@@ -342,140 +223,6 @@ static void fast_bounds(const lb__instr *in, const iv *x, const uint16_t *act, s
     out->hi += 1e-9 * (1.0 + fabs(out->hi));
 }
 
-/* Where Perlin's arguments lie: 0 all within [0, 1] at the top, 1 some
- * finite top above 1, 2 some end infinite (unbounded) */
-static int perlin_reach(const iv *x, size_t k) {
-    int r = 0;
-    for (size_t i = 0; i < k; ++i) {
-        if (!isfinite(x[i].lo) || !isfinite(x[i].hi)) return 2;
-        if (x[i].hi > 1.0) r = 1;
-    }
-    return r;
-}
-
-static void op_bounds(lb_convention conv, const lb__node *n, const iv *x, const iv *c, iv *out,
-                      double *xl) {
-    const size_t k = n->k;
-    if (n->bulge) {
-        bulge_bounds(n, x, out);
-    } else if (n->family == LB__F_BOUNDED) {
-        bounded_bounds(n, x, c, out);
-    } else if (n->family == LB__F_COMPLEMENT) {
-        if (conv == LB_CONVENTION_ZERO) {
-            out->lo = -x[0].hi;
-            out->hi = -x[0].lo;
-        } else { /* max(0, 1 - f) */
-            out->lo = 1.0 - x[0].hi > 0.0 ? 1.0 - x[0].hi : 0.0;
-            out->hi = 1.0 - x[0].lo > 0.0 ? 1.0 - x[0].lo : 0.0;
-        }
-        return; /* exact */
-    } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
-        /* exact, infinite ends included */
-        const int mn = n->family == LB__F_MIN;
-        *out = x[0];
-        for (size_t i = 1; i < k; ++i) {
-            out->lo = mn ? fmin(out->lo, x[i].lo) : fmax(out->lo, x[i].lo);
-            out->hi = mn ? fmin(out->hi, x[i].hi) : fmax(out->hi, x[i].hi);
-        }
-        return;
-    } else if (n->family == LB__F_PERLIN && perlin_reach(x, k) == 2) {
-        out->lo = 0.0; /* soft fields are >= 0; nothing finite bounds the top */
-        out->hi = INFINITY;
-        return;
-    } else if (n->family == LB__F_PERLIN && perlin_reach(x, k) == 1) {
-        /* Perlin's products are monotone only on [0, 1]: an argument a soft
-         * union took above 1 flips a factor's sign. Interval products then
-         * (sound, and exact for points): union 1 - prod(1 - f_i),
-         * intersection prod f_i, difference f_0 prod_{i>0} (1 - f_i). */
-        iv P = {1.0, 1.0};
-        for (size_t i = 0; i < k; ++i) {
-            const int flip = n->op == LB_UNION || (n->op == LB_DIFFERENCE && i > 0);
-            const iv f = flip ? (iv){1.0 - x[i].hi, 1.0 - x[i].lo} : x[i];
-            const double a = P.lo * f.lo, b = P.lo * f.hi, c2 = P.hi * f.lo, d = P.hi * f.hi;
-            P.lo = fmin(fmin(a, b), fmin(c2, d));
-            P.hi = fmax(fmax(a, b), fmax(c2, d));
-        }
-        if (n->op == LB_UNION) P = (iv){1.0 - P.hi, 1.0 - P.lo};
-        out->lo = P.lo > 0.0 ? P.lo : 0.0;
-        out->hi = P.hi > 0.0 ? P.hi : 0.0;
-    } else {
-        double *xh = xl + k, v1 = 0.0, v2 = 0.0; /* xl: the caller's 2k doubles */
-        for (size_t i = 0; i < k; ++i) {
-            const int dec = n->op == LB_DIFFERENCE && i > 0 && is_difference_family(n->family);
-            xl[i] = dec ? x[i].hi : x[i].lo;
-            xh[i] = dec ? x[i].lo : x[i].hi;
-        }
-        /* a corner with an infinite argument, or one the operator refuses:
-         * nothing is known at that end (an end at 1e100 would be a finite
-         * stand-in that the operator's arithmetic can cancel) */
-        const int ok1 = finite_all(xl, k) &&
-                        !lb__node_apply(n, conv, xl, NULL, NULL, &v1, NULL, NULL, NULL, NULL);
-        const int ok2 = finite_all(xh, k) &&
-                        !lb__node_apply(n, conv, xh, NULL, NULL, &v2, NULL, NULL, NULL, NULL);
-        /* The lower end from xl, the upper from xh (monotone), each
-         * unknown where its corner is. Rounding in operators such as the
-         * R-functions (x + y - sqrt(x^2 + y^2)) is relative to the
-         * arguments, not to the result: widen by their size too. */
-        double big = 0.0;
-        for (size_t i = 0; i < 2 * k; ++i)
-            if (isfinite(xl[i]) && fabs(xl[i]) > big) big = fabs(xl[i]);
-        out->lo = ok1 ? (ok2 ? fmin(v1, v2) : v1) : -INFINITY;
-        out->hi = ok2 ? (ok1 ? fmax(v1, v2) : v2) : INFINITY;
-        out->lo -= 1e-9 * (1.0 + fabs(out->lo)) + 1e-14 * big;
-        out->hi += 1e-9 * (1.0 + fabs(out->hi)) + 1e-14 * big;
-        if (conv == LB_CONVENTION_SOFT && out->lo < 0.0) out->lo = 0.0;
-        return;
-    }
-    out->lo -= 1e-9 * (1.0 + fabs(out->lo));
-    out->hi += 1e-9 * (1.0 + fabs(out->hi));
-    if (conv == LB_CONVENTION_SOFT && out->lo < 0.0) out->lo = 0.0; /* soft fields are >= 0 */
-}
-
-/* Argument culling for one operator over a box (the plan's act list):
- * - displacement and conic (no bulge), in union form u (duals negate): the
- *   root h <= H = min_i hi(u_i)/m_i, so argument j's term
- *   [(r_j - u_j + m_j h)/r_j]+ is 0 on the whole box when
- *   lo(u_j) - m_j H >= r_j; dropping it leaves T, its root and the gradient
- *   unchanged (the conic is then outside region II: min(u_i/m_i));
- * - min / max: an argument whose interval lies above the smallest upper
- *   bound (below the largest lower bound) is never selected.
- * The argument attaining H (or the extreme bound) always stays. */
-static uint16_t cull(const lb__node *n, const iv *x, uint16_t *act) {
-    const size_t k = n->k;
-    uint16_t na = 0;
-    if (!n->bulge && (n->family == LB__F_DISPLACEMENT || n->family == LB__F_CONIC)) {
-        double H = INFINITY;
-        for (size_t i = 0; i < k; ++i) {
-            const iv u = dual_iv(n->op, i, x[i]);
-            const double t = u.hi / n->m[i];
-            if (t < H) H = t;
-        }
-        for (size_t i = 0; i < k; ++i) {
-            const iv u = dual_iv(n->op, i, x[i]);
-            /* a relative margin keeps rounding in the kernel on the safe side */
-            const double reach = u.lo - n->m[i] * H;
-            if (!(reach >= n->r[i] * (1.0 + 1e-9) + 1e-12 * fabs(u.lo))) act[na++] = (uint16_t)i;
-        }
-        return na;
-    }
-    if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
-        const int mn = n->family == LB__F_MIN;
-        double ext = mn ? INFINITY : -INFINITY;
-        for (size_t i = 0; i < k; ++i) {
-            if (mn && x[i].hi < ext) ext = x[i].hi;
-            if (!mn && x[i].lo > ext) ext = x[i].lo;
-        }
-        for (size_t i = 0; i < k; ++i)
-            if (mn ? !(x[i].lo > ext) : !(x[i].hi < ext)) act[na++] = (uint16_t)i;
-        return na;
-    }
-    for (size_t i = 0; i < k; ++i) act[na++] = (uint16_t)i;
-    return na;
-}
-
-/* What the root needs, backwards from the plan's argument lists: need and
- * the list. Only instructions of parent's list can be needed when parent
- * is given (a box inside parent's), so only they are visited. */
 static void plan_needs(const lb_evaluator *ev, lb__plan *plan, const lb__plan *parent) {
     for (uint32_t q = 0; q < plan->nlist; ++q) plan->need[plan->list[q]] = 0;
     const size_t m = parent ? parent->nlist : ev->n;
@@ -487,7 +234,8 @@ static void plan_needs(const lb_evaluator *ev, lb__plan *plan, const lb__plan *p
         const uint16_t *act = plan->act + in->aoff;
         for (uint16_t a = 0; a < plan->nact[i]; ++a) {
             plan->need[in->srci[act[a]]] = 1;
-            if (in->op->family == LB__F_BOUNDED) plan->need[in->srcb[act[a]]] = 1;
+            if ((lb__family_info(in->op->family)->flags & LB__R_BOUNDING))
+                plan->need[in->srcb[act[a]]] = 1;
         }
         if (in->op->bulge) /* the Hessian terms re-run both arguments' prefixes */
             for (size_t a = 0; a < in->op->k; ++a) plan->need[in->srci[a]] = 1;
@@ -512,19 +260,19 @@ void lb__bounds_pass(const lb_evaluator *ev, const double bc[3], const double br
         } else {
             const size_t k = in->op->k;
             for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
-            if (in->op->family == LB__F_BOUNDED)
+            if ((lb__family_info(in->op->family)->flags & LB__R_BOUNDING))
                 for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
             if (in->fast == LB__FAST_DISPLACEMENT || in->fast == LB__FAST_CONIC) {
                 uint16_t *act = plan ? plan->act + in->aoff : S.act;
-                const uint16_t na = cull(in->op, x, act);
+                const uint16_t na = lb__op_cull(in->op, x, act);
                 if (plan) plan->nact[i] = na;
                 fast_bounds(in, x, act, na, &o, S.fb);
-            } else if (in->op->family == LB__F_LOCAL || in->op->family == LB__F_CLEAN) {
+            } else if ((lb__family_info(in->op->family)->flags & LB__R_CLEAN_UNION)) {
                 lb__local_bounds(ev, in, x, bc, br, &o);
-                if (plan) plan->nact[i] = cull(in->op, x, plan->act + in->aoff);
+                if (plan) plan->nact[i] = lb__op_cull(in->op, x, plan->act + in->aoff);
             } else {
-                op_bounds(ev->conv, in->op, x, c, &o, S.xl);
-                if (plan) plan->nact[i] = cull(in->op, x, plan->act + in->aoff);
+                lb__op_interval(in->op, ev->conv, x, c, &o, S.xl);
+                if (plan) plan->nact[i] = lb__op_cull(in->op, x, plan->act + in->aoff);
             }
         }
         store_iv(&R[in->dst], o);
@@ -539,12 +287,12 @@ static void all_args_bounds(const lb_evaluator *ev, const lb__instr *in, const d
     iv *x = S.x, *c = S.c;
     const size_t k = in->op->k;
     for (size_t j = 0; j < k; ++j) x[j] = R[in->src[j]];
-    if (in->op->family == LB__F_BOUNDED)
+    if ((lb__family_info(in->op->family)->flags & LB__R_BOUNDING))
         for (size_t j = 0; j < k; ++j) c[j] = R[in->src[k + j]];
-    if (in->op->family == LB__F_LOCAL || in->op->family == LB__F_CLEAN)
+    if ((lb__family_info(in->op->family)->flags & LB__R_CLEAN_UNION))
         lb__local_bounds(ev, in, x, bc, br, o);
     else
-        op_bounds(ev->conv, in->op, x, c, o, S.xl);
+        lb__op_interval(in->op, ev->conv, x, c, o, S.xl);
 }
 
 /* Operator i (in) keeps the parent's argument list in the child plan: the
@@ -577,7 +325,7 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
             const uint16_t pn = parent->nact[i];
             for (uint16_t j = 0; j < pn; ++j) x[pa[j]] = R[in->src[pa[j]]];
             if (in->fast == LB__FAST_MINMAX) {
-                const int mn = in->op->family == LB__F_MIN;
+                const int mn = lb__family_info(in->op->family)->select > 0;
                 o = x[pa[0]];
                 for (uint16_t j = 1; j < pn; ++j) {
                     const iv a = x[pa[j]];
@@ -586,17 +334,17 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                 }
             } else {
                 /* cull among the parent's arguments, as cull() does */
-                const lb__node *n = in->op;
+                const lb__op *n = in->op;
                 double H = INFINITY;
                 for (uint16_t j = 0; j < pn; ++j) {
-                    const iv u = dual_iv(n->op, pa[j], x[pa[j]]);
+                    const iv u = lb__dual_iv(n->op, pa[j], x[pa[j]]);
                     const double t = u.hi / n->m[pa[j]];
                     if (t < H) H = t;
                 }
                 uint16_t *act = S.act, na = 0;
                 for (uint16_t j = 0; j < pn; ++j) {
                     const uint16_t a = pa[j];
-                    const iv u = dual_iv(n->op, a, x[a]);
+                    const iv u = lb__dual_iv(n->op, a, x[a]);
                     const double reach = u.lo - n->m[a] * H;
                     if (!(reach >= n->r[a] * (1.0 + 1e-9) + 1e-12 * fabs(u.lo))) act[na++] = a;
                 }

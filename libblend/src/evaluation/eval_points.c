@@ -164,7 +164,7 @@ static void run_prim(const lb__instr *in, size_t n, const double *x, const doubl
 static double fast_op(const lb__instr *in, size_t k, const uint16_t *act, const double *x,
                       const double *r, const double *p, const double *m, const double *ir,
                       const double *im, double *dx, double *ws) {
-    const lb__node *n = in->op;
+    const lb__op *n = in->op;
     double *xt = ws, *sg = ws + k;
     ws += 2 * k;
     switch (in->fast) {
@@ -271,11 +271,11 @@ LB_VECTOR_CLONES static lb_status run_op(const lb_evaluator *ev, const lb__instr
                                          const lb__plan *plan, size_t n, const double *px,
                                          const double *py, const double *pz, double *regs,
                                          size_t *count, lb_error *err) {
-    const lb__node *nd = in->op;
-    if (nd->family == LB__F_LOCAL || nd->family == LB__F_CLEAN)
+    const lb__op *nd = in->op;
+    if ((lb__op_flags(nd) & LB__R_CLEAN_UNION))
         return lb__local_run(ev, in, n, px, py, pz, regs, err);
     const size_t kf = nd->k;
-    const int bounded = nd->family == LB__F_BOUNDED;
+    const int bounded = (lb__op_flags(nd) & LB__R_BOUNDING);
     /* per-argument arrays in the scratch after the registers (tape.h): the
      * argument indices, values, bounding values and their derivatives, the
      * parameters, the reciprocals, fast_op's 6, the registers' columns */
@@ -350,7 +350,7 @@ LB_VECTOR_CLONES static lb_status run_op(const lb_evaluator *ev, const lb__instr
             if (nd->bulge)
                 for (size_t i = 0; i < 2; ++i)
                     for (int d = 0; d < 3; ++d) ga[3 * i + d] = lb__reg(regs, in->src[i], 1 + d)[j];
-            lb_status s = lb__node_apply(nd, ev->conv, x, c, ga, &v, dx, dc, dg, err);
+            lb_status s = lb__op_apply(nd, ev->conv, x, c, ga, &v, dx, dc, dg, err);
             if (s) {
                 free(dgall);
                 if (err) {

@@ -97,7 +97,8 @@ static double cone_weight(const lb_evaluator *ev, const uint32_t *cone, size_t n
     double w = 0.0;
     for (size_t i = 0; i < n; ++i) {
         const lb__instr *q = &ev->ins[cone[i]];
-        w += q->code == LB__I_OP && q->op->family == LB__F_LOCAL ? LB_LOCAL_RUN_WEIGHT : 1.0;
+        w +=
+            q->code == LB__I_OP && (lb__op_flags(q->op) & LB__R_CURVES) ? LB_LOCAL_RUN_WEIGHT : 1.0;
     }
     return w;
 }
@@ -158,7 +159,7 @@ static lb_status chunk_tape(child_eval *E, int a, int new_group, const double gc
     size_t near = 0;
     for (size_t q = 0; q < nr; ++q) {
         const lb__instr *c = run_ev != E->ev ? &run_ev->ins[q] : &E->ev->ins[cone[q]];
-        near += c->code == LB__I_OP && c->op->family == LB__F_LOCAL &&
+        near += c->code == LB__I_OP && (lb__op_flags(c->op) & LB__R_CURVES) &&
                 lb__local_reaches(c->curves, bc, br);
     }
     *run = run_ev;
@@ -947,7 +948,7 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
 lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, lb_error *err) {
     for (size_t i = 0; i < ev->n; ++i) {
         lb__instr *in = &ev->ins[i];
-        if (in->code != LB__I_OP || in->op->family != LB__F_LOCAL) continue;
+        if (in->code != LB__I_OP || !(lb__op_flags(in->op) & LB__R_CURVES)) continue;
         double bmin[3], bmax[3];
         if (!lb_scene_bounds(scene, bmin, bmax))
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
@@ -1042,7 +1043,7 @@ int lb__local_reaches(const struct lb__curves *C, const double bc[3], const doub
 
 lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
                         const double *y, const double *z, double *regs, lb_error *err) {
-    const lb__node *nd = in->op;
+    const lb__op *nd = in->op;
     const lb_convention conv = ev->conv;
     const double k = conv == LB_CONVENTION_ZERO ? -LB__LOCAL_ISO / nd->lp.zero_scale : 1.0;
     double *ov = lb__reg(regs, in->dst, 0), *ox = lb__reg(regs, in->dst, 1),
@@ -1050,7 +1051,7 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
     const uint32_t r0 = in->src[0], r1 = in->src[1];
     /* a chunk (spatially compact: the evaluator sorts points) that no
      * blending volume reaches skips the distance queries */
-    int reach = nd->family == LB__F_LOCAL && in->curves && in->curves->nseg;
+    int reach = (lb__op_flags(nd) & LB__R_CURVES) && in->curves && in->curves->nseg;
     if (reach && n) {
         double bc[3], br[3];
         points_box(x, y, z, n, bc, br);
@@ -1116,7 +1117,7 @@ static double ur_val(double a, double b) {
 
 void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv x[2],
                       const double bc[3], const double br[3], lb__iv *out) {
-    const lb__node *nd = in->op;
+    const lb__op *nd = in->op;
     const lb_convention conv = ev->conv;
     double lo[2], hi[2];
     if (!isfinite(x[0].lo) || !isfinite(x[0].hi) || !isfinite(x[1].lo) || !isfinite(x[1].hi)) {
@@ -1144,7 +1145,8 @@ void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv 
         double slope = fabs(gu[0]) * w0 + fabs(gu[1]) * w1;
         uint32_t c = 0;
         double Q[3], dist = 0.0;
-        const double a = nd->family == LB__F_LOCAL ? nearest(in->curves, bc, &c, Q, &dist) : 1.0;
+        const double a =
+            (lb__op_flags(nd) & LB__R_CURVES) ? nearest(in->curves, bc, &c, Q, &dist) : 1.0;
         if (a < 1.0) {
             const lb__component *P = &in->curves->comp[c];
             double dw, gm[3];
@@ -1175,7 +1177,7 @@ void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv 
         const double v2 = C + hypot(hi[0] - C, hi[1] - C);
         if (v2 > uhi) uhi = v2;
     }
-    if (nd->family == LB__F_LOCAL && lb__local_reaches(in->curves, bc, br)) {
+    if ((lb__op_flags(nd) & LB__R_CURVES) && lb__local_reaches(in->curves, bc, br)) {
         /* UB >= max, increasing in both: its largest value at the top corner */
         const struct lb__curves *Cv = in->curves;
         for (size_t c = 0; c < Cv->ncomp; ++c) {
@@ -1201,7 +1203,7 @@ size_t lb_evaluator_describe_local(const lb_evaluator *ev, char *buf, size_t siz
     if (!ev) return 0;
     for (size_t i = 0; i < ev->n; ++i) {
         const lb__instr *in = &ev->ins[i];
-        if (in->code != LB__I_OP || in->op->family != LB__F_LOCAL || !in->curves) continue;
+        if (in->code != LB__I_OP || !(lb__op_flags(in->op) & LB__R_CURVES) || !in->curves) continue;
         const struct lb__curves *C = in->curves;
         lb__text_put(&b, "%s: %zu intersection curve%s, %zu vertices\n", in->op->path, C->ncomp,
                      C->ncomp == 1 ? "" : "s", C->nv);
@@ -1225,7 +1227,7 @@ const struct lb__curves *lb__local_nth(const lb_evaluator *ev, size_t which) {
     size_t seen = 0;
     for (size_t i = 0; ev && i < ev->n; ++i) {
         const lb__instr *in = &ev->ins[i];
-        if (in->code == LB__I_OP && in->op->family == LB__F_LOCAL && seen++ == which)
+        if (in->code == LB__I_OP && (lb__op_flags(in->op) & LB__R_CURVES) && seen++ == which)
             return in->curves;
     }
     return NULL;

@@ -32,8 +32,9 @@ typedef struct lb__instr {
     lb_primitive prim;
     lb__affine A; /* world -> primitive frame (operators: -> the node's frame) */
     int identity;
-    /* operators: a copy of the node (args/bounds NULL) and source registers */
-    lb__node *op;
+    /* operators: the operator and its parameters (the tape's own copy) and
+     * source registers */
+    lb__op *op;
     uint32_t *src;  /* k argument registers, then k bounding registers (bounded) */
     uint32_t *srci; /* k argument instruction indices (bulge: prefix re-evaluation) */
     uint32_t *srcb; /* k bounding-solid instruction indices (bounded), else NULL */
@@ -43,7 +44,8 @@ typedef struct lb__instr {
     uint32_t ncone[2];
     double cost;               /* instruction runs per point, reruns included (the cost model) */
     struct lb__curves *curves; /* local_union: intersection curves, blending volumes */
-    const lb__node *node;      /* the scene node (compared, never followed: exports) */
+    const void *node;          /* the scene node it came from: an identity for the exports,
+                                  never followed */
     int fast;                  /* LB__FAST_* */
     int mode;                  /* exponent mode for the fast kernels */
     double lip;                /* primitives: Lipschitz factor of rho in the primitive frame */
@@ -65,11 +67,6 @@ struct lb_evaluator {
     double cost;         /* instruction runs per point for the whole tape (the cost model) */
     double compile_cost; /* instruction runs the local unions' curve finding took */
 };
-
-/* An interval. */
-typedef struct lb__iv {
-    double lo, hi;
-} lb__iv;
 
 /* What one box needs (argument culling, libfive-style tape specialisation):
  * need[i] says whether instruction i contributes to the root anywhere in the
@@ -205,6 +202,12 @@ LB_INTERNAL void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, c
 /* The reference walk (lb_scene_eval_reference) that also walks local
  * unions: inside their blending volumes it takes the curves ev (compiled
  * from s) found, by brute force over every segment (tests). */
+/* the reference walk of one node (reference.c): Ap maps world
+ * coordinates to the node's parent frame; ev is needed for local_union */
+LB_INTERNAL lb_status lb__ref_eval(const lb__node *n, lb_convention conv, const lb__affine *Ap,
+                                   const lb_evaluator *ev, const double X[3], double *v,
+                                   double g[3], lb_error *err);
+
 LB_INTERNAL lb_status lb__scene_eval_walk(const lb_scene *s, const lb_evaluator *ev,
                                           const double X[3], double *value, double grad[3],
                                           lb_error *err);

@@ -85,12 +85,12 @@ typedef struct pctx {
  * subtrees are written once per world frame they are used in, because each
  * use has blending volumes of its own. */
 static int has_local(pctx *c, const lb__node *n) {
-    if (n->family == LB__F_LOCAL) return 1;
-    if (n->family == LB__F_PRIMITIVE) return 0;
+    if ((lb__op_flags(&n->o) & LB__R_CURVES)) return 1;
+    if (n->o.family == LB__F_PRIMITIVE) return 0;
     for (size_t i = 0; i < c->nl; ++i)
         if (c->lnodes[i] == n) return c->lflag[i];
     int f = 0;
-    for (size_t i = 0; i < n->k && !f; ++i)
+    for (size_t i = 0; i < n->o.k && !f; ++i)
         f = has_local(c, n->args[i]) || (n->bounds && has_local(c, n->bounds[i]));
     if (c->nl == c->lcap) {
         const size_t nc = c->lcap ? 2 * c->lcap : 64;
@@ -225,7 +225,7 @@ static int affine_invert(const lb__affine *A, lb__affine *I) {
 static lb_status emit_local(pctx *c, const lb__node *n, int id, const char *name, int a, int d) {
     sbuf *b = c->b;
     const int zero = c->sc->convention == LB_CONVENTION_ZERO;
-    const double S = n->lp.zero_scale, *al = n->lp.alpha;
+    const double S = n->o.lp.zero_scale, *al = n->o.lp.alpha;
     char in1[128], in2[128];
     if (zero) {
         snprintf(in1, sizeof in1, "0.5 * (1 - LBn%d(x, y, z) / %.17g)", a, S);
@@ -236,17 +236,17 @@ static lb_status emit_local(pctx *c, const lb__node *n, int id, const char *name
     }
     /* this use's instruction: the node in this world frame */
     const lb__instr *ins = NULL;
-    for (size_t i = 0; n->family == LB__F_LOCAL && c->ev && i < c->ev->n && !ins; ++i) {
+    for (size_t i = 0; (lb__op_flags(&n->o) & LB__R_CURVES) && c->ev && i < c->ev->n && !ins; ++i) {
         const lb__instr *q = &c->ev->ins[i];
         if (q->code == LB__I_OP && q->node == n && memcmp(&q->A, &c->A, sizeof c->A) == 0) ins = q;
     }
-    if (n->family == LB__F_LOCAL && !ins)
+    if ((lb__op_flags(&n->o) & LB__R_CURVES) && !ins)
         return lb__fail(c->err, LB_ERR_INTERNAL,
                         "%s: %s: the evaluator has no instruction for this "
                         "use of the local union (was ev compiled from this scene?)",
                         FN, n->path);
     const struct lb__curves *C = ins ? ins->curves : NULL;
-    if (n->family == LB__F_LOCAL)
+    if ((lb__op_flags(&n->o) & LB__R_CURVES))
         sb(b, "// %s: local union, %zu blending volume%s\n", n->path[0] ? n->path : "root",
            C ? C->ncomp : 0, C && C->ncomp == 1 ? "" : "s");
     if (!C || !C->nseg) { /* no intersection: the clean union everywhere */
@@ -265,7 +265,7 @@ static lb_status emit_local(pctx *c, const lb__node *n, int id, const char *name
         sb(b,
            "#declare LBk%d_%zu = function(x, y, z, lbLg1, lbLg2, lbLa, lbLp, lbLq, lbLuc) { "
            "lb_local_at(lbLg1, lbLg2, lbLa, lbLp, lbLq, %.17g, lbLuc) }\n",
-           id, K, n->lp.exponent);
+           id, K, n->o.lp.exponent);
         for (size_t k = K; k-- > 0;) {
             int root = -1;
             if (bvh_has(C, 0, k)) bvh_emit(c, C, 0, k, id, &next, &root);
@@ -358,158 +358,174 @@ static lb_status emit(pctx *c, const lb__node *n, int *out) {
     return c->b->oom ? lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN) : LB_OK;
 }
 
+/* a primitive: its include function, with its kernel (soft) */
+static void emit_primitive(sbuf *b, const lb__node *n, int id, const char *name) {
+    const lb_primitive *P = &n->prim;
+    const char *base = P->kernel == LB_KERNEL_NONE ? name : "LBr";
+    sb(b, "#declare %s%d = ", base, id);
+    switch (P->kind) {
+    case LB_PRIM_ELLIPSOID:
+        sb(b, "LB_Ellipsoid(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>)\n", P->c[0], P->c[1],
+           P->c[2], P->a[0], P->a[1], P->a[2]);
+        break;
+    case LB_PRIM_LP:
+        sb(b, "LB_LP(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0], P->c[1],
+           P->c[2], P->a[0], P->a[1], P->a[2], P->s0);
+        break;
+    case LB_PRIM_SUPERQUADRIC:
+        sb(b, "LB_Superquadric(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g, %.17g)\n",
+           P->c[0], P->c[1], P->c[2], P->a[0], P->a[1], P->a[2], P->s0, P->s1);
+        break;
+    case LB_PRIM_SLAB:
+    case LB_PRIM_HALFSPACE:
+        sb(b, "%s(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n",
+           P->kind == LB_PRIM_SLAB ? "LB_Slab" : "LB_Halfspace", P->c[0], P->c[1], P->c[2], P->n[0],
+           P->n[1], P->n[2], P->s0);
+        break;
+    case LB_PRIM_CYLINDER:
+        sb(b, "LB_Cylinder(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0],
+           P->c[1], P->c[2], P->n[0], P->n[1], P->n[2], P->s0);
+        break;
+    case LB_PRIM_CAPSULE:
+        sb(b, "LB_Capsule(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0], P->c[1],
+           P->c[2], P->q[0], P->q[1], P->q[2], P->s0);
+        break;
+    case LB_PRIM_TORUS:
+        sb(b, "LB_Torus(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g, %.17g)\n", P->c[0],
+           P->c[1], P->c[2], P->n[0], P->n[1], P->n[2], P->s0, P->s1);
+        break;
+    }
+    if (P->kernel != LB_KERNEL_NONE)
+        sb(b, "#declare %s%d = function(x, y, z) { %s(LBr%d(x, y, z) + 1) }\n", name, id,
+           P->kernel == LB_KERNEL_WYVILL ? "LB_Wyvill" : "LB_Blinn", id);
+}
+
+/* the row's parameters in the include's order, r, p, m (the row's scalar
+ * parameter in its key's place, or last) */
+static void emit_params(sbuf *b, const lb__family_row *row, const lb__node *n) {
+    static const char *const order[] = {"r", "p", "m"};
+    const double *const arrays[] = {n->o.r, n->o.p, n->o.m};
+    int shape_done = 0;
+    for (int i = 0; i < 3; ++i) {
+        const lb__param *p = lb__family_param(row, order[i]);
+        if (p) {
+            sb(b, ", ");
+            arr(b, n->o.k, arrays[i], p->def);
+        } else if (row->shape && strcmp(row->shape->key, order[i]) == 0) {
+            sb(b, ", %.17g", n->o.shape);
+            shape_done = 1;
+        }
+    }
+    if (row->shape && !shape_done) sb(b, ", %.17g", n->o.shape);
+}
+
+/* an operator written with a macro of the include (LB__POV_MACRO): a
+ * binary one takes its two argument functions, a k-ary one arrays */
+static lb_status emit_macro(pctx *c, const lb__family_row *row, const lb__node *n, int id,
+                            const char *name) {
+    sbuf *b = c->b;
+    lb_status s;
+    const char *macro = row->pov[1] ? row->pov[n->o.op] : row->pov[0];
+    const int with_op = row->ops && !row->pov[1];
+    if (row->kmin == 2 && row->kmax == 2) {
+        int a, d;
+        if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
+        sb(b, "#declare %s%d = %s(", name, id, macro);
+        if (with_op) sb(b, "%d, ", (int)n->o.op);
+        sb(b, "LBn%d, LBn%d", a, d);
+    } else {
+        if ((s = emit_array(c, n->o.k, n->args, 'a', id))) return s;
+        if ((row->flags & LB__R_BOUNDING) && (s = emit_array(c, n->o.k, n->bounds, 'c', id)))
+            return s;
+        sb(b, "#declare %s%d = %s(", name, id, macro);
+        if (with_op) sb(b, "%d, ", (int)n->o.op);
+        sb(b, "LBa%d", id);
+        if (row->flags & LB__R_BOUNDING) sb(b, ", LBc%d", id);
+    }
+    emit_params(b, row, n);
+    sb(b, ")\n");
+    return LB_OK;
+}
+
+/* an operator written out in SDL (min, max, complement, level, a
+ * transformed ref) */
+static lb_status emit_inline(pctx *c, const lb__family_row *row, const lb__node *n, int id,
+                             const char *name) {
+    sbuf *b = c->b;
+    lb_status s;
+    const int zero = c->sc->convention == LB_CONVENTION_ZERO;
+    int a;
+    if (row->pov_form == LB__POV_SELECT) {
+        int *ids;
+        if ((s = emit_list(c, n->o.k, n->args, &ids))) return s;
+        sb(b, "#declare %s%d = function(x, y, z) { %s(", name, id, row->pov[0]);
+        for (size_t i = 0; i < n->o.k; ++i) sb(b, "%sLBn%d(x, y, z)", i ? ", " : "", ids[i]);
+        /* POV-Ray's min and max take two or more */
+        sb(b, "%s) }\n", n->o.k > 1 ? "" : row->select > 0 ? ", 1e300" : ", -1e300");
+        free(ids);
+        return LB_OK;
+    }
+    if ((s = emit(c, n->args[0], &a))) return s;
+    if (row->pov_form == LB__POV_GROUP)
+        sb(b, "#declare %s%d = LBn%d;\n", name, id, a);
+    else if (row->pov_form == LB__POV_COMPLEMENT && zero)
+        sb(b, "#declare %s%d = function(x, y, z) { -LBn%d(x, y, z) }\n", name, id, a);
+    else if (row->pov_form == LB__POV_COMPLEMENT)
+        sb(b, "#declare %s%d = function(x, y, z) { max(0, 1 - LBn%d(x, y, z)) }\n", name, id, a);
+    else if (zero)
+        sb(b, "#declare %s%d = function(x, y, z) { LBn%d(x, y, z) - %.17g }\n", name, id, a,
+           n->o.shape);
+    else
+        sb(b, "#declare %s%d = function(x, y, z) { max(0, LBn%d(x, y, z) - %.17g) }\n", name, id, a,
+           n->o.shape - 0.5);
+    return LB_OK;
+}
+
+/* bulge elimination: the include's LB_Bulge over the family's operator */
+static lb_status emit_bulge(pctx *c, const lb__family_row *row, const lb__node *n, int id,
+                            const char *name) {
+    int a, d;
+    lb_status s;
+    if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
+    const lb_bulge_params *bp = &n->o.bp;
+    sb(c->b,
+       "#declare %s%d = LB_Bulge(%d, %d, LBn%d, LBn%d, array[2] {%.17g, %.17g}, array[2] "
+       "{%.17g, %.17g}, %.17g, array[2] {%.17g, %.17g}, %u, %.17g, %.17g)\n",
+       name, id, row->bulge_family, (int)n->o.op, a, d, bp->r[0], bp->r[1], bp->p[0], bp->p[1],
+       bp->conic_p, bp->m[0], bp->m[1], bp->flags, bp->omega, c->eps);
+    return LB_OK;
+}
+
 static lb_status emit_node(pctx *c, const lb__node *n, int id) {
     sbuf *b = c->b;
     const char *name = n->has_transform ? "LBl" : "LBn";
+    const lb__family_row *row = lb__family_info(n->o.family);
     /* LB_Displacement takes any k (past 16 it re-evaluates its arguments per
-     * step); these three are limited to the include's 16 */
-    const int k16 =
-        n->family == LB__F_SCALE || n->family == LB__F_BOUNDED || n->family == LB__F_SOFT_HYPER;
-    if (k16 && n->k > LB_POV_MAX_ARITY)
+     * step); the LB__R_POV16 rows are limited to the include's 16 */
+    if ((row->flags & LB__R_POV16) && n->o.k > LB_POV_MAX_ARITY)
         return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
                         "%s: %s: a %s blend of %zu arguments; allowed in POV-Ray: at most %d "
                         "(the include's limit; POV-Ray functions take at most 56 parameters)",
-                        FN, n->path, n->type, n->k, LB_POV_MAX_ARITY);
-    if (n->k > LB_MAX_ARITY)
+                        FN, n->path, n->type, n->o.k, LB_POV_MAX_ARITY);
+    if (n->o.k > LB_MAX_ARITY)
         return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
                         "%s: %s: a %s node of %zu arguments; allowed in POV-Ray: at most %d (the "
                         "include's functions run every argument at every point); mesh the scene "
                         "instead (blendtool mesh)",
-                        FN, n->path, n->type, n->k, LB_MAX_ARITY);
+                        FN, n->path, n->type, n->o.k, LB_MAX_ARITY);
     lb_status s = LB_OK;
-    if (n->family == LB__F_PRIMITIVE) {
-        const lb_primitive *P = &n->prim;
-        const char *base = P->kernel == LB_KERNEL_NONE ? name : "LBr";
-        sb(b, "#declare %s%d = ", base, id);
-        switch (P->kind) {
-        case LB_PRIM_ELLIPSOID:
-            sb(b, "LB_Ellipsoid(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>)\n", P->c[0], P->c[1],
-               P->c[2], P->a[0], P->a[1], P->a[2]);
-            break;
-        case LB_PRIM_LP:
-            sb(b, "LB_LP(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0], P->c[1],
-               P->c[2], P->a[0], P->a[1], P->a[2], P->s0);
-            break;
-        case LB_PRIM_SUPERQUADRIC:
-            sb(b, "LB_Superquadric(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g, %.17g)\n",
-               P->c[0], P->c[1], P->c[2], P->a[0], P->a[1], P->a[2], P->s0, P->s1);
-            break;
-        case LB_PRIM_SLAB:
-        case LB_PRIM_HALFSPACE:
-            sb(b, "%s(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n",
-               P->kind == LB_PRIM_SLAB ? "LB_Slab" : "LB_Halfspace", P->c[0], P->c[1], P->c[2],
-               P->n[0], P->n[1], P->n[2], P->s0);
-            break;
-        case LB_PRIM_CYLINDER:
-            sb(b, "LB_Cylinder(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0],
-               P->c[1], P->c[2], P->n[0], P->n[1], P->n[2], P->s0);
-            break;
-        case LB_PRIM_CAPSULE:
-            sb(b, "LB_Capsule(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g)\n", P->c[0],
-               P->c[1], P->c[2], P->q[0], P->q[1], P->q[2], P->s0);
-            break;
-        case LB_PRIM_TORUS:
-            sb(b, "LB_Torus(<%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g>, %.17g, %.17g)\n", P->c[0],
-               P->c[1], P->c[2], P->n[0], P->n[1], P->n[2], P->s0, P->s1);
-            break;
-        }
-        if (P->kernel != LB_KERNEL_NONE)
-            sb(b, "#declare %s%d = function(x, y, z) { %s(LBr%d(x, y, z) + 1) }\n", name, id,
-               P->kernel == LB_KERNEL_WYVILL ? "LB_Wyvill" : "LB_Blinn", id);
-    } else if (n->family == LB__F_LOCAL || n->family == LB__F_CLEAN) {
+    if (n->o.family == LB__F_PRIMITIVE) {
+        emit_primitive(b, n, id, name);
+    } else if (row->pov_form == LB__POV_LOCAL) {
         int a, d;
         if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
         if ((s = emit_local(c, n, id, name, a, d))) return s;
-    } else if (n->family == LB__F_GROUP) {
-        int a;
-        if ((s = emit(c, n->args[0], &a))) return s;
-        sb(b, "#declare %s%d = LBn%d;\n", name, id, a);
-    } else if (n->family == LB__F_MIN || n->family == LB__F_MAX) {
-        int *ids;
-        if ((s = emit_list(c, n->k, n->args, &ids))) return s;
-        sb(b, "#declare %s%d = function(x, y, z) { %s(", name, id,
-           n->family == LB__F_MIN ? "min" : "max");
-        for (size_t i = 0; i < n->k; ++i) sb(b, "%sLBn%d(x, y, z)", i ? ", " : "", ids[i]);
-        sb(b, "%s) }\n", n->k > 1 ? "" : n->family == LB__F_MIN ? ", 1e300" : ", -1e300");
-        free(ids);
-    } else if (n->family == LB__F_COMPLEMENT) {
-        int a;
-        if ((s = emit(c, n->args[0], &a))) return s;
-        if (c->sc->convention == LB_CONVENTION_ZERO)
-            sb(b, "#declare %s%d = function(x, y, z) { -LBn%d(x, y, z) }\n", name, id, a);
-        else
-            sb(b, "#declare %s%d = function(x, y, z) { max(0, 1 - LBn%d(x, y, z)) }\n", name, id,
-               a);
-    } else if (n->family == LB__F_LEVEL) {
-        int a;
-        if ((s = emit(c, n->args[0], &a))) return s;
-        if (c->sc->convention == LB_CONVENTION_ZERO)
-            sb(b, "#declare %s%d = function(x, y, z) { LBn%d(x, y, z) - %.17g }\n", name, id, a,
-               n->shape);
-        else
-            sb(b, "#declare %s%d = function(x, y, z) { max(0, LBn%d(x, y, z) - %.17g) }\n", name,
-               id, a, n->shape - 0.5);
-    } else if (n->family == LB__F_RFUNCTION) {
-        int a, d;
-        if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
-        sb(b, "#declare %s%d = %s(LBn%d, LBn%d)\n", name, id,
-           n->op == LB_UNION ? "LB_RUnion" : "LB_RIntersection", a, d);
-    } else if (n->bulge) {
-        int a, d;
-        if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
-        const lb_bulge_params *bp = &n->bp;
-        const int fam = n->family == LB__F_DISPLACEMENT ? 0 : n->family == LB__F_CONIC ? 1 : 2;
-        sb(b,
-           "#declare %s%d = LB_Bulge(%d, %d, LBn%d, LBn%d, array[2] {%.17g, %.17g}, array[2] "
-           "{%.17g, %.17g}, %.17g, array[2] {%.17g, %.17g}, %u, %.17g, %.17g)\n",
-           name, id, fam, (int)n->op, a, d, bp->r[0], bp->r[1], bp->p[0], bp->p[1], bp->conic_p,
-           bp->m[0], bp->m[1], bp->flags, bp->omega, c->eps);
-    } else if (n->family == LB__F_CONIC || n->family == LB__F_SOFT_CONIC) {
-        int a, d;
-        if ((s = emit(c, n->args[0], &a)) || (s = emit(c, n->args[1], &d))) return s;
-        sb(b, "#declare %s%d = %s(%d, LBn%d, LBn%d, ", name, id,
-           n->family == LB__F_CONIC ? "LB_Conic" : "LB_SoftConic", (int)n->op, a, d);
-        arr(b, 2, n->r, 1.0);
-        sb(b, ", %.17g, ", n->shape);
-        arr(b, 2, n->m, 1.0);
-        sb(b, ")\n");
-    } else {
-        if ((s = emit_array(c, n->k, n->args, 'a', id))) return s;
-        if (n->family == LB__F_BOUNDED) {
-            if ((s = emit_array(c, n->k, n->bounds, 'c', id))) return s;
-            sb(b, "#declare %s%d = LB_Bounded(%d, LBa%d, LBc%d, ", name, id, (int)n->op, id, id);
-            arr(b, n->k, n->p, 2.0);
-            sb(b, ")\n");
-        } else if (n->family == LB__F_DISPLACEMENT || n->family == LB__F_SOFT_HYPER) {
-            sb(b, "#declare %s%d = %s(%d, LBa%d, ", name, id,
-               n->family == LB__F_DISPLACEMENT ? "LB_Displacement" : "LB_SoftHyper", (int)n->op,
-               id);
-            arr(b, n->k, n->r, 1.0);
-            sb(b, ", ");
-            arr(b, n->k, n->p, 2.0);
-            sb(b, ", ");
-            arr(b, n->k, n->m, 1.0);
-            sb(b, ")\n");
-        } else if (n->family == LB__F_SCALE) {
-            sb(b, "#declare %s%d = LB_Scale(%d, LBa%d, ", name, id, (int)n->op, id);
-            arr(b, n->k, n->r, 1.0);
-            sb(b, ", ");
-            arr(b, n->k, n->p, 2.0);
-            sb(b, ")\n");
-        } else if (n->family == LB__F_SOFT_SUM) {
-            sb(b, "#declare %s%d = LB_SoftSum(LBa%d)\n", name, id, id);
-        } else if (n->family == LB__F_RICCI) {
-            sb(b, "#declare %s%d = LB_Ricci(LBa%d, %.17g)\n", name, id, id, n->shape);
-        } else if (n->family == LB__F_PERLIN) {
-            sb(b, "#declare %s%d = %s(LBa%d)\n", name, id,
-               n->op == LB_UNION          ? "LB_PerlinUnion"
-               : n->op == LB_INTERSECTION ? "LB_PerlinIntersection"
-                                          : "LB_PerlinDifference",
-               id);
-        } else {
-            return lb__fail(c->err, LB_ERR_INTERNAL, "%s: %s: no POV-Ray form for %s", FN, n->path,
-                            n->type);
-        }
+    } else if (n->o.bulge) {
+        if ((s = emit_bulge(c, row, n, id, name))) return s;
+    } else if (row->pov_form == LB__POV_MACRO) {
+        if ((s = emit_macro(c, row, n, id, name))) return s;
+    } else if ((s = emit_inline(c, row, n, id, name))) {
+        return s;
     }
     if (n->has_transform) {
         sb(b, "#declare LBn%d = function(x, y, z) { LBl%d(", id, id);
@@ -531,7 +547,7 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
 
 static void score_expr(pctx *c, const lb__node *n, size_t i, int fid, const lb__affine *A) {
     double sign, off;
-    lb__material_score(n, c->sc->convention, i, &sign, &off);
+    lb__material_score(&n->o, c->sc->convention, i, &sign, &off);
     sb(c->b, "%s%sLBn%d(", off != 0.0 ? "1" : "", sign < 0 ? "-" : off != 0.0 ? "+" : "", fid);
     if (lb__affine_is_identity(A))
         sb(c->b, "x, y, z");
@@ -544,9 +560,9 @@ static void score_expr(pctx *c, const lb__node *n, size_t i, int fid, const lb__
 static void group_expr(pctx *c, const lb__node *n, const int *group, int g, const int *fid,
                        const lb__affine *A) {
     int count = 0;
-    for (size_t i = 0; i < n->k; ++i) count += group[i] == g;
+    for (size_t i = 0; i < n->o.k; ++i) count += group[i] == g;
     if (count > 1) sb(c->b, "min(");
-    for (size_t i = 0, w = 0; i < n->k; ++i)
+    for (size_t i = 0, w = 0; i < n->o.k; ++i)
         if (group[i] == g) {
             if (w++) sb(c->b, ", ");
             score_expr(c, n, i, fid[i], A);
@@ -564,8 +580,8 @@ static lb_status tex(pctx *c, const lb__node *n, const lb__affine *Ap, size_t in
     }
     lb__affine A = *Ap;
     if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
-    if (n->k == 1) return tex(c, n->args[0], &A, eff, name);
-    const size_t k = n->k;
+    if (n->o.k == 1) return tex(c, n->args[0], &A, eff, name);
+    const size_t k = n->o.k;
     char(*sub)[24] = malloc(k * sizeof *sub);
     int *fid = malloc(2 * k * sizeof *fid), *group = fid ? fid + k : NULL;
     lb_status s = sub && fid ? LB_OK : lb__fail(c->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);

@@ -32,7 +32,7 @@ static lb__node *new_node(pctx *c, lb__family fam, const char *type) {
         return NULL;
     }
     memcpy(n->path, c->path, c->plen + 1);
-    n->family = fam;
+    n->o.family = fam;
     n->type = type;
     n->depth = 1;
     lb__affine_identity(&n->to_local);
@@ -148,100 +148,66 @@ static lb_status get_transform(pctx *c, const cJSON *obj, lb__node *n) {
     return LB_OK;
 }
 
-/* ---- type table ---- */
+/* ---- the registry's lists, in words (only for messages) ---- */
 
 /* keys every node takes: its transform and its material */
-#define TRANSFORM_KEYS "translate", "rotate", "scale", "material"
+#define TRANSFORM_KEYS LB__TRANSFORM_KEYS
 
-typedef struct type_info {
-    const char *name;
-    lb__family family;
-    int prim_kind; /* primitives */
-    int conv;      /* bit 1: zero, bit 2: soft */
-    int has_op;    /* 1: union/intersection/difference; 2: union/intersection only */
-    size_t kmin, kmax;
-    const char *const *keys;
-} type_info;
+/* every type a scene names, in the registry's order */
+static void type_list(char *buf, size_t size) {
+    size_t np = 0, len = 0;
+    const lb__primitive_row *P = lb__primitive_rows(&np);
+    buf[0] = '\0';
+    for (size_t i = 0; i < np; ++i)
+        len += (size_t)snprintf(buf + len, size - len, "%s, ", P[i].name);
+    for (int f = 1; f < LB__F_COUNT && len < size; ++f) {
+        const lb__family_row *row = lb__family_info((lb__family)f);
+        if (!(row->flags & LB__R_NO_PARSE))
+            len += (size_t)snprintf(buf + len, size - len, "%s, ", row->name);
+    }
+    if (len >= 2 && len < size) snprintf(buf + len - 2, size - len + 2, " (or {\"ref\": NAME})");
+}
 
-static const char *const k_sphere[] = {"type", "center", "radius", "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_ellipsoid[] = {"type",   "center",       "semi_axes",
-                                          "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_lp[] = {"type",   "center",       "semi_axes", "exponent",
-                                   "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_superquadric[] = {"type", "center", "semi_axes",    "e1",
-                                             "e2",   "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_slab[] = {"type",   "point",        "normal", "half_width",
-                                     "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_halfspace[] = {"type",   "point",        "normal", "width",
-                                          "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_cylinder[] = {"type",   "point",        "axis", "radius",
-                                         "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_capsule[] = {"type",   "start",        "end", "radius",
-                                        "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_torus[] = {"type",         "center", "axis",         "major_radius",
-                                      "minor_radius", "kernel", TRANSFORM_KEYS, NULL};
-static const char *const k_displacement[] = {"type", "op",    "args",         "r", "p",
-                                             "m",    "bulge", TRANSFORM_KEYS, NULL};
-static const char *const k_scale[] = {"type", "op",    "args",         "r",
-                                      "p",    "bulge", TRANSFORM_KEYS, NULL};
-static const char *const k_bounded[] = {"type", "op", "args", "bounds", "p", TRANSFORM_KEYS, NULL};
-static const char *const k_soft[] = {"type", "op", "args", "r", "p", "m", TRANSFORM_KEYS, NULL};
-static const char *const k_args[] = {"type", "args", TRANSFORM_KEYS, NULL};
-static const char *const k_opargs[] = {"type", "op", "args", TRANSFORM_KEYS, NULL};
-static const char *const k_ricci[] = {"type", "args", "n", TRANSFORM_KEYS, NULL};
-static const char *const k_level[] = {"type", "args", "level", TRANSFORM_KEYS, NULL};
-static const char *const k_local[] = {"type",   "args",       "feature_size",   "limits",
-                                      "radius", "support",    "support_factor", "exponent",
-                                      "alpha",  "zero_scale", TRANSFORM_KEYS,   NULL};
-static const char *const k_clean[] = {"type", "args", "alpha", "zero_scale", TRANSFORM_KEYS, NULL};
+/* the operators of one convention (bit), or those that take up to
+ * LB_MAX_ARITY_WIDE arguments (bit 0) */
+static int listed(const lb__family_row *row, int bit) {
+    return !(row->flags & LB__R_NO_PARSE) &&
+           (bit ? (row->conv & bit) != 0 : row->kmax == LB_MAX_ARITY_WIDE);
+}
+static void row_list(int bit, char *buf, size_t size) {
+    size_t len = 0, n = 0, count = 0;
+    for (int f = 1; f < LB__F_COUNT; ++f) count += listed(lb__family_info((lb__family)f), bit);
+    buf[0] = '\0';
+    for (int f = 1; f < LB__F_COUNT && len < size; ++f) {
+        const lb__family_row *row = lb__family_info((lb__family)f);
+        if (!listed(row, bit)) continue;
+        ++n;
+        const char *sep = n == 1 ? "" : !bit && n == count ? " and " : ", ";
+        len += (size_t)snprintf(buf + len, size - len, "%s%s", sep, row->name);
+    }
+}
 
-enum { CONV_ZERO = 1, CONV_SOFT = 2, CONV_BOTH = 3 };
-
-static const type_info TYPES[] = {
-    {"sphere", LB__F_PRIMITIVE, LB_PRIM_ELLIPSOID, CONV_BOTH, 0, 0, 0, k_sphere},
-    {"ellipsoid", LB__F_PRIMITIVE, LB_PRIM_ELLIPSOID, CONV_BOTH, 0, 0, 0, k_ellipsoid},
-    {"lp", LB__F_PRIMITIVE, LB_PRIM_LP, CONV_BOTH, 0, 0, 0, k_lp},
-    {"superquadric", LB__F_PRIMITIVE, LB_PRIM_SUPERQUADRIC, CONV_BOTH, 0, 0, 0, k_superquadric},
-    {"slab", LB__F_PRIMITIVE, LB_PRIM_SLAB, CONV_BOTH, 0, 0, 0, k_slab},
-    {"halfspace", LB__F_PRIMITIVE, LB_PRIM_HALFSPACE, CONV_BOTH, 0, 0, 0, k_halfspace},
-    {"cylinder", LB__F_PRIMITIVE, LB_PRIM_CYLINDER, CONV_BOTH, 0, 0, 0, k_cylinder},
-    {"capsule", LB__F_PRIMITIVE, LB_PRIM_CAPSULE, CONV_BOTH, 0, 0, 0, k_capsule},
-    {"torus", LB__F_PRIMITIVE, LB_PRIM_TORUS, CONV_BOTH, 0, 0, 0, k_torus},
-    {"displacement", LB__F_DISPLACEMENT, 0, CONV_ZERO, 1, 1, LB_MAX_ARITY_WIDE, k_displacement},
-    {"conic", LB__F_CONIC, 0, CONV_ZERO, 1, 2, 2, k_displacement},
-    {"scale", LB__F_SCALE, 0, CONV_ZERO, 1, 1, LB_MAX_ARITY, k_scale},
-    {"bounded", LB__F_BOUNDED, 0, CONV_ZERO, 1, 1, LB_MAX_ARITY, k_bounded},
-    {"soft_hyper", LB__F_SOFT_HYPER, 0, CONV_SOFT, 1, 1, LB_MAX_ARITY, k_soft},
-    {"soft_conic", LB__F_SOFT_CONIC, 0, CONV_SOFT, 1, 2, 2, k_soft},
-    {"min", LB__F_MIN, 0, CONV_BOTH, 0, 1, LB_MAX_ARITY_WIDE, k_args},
-    {"max", LB__F_MAX, 0, CONV_BOTH, 0, 1, LB_MAX_ARITY_WIDE, k_args},
-    {"rfunction", LB__F_RFUNCTION, 0, CONV_ZERO, 2, 2, 2, k_opargs},
-    {"soft_sum", LB__F_SOFT_SUM, 0, CONV_SOFT, 0, 1, LB_MAX_ARITY_WIDE, k_args},
-    {"ricci", LB__F_RICCI, 0, CONV_SOFT, 0, 1, LB_MAX_ARITY_WIDE, k_ricci},
-    {"perlin", LB__F_PERLIN, 0, CONV_SOFT, 1, 1, LB_MAX_ARITY, k_opargs},
-    {"complement", LB__F_COMPLEMENT, 0, CONV_BOTH, 0, 1, 1, k_args},
-    {"local_union", LB__F_LOCAL, 0, CONV_BOTH, 0, 2, LB_MAX_ARITY, k_local},
-    {"clean_union", LB__F_CLEAN, 0, CONV_BOTH, 0, 2, LB_MAX_ARITY, k_clean},
-    {"level", LB__F_LEVEL, 0, CONV_BOTH, 0, 1, 1, k_level},
-};
-#define NTYPES (sizeof TYPES / sizeof TYPES[0])
-
-static const char TYPE_LIST[] =
-    "sphere, ellipsoid, lp, superquadric, slab, halfspace, cylinder, capsule, torus, "
-    "displacement, conic, scale, bounded, soft_hyper, soft_conic, min, max, rfunction, "
-    "soft_sum, ricci, perlin, complement, local_union, clean_union, level (or {\"ref\": "
-    "NAME})";
+/* the row's keys (and more, may be NULL) and every node's, NULL-terminated,
+ * into keys (32) */
+static void node_keys(const char *const *own, const char *const *more, const char **keys) {
+    static const char *const common[] = {TRANSFORM_KEYS, NULL};
+    size_t n = 0;
+    for (const char *const *k = own; *k && n < 20; ++k) keys[n++] = *k;
+    for (const char *const *k = more; k && *k && n < 24; ++k) keys[n++] = *k;
+    for (const char *const *k = common; *k; ++k) keys[n++] = *k;
+    keys[n] = NULL;
+}
 
 /* ---- primitives ---- */
 
-static lb_status parse_primitive(pctx *c, const cJSON *j, const type_info *t, lb__node *n) {
+static lb_status parse_primitive(pctx *c, const cJSON *j, const lb__primitive_row *t, lb__node *n) {
     double ctr[3] = {0, 0, 0}, a[3] = {1, 1, 1}, nv[3] = {0, 0, 1}, q[3] = {0, 0, 0};
     double s0 = 1.0, s1 = 1.0;
     const double CMAX = LB_SCENE_MAX_COORD;
     const char *len_ok = "1e-9 <= value <= 1e9 (a length)";
     lb_status s = LB_OK;
     lb_error perr_local = {LB_OK, ""};
-    switch ((lb_primitive_kind)t->prim_kind) {
+    switch (t->kind) {
     case LB_PRIM_ELLIPSOID:
         if ((s = lb__get_vec3(c, j, "center", 0, -CMAX, CMAX, "|value| <= 1e9", ctr))) return s;
         if (strcmp(t->name, "sphere") == 0) {
@@ -269,7 +235,7 @@ static lb_status parse_primitive(pctx *c, const cJSON *j, const type_info *t, lb
         break;
     case LB_PRIM_SLAB:
     case LB_PRIM_HALFSPACE: {
-        const int slab = t->prim_kind == LB_PRIM_SLAB;
+        const int slab = t->kind == LB_PRIM_SLAB;
         if ((s = lb__get_vec3(c, j, "point", 0, -CMAX, CMAX, "|value| <= 1e9", ctr)) ||
             (s = lb__get_vec3(c, j, "normal", 1, -1e9, 1e9, "a non-zero vector", nv)) ||
             (s = lb__get_number(c, j, slab ? "half_width" : "width", 1, 1e-9, 1e9, len_ok, &s0)))
@@ -430,7 +396,7 @@ static lb_status parse_ref(pctx *c, const cJSON *j, size_t depth, lb__node **out
     /* a ref with its own transform or material is a group over the def */
     lb__node *g = new_node(c, LB__F_GROUP, "ref");
     if (!g) return lb__oom(c);
-    g->k = 1;
+    g->o.k = 1;
     g->args = malloc(sizeof *g->args);
     if (!g->args) return lb__oom(c);
     g->args[0] = target;
@@ -446,17 +412,18 @@ static lb_status parse_ref(pctx *c, const cJSON *j, size_t depth, lb__node **out
     return LB_OK;
 }
 
-static lb_status parse_args(pctx *c, const cJSON *j, const char *key, const type_info *t,
-                            size_t depth, lb__node ***out, size_t *k_out) {
+static lb_status parse_args(pctx *c, const cJSON *j, const char *key, const lb__family_row *t,
+                            size_t kmin, size_t kmax, size_t depth, lb__node ***out,
+                            size_t *k_out) {
     const cJSON *a = cJSON_GetObjectItemCaseSensitive(j, key);
     const size_t old = lb__push_key(c, key);
     lb_status s = LB_OK;
     char allowed[96];
-    if (t->kmin == t->kmax)
-        snprintf(allowed, sizeof allowed, "an array of exactly %zu node%s", t->kmin,
-                 t->kmin == 1 ? "" : "s");
+    if (kmin == kmax)
+        snprintf(allowed, sizeof allowed, "an array of exactly %zu node%s", kmin,
+                 kmin == 1 ? "" : "s");
     else
-        snprintf(allowed, sizeof allowed, "an array of %zu to %zu nodes", t->kmin, t->kmax);
+        snprintf(allowed, sizeof allowed, "an array of %zu to %zu nodes", kmin, kmax);
     if (!a) {
         s = lb__perr(c, LB_ERR_INVALID_ARGUMENT, "missing required field; allowed: %s", allowed);
     } else if (!cJSON_IsArray(a)) {
@@ -464,13 +431,16 @@ static lb_status parse_args(pctx *c, const cJSON *j, const char *key, const type
                      lb__json_kind(a), allowed);
     } else {
         const size_t k = (size_t)cJSON_GetArraySize(a);
-        if (k < t->kmin || k > t->kmax) {
+        if (k < kmin || k > kmax) {
+            char wide[160] = "";
+            if (k > kmax && kmax == LB_MAX_ARITY) {
+                char names[120];
+                row_list(0, names, sizeof names);
+                snprintf(wide, sizeof wide, " (%s take up to %d; or nest this node)", names,
+                         LB_MAX_ARITY_WIDE);
+            }
             s = lb__perr(c, LB_ERR_INVALID_ARGUMENT, "%s \"%s\" has %zu argument%s; allowed: %s%s",
-                         t->name, key, k, k == 1 ? "" : "s", allowed,
-                         k > t->kmax && t->kmax == LB_MAX_ARITY
-                             ? " (displacement, min, max, soft_sum and ricci take up to 65535; "
-                               "or nest this node)"
-                             : "");
+                         t->name, key, k, k == 1 ? "" : "s", allowed, wide);
         } else {
             lb__node **v = calloc(k, sizeof *v);
             if (!v) {
@@ -495,17 +465,17 @@ static lb_status parse_args(pctx *c, const cJSON *j, const char *key, const type
     return s;
 }
 
-static lb_status parse_op(pctx *c, const cJSON *j, const type_info *t, lb_setop *op) {
+static lb_status parse_op(pctx *c, const cJSON *j, const lb__family_row *t, lb_setop *op) {
     const char *str = NULL;
-    const char *allowed = t->has_op == 2 ? "\"union\" or \"intersection\""
-                                         : "\"union\", \"intersection\" or \"difference\"";
+    const char *allowed = t->ops == LB__OPS_UI ? "\"union\" or \"intersection\""
+                                               : "\"union\", \"intersection\" or \"difference\"";
     lb_status s = lb__get_string(c, j, "op", 1, allowed, &str);
     if (s) return s;
     if (strcmp(str, "union") == 0)
         *op = LB_UNION;
     else if (strcmp(str, "intersection") == 0)
         *op = LB_INTERSECTION;
-    else if (strcmp(str, "difference") == 0 && t->has_op == 1)
+    else if (strcmp(str, "difference") == 0 && t->ops == LB__OPS_ALL)
         *op = LB_DIFFERENCE;
     else {
         const size_t old = lb__push_key(c, "op");
@@ -518,7 +488,7 @@ static lb_status parse_op(pctx *c, const cJSON *j, const type_info *t, lb_setop 
 
 /* local_union / clean_union parameters, with their defaults */
 static lb_status parse_local(pctx *c, const cJSON *j, lb__node *n) {
-    lb__local_params *L = &n->lp;
+    lb__local_params *L = &n->o.lp;
     memset(L, 0, sizeof *L);
     L->support = 0.25;
     L->exponent = 2.0;
@@ -536,7 +506,7 @@ static lb_status parse_local(pctx *c, const cJSON *j, lb__node *n) {
                             "1e-9 <= zero_scale <= 1e9 (scene units: g = 0.5 (1 - f / zero_scale))",
                             &L->zero_scale)))
         return s;
-    if (n->family == LB__F_CLEAN) return LB_OK;
+    if (!(lb__family_info(n->o.family)->flags & LB__R_CURVES)) return LB_OK; /* clean_union */
     if ((s = get_param(c, j, "feature_size", 2, 0, 0, 0.0, 1e-9, 1e9,
                        "1e-9 <= value <= 1e9 (half the radius of the smallest feature to keep)",
                        &v)))
@@ -585,8 +555,8 @@ static lb_status parse_local(pctx *c, const cJSON *j, lb__node *n) {
  * matters): n keeps (fold of the first k - 1, last). */
 static lb_status fold_local(pctx *c, lb__node *n) {
     lb__node *acc = n->args[0];
-    for (size_t i = 1; i + 1 < n->k; ++i) {
-        lb__node *m = new_node(c, n->family, n->type);
+    for (size_t i = 1; i + 1 < n->o.k; ++i) {
+        lb__node *m = new_node(c, n->o.family, n->type);
         if (!m) return lb__oom(c);
         /* the fold's inner node: named by the arguments it unites */
         const size_t pl = strlen(m->path) + 32;
@@ -595,8 +565,8 @@ static lb_status fold_local(pctx *c, lb__node *n) {
         snprintf(path, pl, "%s (args 0-%zu)", m->path, i);
         free(m->path);
         m->path = path;
-        m->lp = n->lp;
-        m->k = 2;
+        m->o.lp = n->o.lp;
+        m->o.k = 2;
         m->args = malloc(2 * sizeof *m->args);
         if (!m->args) return lb__oom(c);
         m->args[0] = acc;
@@ -609,8 +579,8 @@ static lb_status fold_local(pctx *c, lb__node *n) {
         acc = m;
     }
     n->args[0] = acc;
-    n->args[1] = n->args[n->k - 1];
-    n->k = 2;
+    n->args[1] = n->args[n->o.k - 1];
+    n->o.k = 2;
     return LB_OK;
 }
 
@@ -625,11 +595,11 @@ static lb_status parse_bulge(pctx *c, const cJSON *j, lb__node *n) {
                      "expected an object, found %s; allowed: {\"range\": true, \"slope\": false, "
                      "\"omega\": 0.001}",
                      lb__json_kind(b));
-    } else if (n->k != 2) {
+    } else if (n->o.k != 2) {
         s = lb__perr(c, LB_ERR_INVALID_ARGUMENT,
                      "bulge elimination needs exactly 2 arguments, this node has %zu; allowed: "
                      "bulge on binary blends only",
-                     n->k);
+                     n->o.k);
     } else if (!(s = lb__check_keys(c, b, keys, "bulge"))) {
         unsigned flags = LB_BULGE_RANGE;
         const char *names[2] = {"range", "slope"};
@@ -654,20 +624,22 @@ static lb_status parse_bulge(pctx *c, const cJSON *j, lb__node *n) {
             s = lb__perr(c, LB_ERR_INVALID_ARGUMENT,
                          "both range and slope are false; allowed: at least one true, or leave out "
                          "\"bulge\"");
-        if (!s && (flags & LB_BULGE_SLOPE) && n->family == LB__F_SCALE)
+        const lb__family_row *row = lb__family_info(n->o.family);
+        if (!s && (flags & LB_BULGE_SLOPE) && !lb__family_param(row, "m"))
             s = lb__perr(c, LB_ERR_INVALID_ARGUMENT,
-                         "\"slope\" needs m, which the scale family does not have; allowed: "
-                         "{\"range\": true}");
+                         "\"slope\" needs m, which the %s family does not have; allowed: "
+                         "{\"range\": true}",
+                         row->name);
         if (!s) {
-            n->bulge = 1;
-            n->bp.flags = flags;
-            n->bp.omega = omega;
+            n->o.bulge = 1;
+            n->o.bp.flags = flags;
+            n->o.bp.omega = omega;
             for (int i = 0; i < 2; ++i) {
-                n->bp.r[i] = n->r ? n->r[i] : 1.0;
-                n->bp.p[i] = n->p ? n->p[i] : 2.0;
-                n->bp.m[i] = n->m ? n->m[i] : 1.0;
+                n->o.bp.r[i] = n->o.r ? n->o.r[i] : 1.0;
+                n->o.bp.p[i] = n->o.p ? n->o.p[i] : 2.0;
+                n->o.bp.m[i] = n->o.m ? n->o.m[i] : 1.0;
             }
-            n->bp.conic_p = n->shape;
+            n->o.bp.conic_p = n->o.shape;
         }
     }
     lb__pop(c, old);
@@ -678,11 +650,11 @@ static lb_status parse_bulge(pctx *c, const cJSON *j, lb__node *n) {
  * sphere/ellipsoid argument and bounding solid with the same centre. */
 static lb_status check_bound_contains(pctx *c, const lb__node *n, size_t i) {
     const lb__node *a = n->args[i], *b = n->bounds[i];
-    if (a->family != LB__F_PRIMITIVE || b->family != LB__F_PRIMITIVE || a->has_transform ||
+    if (a->o.family != LB__F_PRIMITIVE || b->o.family != LB__F_PRIMITIVE || a->has_transform ||
         b->has_transform || a->prim.kind != LB_PRIM_ELLIPSOID || b->prim.kind != LB_PRIM_ELLIPSOID)
         return LB_OK;
     if (memcmp(a->prim.c, b->prim.c, sizeof a->prim.c) != 0) return LB_OK;
-    const int union_like = n->op == LB_UNION || (n->op == LB_DIFFERENCE && i > 0);
+    const int union_like = n->o.op == LB_UNION || (n->o.op == LB_DIFFERENCE && i > 0);
     for (int d = 0; d < 3; ++d) {
         const int bad = union_like ? b->prim.a[d] < a->prim.a[d] : b->prim.a[d] > a->prim.a[d];
         if (bad) {
@@ -702,177 +674,106 @@ static lb_status check_bound_contains(pctx *c, const lb__node *n, size_t i) {
 }
 
 /* the conic's shape "p" of n (default 0, the quarter ellipse): below r1 r2,
- * n->r already read (conic and soft_conic) */
+ * n->o.r already read (conic and soft_conic) */
 static lb_status get_conic_shape(pctx *c, const cJSON *j, lb__node *n) {
     char ok[96];
     snprintf(ok, sizeof ok, "a number below r1 r2 = %.17g (0 = quarter ellipse)",
-             n->r[0] * n->r[1]);
-    n->shape = 0.0;
-    lb_status s = lb__get_number(c, j, "p", 0, -1e18, 1e18, ok, &n->shape);
-    if (!s && !(n->shape < n->r[0] * n->r[1])) {
+             n->o.r[0] * n->o.r[1]);
+    n->o.shape = 0.0;
+    lb_status s = lb__get_number(c, j, "p", 0, -1e18, 1e18, ok, &n->o.shape);
+    if (!s && !(n->o.shape < n->o.r[0] * n->o.r[1])) {
         const size_t old = lb__push_key(c, "p");
         s = lb__perr(c, LB_ERR_INVALID_ARGUMENT, "p = %.17g is not below r1 r2; allowed: %s",
-                     n->shape, ok);
+                     n->o.shape, ok);
         lb__pop(c, old);
     }
     return s;
 }
 
-lb_status lb__parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **out) {
-    lb_status s;
-    if (!cJSON_IsObject(j))
-        return lb__perr(
-            c, LB_ERR_INVALID_ARGUMENT,
-            "expected a node object, found %s; allowed: {\"type\": ...} or {\"ref\": ...}",
-            lb__json_kind(j));
-    if (depth > LB_SCENE_MAX_DEPTH)
-        return lb__perr(c, LB_ERR_INVALID_ARGUMENT,
-                        "nodes nested deeper than %d levels; allowed: at most %d levels (use defs "
-                        "and refs to share subtrees)",
-                        LB_SCENE_MAX_DEPTH, LB_SCENE_MAX_DEPTH);
-    if (++c->count > LB_SCENE_MAX_NODES)
-        return lb__perr(c, LB_ERR_INVALID_ARGUMENT, "more than %d nodes; allowed: at most %d nodes",
-                        LB_SCENE_MAX_NODES, LB_SCENE_MAX_NODES);
-    if (cJSON_GetObjectItemCaseSensitive(j, "ref")) return parse_ref(c, j, depth, out);
-    const char *type = NULL;
-    if ((s = lb__get_string(c, j, "type", 1, TYPE_LIST, &type))) return s;
-    const type_info *t = NULL;
-    for (size_t i = 0; i < NTYPES && !t; ++i)
-        if (strcmp(TYPES[i].name, type) == 0) t = &TYPES[i];
-    if (!t) {
-        const size_t old = lb__push_key(c, "type");
-        s = lb__perr(c, LB_ERR_INVALID_ARGUMENT, "unknown node type \"%.60s\"; allowed: %s", type,
-                     TYPE_LIST);
-        lb__pop(c, old);
-        return s;
+/* a per-argument parameter of the row into the node's array (n->o.k known,
+ * n->o.op read) */
+static lb_status read_param(pctx *c, const cJSON *j, const lb__param *p, lb__node *n) {
+    double **dst = strcmp(p->key, "r") == 0   ? &n->o.r
+                   : strcmp(p->key, "p") == 0 ? &n->o.p
+                                              : &n->o.m;
+    const int alt = (p->hi_alt_ops >> n->o.op) & 1u;
+    char ok[96];
+    lb__param_allowed(p, alt, ok, sizeof ok);
+    /* an open lower end: the next representable step past it that the
+     * kernels accept (1 < p: p >= 1 + 1e-12) */
+    const double lo = p->open_lo ? p->lo + 1e-12 : p->lo;
+    return get_param(c, j, p->key, n->o.k, p->required, !p->required, p->def, lo,
+                     alt ? p->hi_alt : p->hi, ok, dst);
+}
+
+/* the row's scalar parameter into n->o.shape (n->o.r read: the conics) */
+static lb_status read_shape(pctx *c, const cJSON *j, const lb__shape *sh, lb__node *n) {
+    if (sh->below_r1r2) return get_conic_shape(c, j, n);
+    const int cv = c->s->convention == LB_CONVENTION_SOFT;
+    char ok[96], lo[40], hi[40];
+    if (sh->allowed[cv]) {
+        snprintf(ok, sizeof ok, "%s", sh->allowed[cv]);
+    } else {
+        lb__short_number(sh->lo[cv], lo, sizeof lo);
+        lb__short_number(sh->hi[cv], hi, sizeof hi);
+        snprintf(ok, sizeof ok, "%s <= %s <= %s", lo, sh->key, hi);
     }
-    char what[64];
-    snprintf(what, sizeof what, "a %s node", t->name);
-    if ((s = lb__check_keys(c, j, t->keys, what))) return s;
-    const int conv_bit = c->s->convention == LB_CONVENTION_ZERO ? CONV_ZERO : CONV_SOFT;
-    if (!(t->conv & conv_bit)) {
-        const size_t old = lb__push_key(c, "type");
-        s = lb__perr(
-            c, LB_ERR_INVALID_ARGUMENT,
-            "%s is a %s-convention operator but the scene's convention is \"%s\"; allowed: "
-            "%s",
-            t->name, t->conv == CONV_ZERO ? "zero" : "soft",
-            conv_bit == CONV_ZERO ? "zero" : "soft",
-            conv_bit == CONV_ZERO ? "displacement, conic, scale, bounded, rfunction, min, "
-                                    "max, complement, local_union, clean_union, level"
-                                  : "soft_hyper, soft_conic, soft_sum, ricci, perlin, min, "
-                                    "max, complement, local_union, clean_union, level");
-        lb__pop(c, old);
-        return s;
-    }
-    lb__node *n = new_node(c, t->family, t->name);
-    if (!n) return lb__oom(c);
-    if ((s = get_transform(c, j, n)) || (s = node_material(c, j, n))) return s;
-    if (t->family == LB__F_PRIMITIVE) {
-        if ((s = parse_primitive(c, j, t, n))) return s;
-        *out = n;
-        return LB_OK;
-    }
-    if (t->has_op && (s = parse_op(c, j, t, &n->op))) return s;
-    if ((s = parse_args(c, j, "args", t, depth, &n->args, &n->k))) return s;
-    const size_t k = n->k;
-    const char *r_ok = "1e-9 <= r <= 1e9";
-    const char *p_ok = "1 < p <= 1000";
-    const char *m_ok = "1e-6 <= m <= 1e6";
-    switch (t->family) {
-    case LB__F_DISPLACEMENT:
-        if ((s = get_param(c, j, "r", k, 1, 0, 0, 1e-9, 1e9, r_ok, &n->r)) ||
-            (s = get_param(c, j, "p", k, 0, 1, 2.0, 1.0 + 1e-12, 1000.0, p_ok, &n->p)) ||
-            (s = get_param(c, j, "m", k, 0, 1, 1.0, 1e-6, 1e6, m_ok, &n->m)) ||
-            (s = parse_bulge(c, j, n)))
-            return s;
-        break;
-    case LB__F_CONIC: {
-        if ((s = get_param(c, j, "r", k, 1, 0, 0, 1e-9, 1e9, r_ok, &n->r)) ||
-            (s = get_param(c, j, "m", k, 0, 1, 1.0, 1e-6, 1e6, m_ok, &n->m)))
-            return s;
-        if ((s = get_conic_shape(c, j, n)) || (s = parse_bulge(c, j, n))) return s;
-        break;
-    }
-    case LB__F_SCALE: {
-        const double rmax = n->op == LB_UNION ? 1e9 : 1.0;
-        if ((s = get_param(c, j, "r", k, 1, 0, 0, 1e-9, rmax,
-                           n->op == LB_UNION ? r_ok : "1e-9 <= r <= 1 (intersection, difference)",
-                           &n->r)) ||
-            (s = get_param(c, j, "p", k, 0, 1, 2.0, 1.0 + 1e-12, 1000.0, p_ok, &n->p)) ||
-            (s = parse_bulge(c, j, n)))
-            return s;
-        break;
-    }
-    case LB__F_BOUNDED: {
-        if ((s = get_param(c, j, "p", k, 0, 1, 2.0, 1.0 + 1e-12, 1000.0, p_ok, &n->p))) return s;
-        const cJSON *b = cJSON_GetObjectItemCaseSensitive(j, "bounds");
-        if (!b) {
-            const size_t old = lb__push_key(c, "bounds");
-            s = lb__perr(
-                c, LB_ERR_INVALID_ARGUMENT,
-                "missing required field; allowed: an array of %zu bounding solids, one per "
-                "argument",
-                k);
-            lb__pop(c, old);
-            return s;
-        }
-        if (cJSON_IsArray(b) && (size_t)cJSON_GetArraySize(b) != k) {
-            const size_t old = lb__push_key(c, "bounds");
+    n->o.shape = sh->def;
+    return lb__get_number(c, j, sh->key, sh->required, sh->lo[cv], sh->hi[cv], ok, &n->o.shape);
+}
+
+/* "bounds": one bounding solid per argument (LB__R_BOUNDING) */
+static lb_status parse_bounds(pctx *c, const cJSON *j, const lb__family_row *t, size_t depth,
+                              lb__node *n) {
+    const size_t k = n->o.k;
+    const cJSON *b = cJSON_GetObjectItemCaseSensitive(j, "bounds");
+    lb_status s = LB_OK;
+    if (!b || (cJSON_IsArray(b) && (size_t)cJSON_GetArraySize(b) != k)) {
+        const size_t old = lb__push_key(c, "bounds");
+        if (!b)
+            s = lb__perr(c, LB_ERR_INVALID_ARGUMENT,
+                         "missing required field; allowed: an array of %zu bounding solids, one "
+                         "per argument",
+                         k);
+        else
             s = lb__perr(
                 c, LB_ERR_INVALID_ARGUMENT,
                 "has %d bounding solids for %zu arguments; allowed: exactly one per argument",
                 cJSON_GetArraySize(b), k);
-            lb__pop(c, old);
-            return s;
-        }
-        size_t kb = 0;
-        type_info tb = *t;
-        tb.kmin = tb.kmax = k;
-        if ((s = parse_args(c, j, "bounds", &tb, depth, &n->bounds, &kb))) return s;
-        for (size_t i = 0; i < k; ++i)
-            if ((s = check_bound_contains(c, n, i))) return s;
-        break;
+        lb__pop(c, old);
+        return s;
     }
-    case LB__F_SOFT_HYPER:
-    case LB__F_SOFT_CONIC: {
-        const double rmax = n->op == LB_UNION ? 1.0 : 1e9;
-        if ((s = get_param(c, j, "r", k, 1, 0, 0, 1e-9, rmax,
-                           n->op == LB_UNION ? "1e-9 <= r <= 1 (soft union)" : r_ok, &n->r)) ||
-            (s = get_param(c, j, "m", k, 0, 1, 1.0, LB_SOFT_MIN_SLOPE, LB_SOFT_MAX_SLOPE,
-                           "0.05 <= m <= 20 (soft)", &n->m)))
-            return s;
-        if (t->family == LB__F_SOFT_HYPER) {
-            if ((s = get_param(c, j, "p", k, 0, 1, 2.0, 1.0 + 1e-12, 1000.0, p_ok, &n->p)))
-                return s;
-        } else if ((s = get_conic_shape(c, j, n))) {
-            return s;
-        }
-        break;
-    }
-    case LB__F_LOCAL:
-    case LB__F_CLEAN:
+    size_t kb = 0;
+    if ((s = parse_args(c, j, "bounds", t, k, k, depth, &n->bounds, &kb))) return s;
+    for (size_t i = 0; i < k; ++i)
+        if ((s = check_bound_contains(c, n, i))) return s;
+    return LB_OK;
+}
+
+/* an operator node's own fields, in the row's order: its parameters, its
+ * scalar parameter, bulge, bounding solids, local blending */
+static lb_status parse_operator(pctx *c, const cJSON *j, const lb__family_row *t, size_t depth,
+                                lb__node *n) {
+    lb_status s;
+    if (t->ops && (s = parse_op(c, j, t, &n->o.op))) return s;
+    if ((s = parse_args(c, j, "args", t, t->kmin, t->kmax, depth, &n->args, &n->o.k))) return s;
+    for (const lb__param *p = t->params; p->key; ++p)
+        if ((s = read_param(c, j, p, n))) return s;
+    if (t->shape && (s = read_shape(c, j, t->shape, n))) return s;
+    if (t->bulge_family >= 0 && (s = parse_bulge(c, j, n))) return s;
+    if ((t->flags & LB__R_BOUNDING) && (s = parse_bounds(c, j, t, depth, n))) return s;
+    if (t->flags & LB__R_FOLD_BINARY) {
         if ((s = parse_local(c, j, n))) return s;
-        if (k > 2 && (s = fold_local(c, n))) return s;
-        break;
-    case LB__F_RICCI:
-        n->shape = 2.0;
-        if ((s = lb__get_number(c, j, "n", 1, 1.0, 1000.0, "1 <= n <= 1000", &n->shape))) return s;
-        break;
-    case LB__F_LEVEL:
-        /* zero: any level (an offset surface); soft: inside the field's [0, 1] */
-        if (c->s->convention == LB_CONVENTION_ZERO)
-            s = lb__get_number(c, j, "level", 1, -1e9, 1e9, "|level| <= 1e9", &n->shape);
-        else
-            s = lb__get_number(c, j, "level", 1, 1e-6, 1.0 - 1e-6,
-                               "0 < level < 1 (soft fields lie "
-                               "in [0, 1])",
-                               &n->shape);
-        if (s) return s;
-        break;
-    default:
-        break;
+        if (n->o.k > 2 && (s = fold_local(c, n))) return s;
     }
+    return LB_OK;
+}
+
+/* what a node's arguments give it: height, bulge nesting, walk cost,
+ * materials below; then the operator's own check at a neutral point */
+static lb_status finish_operator(pctx *c, lb__node *n) {
+    const size_t k = n->o.k;
+    lb_status s;
     for (size_t i = 0; i < k; ++i) {
         const lb__node *a = n->args[i];
         n->mat_below |= a->mat || a->mat_below;
@@ -892,10 +793,10 @@ lb_status lb__parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **out) 
             n->bulge_depth = n->bounds[i]->bulge_depth;
         /* the reference walk visits a shared node once per use, and a
          * bulge-eliminated blend walks each argument twice more */
-        n->walk_cost += (n->bulge ? 3.0 : 1.0) * a->walk_cost;
+        n->walk_cost += (n->o.bulge ? 3.0 : 1.0) * a->walk_cost;
         if (n->bounds) n->walk_cost += n->bounds[i]->walk_cost;
     }
-    if (n->bulge && ++n->bulge_depth > LB_SCENE_MAX_BULGE_NESTING) {
+    if (n->o.bulge && ++n->bulge_depth > LB_SCENE_MAX_BULGE_NESTING) {
         const size_t old = lb__push_key(c, "bulge");
         s = lb__perr(c, LB_ERR_INVALID_ARGUMENT,
                      "bulge elimination nested %zu deep (each level evaluates its arguments 4 more "
@@ -905,19 +806,89 @@ lb_status lb__parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **out) 
         return s;
     }
     /* backstop: the operator itself accepts the parameters at a neutral point */
-    {
-        double *x = malloc(2 * k * sizeof *x), g[6] = {1, 0, 0, 0, 1, 0}, v = 0.0;
-        if (!x) return lb__oom(c);
-        double *cb = x + k;
-        for (size_t i = 0; i < k; ++i) {
-            x[i] = c->s->convention == LB_CONVENTION_ZERO ? 0.0 : 0.5;
-            cb[i] = 0.5;
-        }
-        lb_error e = {LB_OK, ""};
-        const lb_status as =
-            lb__node_apply(n, c->s->convention, x, cb, g, &v, NULL, NULL, NULL, &e);
-        free(x);
-        if (as) return lb__perr(c, LB_ERR_INVALID_ARGUMENT, "%s", e.message);
+    double *x = malloc(2 * k * sizeof *x), g[6] = {1, 0, 0, 0, 1, 0}, v = 0.0;
+    if (!x) return lb__oom(c);
+    double *cb = x + k;
+    for (size_t i = 0; i < k; ++i) {
+        x[i] = c->s->convention == LB_CONVENTION_ZERO ? 0.0 : 0.5;
+        cb[i] = 0.5;
+    }
+    lb_error e = {LB_OK, ""};
+    n->o.path = n->path;
+    const lb_status as = lb__op_apply(&n->o, c->s->convention, x, cb, g, &v, NULL, NULL, NULL, &e);
+    free(x);
+    if (as) return lb__perr(c, LB_ERR_INVALID_ARGUMENT, "%s", e.message);
+    return LB_OK;
+}
+
+/* the node's "type" looked up in the registry, its keys and convention
+ * checked; *row and *prim receive the rows */
+static lb_status node_type(pctx *c, const cJSON *j, const lb__family_row **row,
+                           const lb__primitive_row **prim) {
+    lb_status s;
+    char list[512] = "";
+    const cJSON *tj = cJSON_GetObjectItemCaseSensitive(j, "type");
+    const char *type = NULL;
+    if (!cJSON_IsString(tj)) type_list(list, sizeof list);
+    if ((s = lb__get_string(c, j, "type", 1, list, &type))) return s;
+    const lb__family_row *t = lb__family_find(type, prim);
+    if (!t) {
+        type_list(list, sizeof list);
+        const size_t old = lb__push_key(c, "type");
+        s = lb__perr(c, LB_ERR_INVALID_ARGUMENT, "unknown node type \"%.60s\"; allowed: %s", type,
+                     list);
+        lb__pop(c, old);
+        return s;
+    }
+    const char *keys[32];
+    /* a kernel in a zero scene is refused by parse_primitive, naming the
+     * kernel rather than an unknown key */
+    node_keys(*prim ? (*prim)->keys : t->keys, *prim ? (*prim)->soft_keys : NULL, keys);
+    char what[64];
+    snprintf(what, sizeof what, "a %s node", type);
+    if ((s = lb__check_keys(c, j, keys, what))) return s;
+    const int conv_bit = c->s->convention == LB_CONVENTION_ZERO ? LB__CONV_ZERO : LB__CONV_SOFT;
+    if (!(t->conv & conv_bit)) {
+        row_list(conv_bit, list, sizeof list);
+        const size_t old = lb__push_key(c, "type");
+        s = lb__perr(c, LB_ERR_INVALID_ARGUMENT,
+                     "%s is a %s-convention operator but the scene's convention is \"%s\"; "
+                     "allowed: %s",
+                     t->name, t->conv == LB__CONV_ZERO ? "zero" : "soft",
+                     conv_bit == LB__CONV_ZERO ? "zero" : "soft", list);
+        lb__pop(c, old);
+        return s;
+    }
+    *row = t;
+    return LB_OK;
+}
+
+lb_status lb__parse_node(pctx *c, const cJSON *j, size_t depth, lb__node **out) {
+    lb_status s;
+    if (!cJSON_IsObject(j))
+        return lb__perr(
+            c, LB_ERR_INVALID_ARGUMENT,
+            "expected a node object, found %s; allowed: {\"type\": ...} or {\"ref\": ...}",
+            lb__json_kind(j));
+    if (depth > LB_SCENE_MAX_DEPTH)
+        return lb__perr(c, LB_ERR_INVALID_ARGUMENT,
+                        "nodes nested deeper than %d levels; allowed: at most %d levels (use defs "
+                        "and refs to share subtrees)",
+                        LB_SCENE_MAX_DEPTH, LB_SCENE_MAX_DEPTH);
+    if (++c->count > LB_SCENE_MAX_NODES)
+        return lb__perr(c, LB_ERR_INVALID_ARGUMENT, "more than %d nodes; allowed: at most %d nodes",
+                        LB_SCENE_MAX_NODES, LB_SCENE_MAX_NODES);
+    if (cJSON_GetObjectItemCaseSensitive(j, "ref")) return parse_ref(c, j, depth, out);
+    const lb__family_row *t = NULL;
+    const lb__primitive_row *prim = NULL;
+    if ((s = node_type(c, j, &t, &prim))) return s;
+    lb__node *n = new_node(c, t->id, prim ? prim->name : t->name);
+    if (!n) return lb__oom(c);
+    if ((s = get_transform(c, j, n)) || (s = node_material(c, j, n))) return s;
+    if (prim) {
+        if ((s = parse_primitive(c, j, prim, n))) return s;
+    } else if ((s = parse_operator(c, j, t, depth, n)) || (s = finish_operator(c, n))) {
+        return s;
     }
     *out = n;
     return LB_OK;
