@@ -68,9 +68,8 @@ def _blend_items(self, context):
     a = context.view_layer.objects.active if context else None
     out = tree.output_of(a) if a else None
     if out is not None and out.libblend.convention == "soft":
-        return props.BLENDS_SOFT + [b for b in props.BLENDS_ZERO if b[0] in (
-            "min", "max", "complement")] + props.BLENDS_BOTH
-    return props.BLENDS_ZERO + props.BLENDS_BOTH
+        return props.BLENDS_SOFT + props.BLENDS_SHARP + props.BLENDS_BOTH
+    return props.BLENDS_ZERO + props.BLENDS_SHARP + props.BLENDS_BOTH
 
 
 class LIBBLEND_OT_add_field(bpy.types.Operator):

@@ -40,6 +40,9 @@ BLENDS_ZERO = [
     ("scale", "Scale (Hsu-Lee)", "scale-method blend"),
     ("bounded", "Bounded", "blend limited by a bounding solid per argument"),
     ("rfunction", "R-function", "Rvachev union / intersection"),
+]
+#: both conventions, the sharp operations
+BLENDS_SHARP = [
     ("min", "Min (sharp union)", "min of the arguments"),
     ("max", "Max (sharp intersection)", "max of the arguments"),
     ("complement", "Complement", "-f"),
@@ -59,7 +62,8 @@ BLENDS_BOTH = [
     ("level", "Level", "its argument's level set at Level is the surface (zero: an offset "
      "surface; soft: another threshold)"),
 ]
-BLENDS = BLENDS_ZERO + [b for b in BLENDS_SOFT] + BLENDS_BOTH
+#: the order saved .blend files number the items by (an enum stores a position)
+BLENDS = BLENDS_ZERO + BLENDS_SHARP + BLENDS_SOFT + BLENDS_BOTH
 OPS = [("union", "Union", ""), ("intersection", "Intersection", ""),
        ("difference", "Difference", "the first argument minus the others")]
 

@@ -55,13 +55,59 @@ static int run_validate(int argc, char **argv) {
     return worst;
 }
 
+/* info --families: the node types the library knows (its registry) */
+static int print_families(const char *cmd, int json) {
+    const size_t len = lb_scene_families_json(NULL, 0);
+    char *txt = len ? malloc(len + 1) : NULL;
+    if (!txt) {
+        bt_error(cmd, "out of memory");
+        return BT_EXIT_INTERNAL;
+    }
+    lb_scene_families_json(txt, len + 1);
+    if (json) {
+        printf("%s\n", txt);
+        free(txt);
+        return 0;
+    }
+    cJSON *root = cJSON_Parse(txt);
+    free(txt);
+    if (!root) {
+        bt_error(cmd, "out of memory");
+        return BT_EXIT_INTERNAL;
+    }
+    const cJSON *e;
+    printf("primitives (both conventions):\n");
+    cJSON_ArrayForEach(e, cJSON_GetObjectItem(root, "primitives")) {
+        printf("  %-13s %s\n", cJSON_GetObjectItem(e, "type")->valuestring,
+               cJSON_GetObjectItem(e, "description")->valuestring);
+    }
+    printf("operators:\n");
+    cJSON_ArrayForEach(e, cJSON_GetObjectItem(root, "operators")) {
+        const cJSON *c, *conv = cJSON_GetObjectItem(e, "conventions");
+        printf("  %-13s %-9s args %g-%g  ", cJSON_GetObjectItem(e, "type")->valuestring,
+               cJSON_GetArraySize(conv) == 2 ? "zero/soft" : conv->child->valuestring,
+               cJSON_GetObjectItem(e, "min_args")->valuedouble,
+               cJSON_GetObjectItem(e, "max_args")->valuedouble);
+        cJSON_ArrayForEach(c, cJSON_GetObjectItem(e, "parameters")) {
+            const cJSON *a = cJSON_GetObjectItem(c, "allowed");
+            printf("%s%s", cJSON_GetObjectItem(c, "key")->valuestring, a ? "" : " ");
+            if (a) printf(" (%s) ", a->valuestring);
+        }
+        printf("\n      %s\n", cJSON_GetObjectItem(e, "description")->valuestring);
+    }
+    cJSON_Delete(root);
+    return 0;
+}
+
 static int run_info(int argc, char **argv) {
     const char *cmd = "info";
     const char *path = NULL;
-    int json = 0;
+    int json = 0, families = 0;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--json") == 0)
             json = 1;
+        else if (strcmp(argv[i], "--families") == 0)
+            families = 1;
         else if (argv[i][0] == '-' && argv[i][1])
             return unknown_option(cmd, argv[i]);
         else if (path) {
@@ -70,6 +116,14 @@ static int run_info(int argc, char **argv) {
         } else
             path = argv[i];
     }
+    if (families && path) {
+        bt_error(cmd,
+                 "--families takes no scene (%s given); usage: blendtool info --families "
+                 "[--json]",
+                 path);
+        return BT_EXIT_BAD_INPUT;
+    }
+    if (families) return print_families(cmd, json);
     if (!path) {
         bt_error(cmd, "no scene given; usage: blendtool info [--json] SCENE");
         return BT_EXIT_BAD_INPUT;
@@ -164,9 +218,14 @@ const bt_command bt_cmd_validate = {
 
 const bt_command bt_cmd_info = {
     "info", "describe a scene: convention, bounds, tree, operator count",
-    "usage: blendtool info [--json] SCENE\n\n"
+    "usage: blendtool info [--json] SCENE\n"
+    "       blendtool info --families [--json]\n\n"
     "Prints the scene's convention, declared bounds, node and operator counts,\n"
     "the size of the compiled tape and the tree (shared defs printed once).\n"
-    "  --json   the same as one JSON object\n"
+    "  --json       the same as one JSON object\n"
+    "  --families   the node types the library knows instead of a scene: every\n"
+    "               primitive and operator with its conventions, arity, keys and\n"
+    "               parameter ranges (--json: the registry the JSON Schema, the\n"
+    "               Blender add-on and the fuzz dictionary are checked against)\n"
     "Exit status: 0 success, 2 invalid scene, 1 internal failure.\n",
     run_info};
