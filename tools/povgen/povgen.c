@@ -27,8 +27,8 @@
 #define TOL 1e-10  /* early exit: the Newton step below TOL (1 + abs(h)); the exit takes it */
 #define P_MIN 1.05 /* documented ranges of the root-solved macros */
 #define P_MAX 16.0
-#define M_MIN 0.05
-#define M_MAX 20.0
+#define M_MIN LB_SOFT_MIN_SLOPE /* the library's soft slope range */
+#define M_MAX LB_SOFT_MAX_SLOPE
 
 /* ---- the documented ranges, checked against the C library ---- */
 
@@ -887,6 +887,42 @@ static void alist(void) {
 }
 
 /* LB_SoftHyper(Op, F, R, P, M): mirroring lb_soft_hyper. */
+/* LB_SoftHyper's bracketed Newton chain in lambda: lbN0 .. lbN<steps> */
+static void soft_hyper_newton(int steps) {
+    /* CPS bracketed Newton */
+    w("  #local lbN%d = function(lbl, lblo, lbhi, ", steps);
+    alist();
+    w(") { lbl }\n");
+    for (int n = steps - 1; n >= 0; --n) {
+        /* F_n(next, lo, hi): Newton if inside, else bisection */
+        w("  #local lbF%d = function(lbx, lblo, lbhi, ", n);
+        alist();
+        w(") { lbN%d(select((lbx > lblo) * (lbx < lbhi) - 0.5, 0.5 * (lblo + lbhi), lbx), lblo, "
+          "lbhi, ",
+          n + 1);
+        alist();
+        w(") }\n");
+        /* E_n(lambda, T, D, lo, hi): exit, or the next step with the bracket updated */
+        w("  #local lbE%d = function(lbl, lbt, lbd, lblo, lbhi, ", n);
+        alist();
+        w(") { select(abs(lbt / lbd) - %.17g, min(lbhi, max(lblo, lbl - lbt / lbd)), min(lbhi, "
+          "max(lblo, lbl - lbt / lbd)), lbF%d(lbl - lbt / lbd, select(-lbt, lblo, lbl), "
+          "select(-lbt, lbl, lbhi), ",
+          LTOL, n);
+        alist();
+        w(")) }\n");
+        w("  #local lbN%d = function(lbl, lblo, lbhi, ", n);
+        alist();
+        w(") { lbE%d(lbl, lbT(lbl, ", n);
+        alist();
+        w("), lbD(lbl, ");
+        alist();
+        w("), lblo, lbhi, ");
+        alist();
+        w(") }\n");
+    }
+}
+
 static void soft_hyper(int steps) {
     w("// ---- soft objects: super-ellipsoidal blends with non-uniform scaling ----\n"
       "// LB_SoftHyper(Op, F, R, P, M) (soft convention): Op 0 union, 1 intersection,\n"
@@ -932,38 +968,7 @@ static void soft_hyper(int steps) {
           "exp(lba%d - lbM[%d] * lbl), 0, 0)",
           i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i, i);
     w(" }\n");
-    /* CPS bracketed Newton */
-    w("  #local lbN%d = function(lbl, lblo, lbhi, ", steps);
-    alist();
-    w(") { lbl }\n");
-    for (int n = steps - 1; n >= 0; --n) {
-        /* F_n(next, lo, hi): Newton if inside, else bisection */
-        w("  #local lbF%d = function(lbx, lblo, lbhi, ", n);
-        alist();
-        w(") { lbN%d(select((lbx > lblo) * (lbx < lbhi) - 0.5, 0.5 * (lblo + lbhi), lbx), lblo, "
-          "lbhi, ",
-          n + 1);
-        alist();
-        w(") }\n");
-        /* E_n(lambda, T, D, lo, hi): exit, or the next step with the bracket updated */
-        w("  #local lbE%d = function(lbl, lbt, lbd, lblo, lbhi, ", n);
-        alist();
-        w(") { select(abs(lbt / lbd) - %.17g, min(lbhi, max(lblo, lbl - lbt / lbd)), min(lbhi, "
-          "max(lblo, lbl - lbt / lbd)), lbF%d(lbl - lbt / lbd, select(-lbt, lblo, lbl), "
-          "select(-lbt, lbl, lbhi), ",
-          LTOL, n);
-        alist();
-        w(")) }\n");
-        w("  #local lbN%d = function(lbl, lblo, lbhi, ", n);
-        alist();
-        w(") { lbE%d(lbl, lbT(lbl, ", n);
-        alist();
-        w("), lbD(lbl, ");
-        alist();
-        w("), lblo, lbhi, ");
-        alist();
-        w(") }\n");
-    }
+    soft_hyper_newton(steps);
     /* from the (adjusted) values: a_i, the bracket, then h = exp(lambda) */
     w("  #local lbNpos = function(");
     ylist("");

@@ -31,35 +31,11 @@ lb_status lb__material_fields(pctx *c, const cJSON *mat, lb_material *m) {
     return lb__get_number(c, mat, "specular", 0, 0.0, 1.0, "0 <= specular <= 1", &m->specular);
 }
 
-lb_status lb__parse_render(pctx *c, const cJSON *root) {
-    lb_render *R = &c->s->render;
-    R->angle = 40.0;
-    R->color[0] = R->color[1] = R->color[2] = 0.8;
-    R->ambient = 0.1;
-    R->diffuse = 0.7;
-    R->specular = 0.3;
-    R->up[0] = R->up[1] = 0.0;
-    R->up[2] = 1.0;
-    R->floor = 1;
-    R->floor_color[0] = R->floor_color[1] = R->floor_color[2] = 0.75;
-    R->background[0] = R->background[1] = R->background[2] = 0.9;
-    const cJSON *r = cJSON_GetObjectItemCaseSensitive(root, "render");
-    if (!r) return LB_OK;
-    static const char *const keys[] = {"camera", "lights", "material", "floor", "background", NULL};
+/* render.camera into R (has_camera set when it is valid) */
+static lb_status parse_camera(pctx *c, const cJSON *r, lb_render *R) {
     static const char *const cam_keys[] = {"location", "look_at", "up", "angle", NULL};
-    static const char *const floor_keys[] = {"color", NULL};
-    static const char *const light_keys[] = {"location", "color", NULL};
     const double CM = LB_SCENE_MAX_COORD;
-    const size_t old = lb__push_key(c, "render");
     lb_status s = LB_OK;
-    if (!cJSON_IsObject(r)) {
-        s = lb__perr(c, LB_ERR_INVALID_ARGUMENT,
-                     "expected an object, found %s; allowed: {\"camera\": ..., \"lights\": [...], "
-                     "\"material\": ...}",
-                     lb__json_kind(r));
-        goto done;
-    }
-    if ((s = lb__check_keys(c, r, keys, "render"))) goto done;
     const cJSON *cam = cJSON_GetObjectItemCaseSensitive(r, "camera");
     if (cam) {
         const size_t o = lb__push_key(c, "camera");
@@ -95,8 +71,15 @@ lb_status lb__parse_render(pctx *c, const cJSON *root) {
             R->has_camera = !s;
         }
         lb__pop(c, o);
-        if (s) goto done;
     }
+    return s;
+}
+
+/* render.lights into R */
+static lb_status parse_lights(pctx *c, const cJSON *r, lb_render *R) {
+    static const char *const light_keys[] = {"location", "color", NULL};
+    const double CM = LB_SCENE_MAX_COORD;
+    lb_status s = LB_OK;
     const cJSON *lights = cJSON_GetObjectItemCaseSensitive(r, "lights");
     if (lights) {
         const size_t o = lb__push_key(c, "lights");
@@ -124,8 +107,38 @@ lb_status lb__parse_render(pctx *c, const cJSON *root) {
             if (!s) R->light_count = i;
         }
         lb__pop(c, o);
-        if (s) goto done;
     }
+    return s;
+}
+
+lb_status lb__parse_render(pctx *c, const cJSON *root) {
+    lb_render *R = &c->s->render;
+    R->angle = 40.0;
+    R->color[0] = R->color[1] = R->color[2] = 0.8;
+    R->ambient = 0.1;
+    R->diffuse = 0.7;
+    R->specular = 0.3;
+    R->up[0] = R->up[1] = 0.0;
+    R->up[2] = 1.0;
+    R->floor = 1;
+    R->floor_color[0] = R->floor_color[1] = R->floor_color[2] = 0.75;
+    R->background[0] = R->background[1] = R->background[2] = 0.9;
+    const cJSON *r = cJSON_GetObjectItemCaseSensitive(root, "render");
+    if (!r) return LB_OK;
+    static const char *const keys[] = {"camera", "lights", "material", "floor", "background", NULL};
+    static const char *const floor_keys[] = {"color", NULL};
+    const size_t old = lb__push_key(c, "render");
+    lb_status s = LB_OK;
+    if (!cJSON_IsObject(r)) {
+        s = lb__perr(c, LB_ERR_INVALID_ARGUMENT,
+                     "expected an object, found %s; allowed: {\"camera\": ..., \"lights\": [...], "
+                     "\"material\": ...}",
+                     lb__json_kind(r));
+        goto done;
+    }
+    if ((s = lb__check_keys(c, r, keys, "render"))) goto done;
+    if ((s = parse_camera(c, r, R))) goto done;
+    if ((s = parse_lights(c, r, R))) goto done;
     const cJSON *mat = cJSON_GetObjectItemCaseSensitive(r, "material");
     if (mat) {
         lb_material m = {
