@@ -1,6 +1,6 @@
 /* The Kuhn (Freudenthal) split of a grid cell into six tetrahedra, shared
  * by the tetrahedral mesher (meshing/tetra.c) and the local blend's curve
- * tracing (evaluation/local.c).
+ * tracing (evaluation/local_curves.c).
  *
  * Convention: a cell's corner c in 0..7 sits at offset (c & 1, (c >> 1) & 1,
  * (c >> 2) & 1) cells from the cell's first node. Each tetrahedron is a

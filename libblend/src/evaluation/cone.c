@@ -1,5 +1,5 @@
 /* A child's cone reduced over a box, for the local unions' compile-time
- * evaluation (local.c).
+ * evaluation (local_curves.c).
  *
  * A local_union of k children folds left, so the left child of the i-th
  * fold is a chain of i - 1 binary local unions: run as it stands, every

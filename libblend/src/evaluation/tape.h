@@ -115,7 +115,7 @@ LB_INTERNAL void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *par
                                      lb__plan *child);
 
 /* Run instructions list[0..nlist) (tape order, no culling) on n <= LB__CHUNK
- * points into regs: one argument's cone, at compile time (local.c). */
+ * points into regs: one argument's cone, at compile time (local_curves.c). */
 LB_INTERNAL lb_status lb__tape_run_list(const lb_evaluator *ev, const uint32_t *list, size_t nlist,
                                         size_t n, const double *x, const double *y, const double *z,
                                         double *regs, lb_error *err);
@@ -157,7 +157,7 @@ LB_INTERNAL void lb__cone_free(lb__cone *S);
 LB_INTERNAL int lb__local_reaches(const struct lb__curves *C, const double bc[3],
                                   const double br[3]);
 
-/* One intersection component and its blending volume (local.c). */
+/* One intersection component and its blending volume (local_curves.c). */
 typedef struct lb__component {
     size_t first, count; /* vertices [first, first + count) */
     int closed;
@@ -184,7 +184,7 @@ struct lb__curves {
 /* The n-th local_union instruction's curves, in tape order (tests). */
 LB_INTERNAL const struct lb__curves *lb__local_nth(const lb_evaluator *ev, size_t which);
 
-/* ---- local blending (local.c) ----
+/* ---- local blending (local_*.c) ----
  * After registers are assigned, every local_union instruction gets its
  * children's intersection curves (octree by intervals, segments exact on
  * each tetrahedron's linear pieces, chained, refined onto both surfaces),

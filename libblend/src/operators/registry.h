@@ -88,7 +88,7 @@ enum {
     LB__R_POV16 = 4u,        /* the POV-Ray macro takes at most LB_POV_MAX_ARITY arguments */
     LB__R_NO_PARSE = 8u,     /* made by the parser, never named in a scene (a transformed ref) */
     LB__R_FOLD_BINARY = 16u, /* k > 2 is folded into nested binary nodes by the parser */
-    LB__R_CLEAN_UNION = 32u  /* built on the clean union UC: bounded by evaluation/local.c */
+    LB__R_CLEAN_UNION = 32u  /* built on the clean union UC: bounded by evaluation/local_bounds.c */
 };
 
 /* A per-argument parameter ("r", "p", "m"): a number for every argument

@@ -27,8 +27,12 @@
  * At a point: v = W(d / R) (Wyvill's kernel of the distance to the nearest
  * curve, the component with the smallest d / R), UC and UB = Barthe's blend
  * with q = v1 / C, p = v2 / C, and U = (1 - v^n) UC + v^n UB. Outside every
- * volume U = UC exactly. */
-#include "tape.h"
+ * volume U = UC exactly.
+ *
+ * This file finds the curves and the volumes' parameters (steps 1-5) and
+ * describes them; local_bvh.c builds and queries step 6's hierarchy,
+ * local_eval.c evaluates at points, local_bounds.c over boxes. */
+#include "local_internal.h"
 #include "../common/kuhn.h"
 
 #include <float.h>
@@ -104,19 +108,6 @@ static double cone_weight(const lb_evaluator *ev, const uint32_t *cone, size_t n
 }
 
 /* the centre and half-size of the box around n points */
-static void points_box(const double *x, const double *y, const double *z, size_t n, double bc[3],
-                       double br[3]) {
-    double bmin[3] = {x[0], y[0], z[0]}, bmax[3] = {x[0], y[0], z[0]};
-    for (size_t j = 1; j < n; ++j) {
-        const double P[3] = {x[j], y[j], z[j]};
-        for (int d = 0; d < 3; ++d) {
-            if (P[d] < bmin[d]) bmin[d] = P[d];
-            if (P[d] > bmax[d]) bmax[d] = P[d];
-        }
-    }
-    lb__box_centre(bmin, bmax, bc, br);
-}
-
 /* The tape that computes child a at a chunk of points in box (bc, br): the
  * run, the register of the child's value and the charge per point. A long
  * cone is reduced over the chunk's group of chunks (box (gc, gr), at its
@@ -184,9 +175,9 @@ static lb_status children_at(child_eval *E, size_t n, const double *x, const dou
         const int new_group = s % (REDUCE_GROUP * LB__CHUNK) == 0;
         if (new_group) {
             const size_t gm = n - s < REDUCE_GROUP * LB__CHUNK ? n - s : REDUCE_GROUP * LB__CHUNK;
-            points_box(x + s, y + s, z + s, gm, gc, gr);
+            lb__points_box(x + s, y + s, z + s, gm, gc, gr);
         }
-        points_box(x + s, y + s, z + s, m, bc, br);
+        lb__points_box(x + s, y + s, z + s, m, bc, br);
         for (int a = 0; a < 2; ++a) {
             const uint32_t *cone = in->cone + (a ? in->ncone[0] : 0);
             const lb_evaluator *run_ev;
@@ -727,111 +718,6 @@ static lb_status parameters(child_eval *E, struct lb__curves *C, double size) {
     return s;
 }
 
-/* ---- step 6: the segment hierarchy ---- */
-
-static void seg_box(const struct lb__curves *C, uint32_t s, double lo[3], double hi[3]) {
-    const double *a = C->pts + 3 * C->seg[2 * s], *b = C->pts + 3 * C->seg[2 * s + 1];
-    for (int d = 0; d < 3; ++d) {
-        lo[d] = a[d] < b[d] ? a[d] : b[d];
-        hi[d] = a[d] < b[d] ? b[d] : a[d];
-    }
-}
-
-static uint32_t build(struct lb__curves *C, uint32_t *order, uint32_t first, uint32_t count) {
-    const uint32_t id = (uint32_t)C->nnodes++;
-    bvh_node *N = &C->bvh[id];
-    for (int d = 0; d < 3; ++d) {
-        N->lo[d] = INFINITY;
-        N->hi[d] = -INFINITY;
-    }
-    for (uint32_t i = 0; i < count; ++i) {
-        double lo[3], hi[3];
-        seg_box(C, order[first + i], lo, hi);
-        for (int d = 0; d < 3; ++d) {
-            if (lo[d] < N->lo[d]) N->lo[d] = lo[d];
-            if (hi[d] > N->hi[d]) N->hi[d] = hi[d];
-        }
-    }
-    if (count <= 4) {
-        N->leaf = 1;
-        N->left = first;
-        N->right = count;
-        return id;
-    }
-    int axis = 0;
-    for (int d = 1; d < 3; ++d)
-        if (N->hi[d] - N->lo[d] > N->hi[axis] - N->lo[axis]) axis = d;
-    /* partial sort by the segments' centres along the axis: median split */
-    const double cut = 0.5 * (N->lo[axis] + N->hi[axis]);
-    uint32_t l = first, r = first + count;
-    while (l < r) {
-        const uint32_t s = order[l];
-        const double c =
-            0.5 * (C->pts[3 * C->seg[2 * s] + axis] + C->pts[3 * C->seg[2 * s + 1] + axis]);
-        if (c < cut)
-            ++l;
-        else {
-            order[l] = order[--r];
-            order[r] = s;
-        }
-    }
-    uint32_t half = l - first;
-    if (half == 0 || half == count) half = count / 2;
-    N->leaf = 0;
-    const uint32_t left = build(C, order, first, half);
-    const uint32_t right = build(C, order, first + half, count - half);
-    C->bvh[id].left = left;
-    C->bvh[id].right = right;
-    return id;
-}
-
-static lb_status make_bvh(child_eval *E, struct lb__curves *C) {
-    size_t ns = 0;
-    for (size_t c = 0; c < C->ncomp; ++c) ns += C->comp[c].count - (C->comp[c].closed ? 0 : 1);
-    C->nseg = ns;
-    if (!ns) return LB_OK;
-    C->seg = malloc(2 * ns * sizeof *C->seg);
-    C->segc = malloc(ns * sizeof *C->segc);
-    C->bvh = malloc(2 * ns * sizeof *C->bvh);
-    uint32_t *order = malloc(ns * sizeof *order);
-    if (!C->seg || !C->segc || !C->bvh || !order) {
-        free(order);
-        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
-    }
-    size_t q = 0;
-    for (size_t c = 0; c < C->ncomp; ++c) {
-        const lb__component *K = &C->comp[c];
-        for (size_t i = 0; i + 1 < K->count || (K->closed && i < K->count); ++i) {
-            C->seg[2 * q] = (uint32_t)(K->first + i);
-            C->seg[2 * q + 1] = (uint32_t)(K->first + (i + 1) % K->count);
-            C->segc[q] = (uint32_t)c;
-            order[q] = (uint32_t)q;
-            ++q;
-        }
-    }
-    C->nnodes = 0;
-    build(C, order, 0, (uint32_t)ns);
-    /* leaves refer to the order: store the segments in that order */
-    uint32_t *seg = malloc(2 * ns * sizeof *seg), *segc = malloc(ns * sizeof *segc);
-    if (!seg || !segc) {
-        free(seg);
-        free(segc);
-        free(order);
-        return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", E->in->op->path);
-    }
-    for (size_t i = 0; i < ns; ++i) {
-        seg[2 * i] = C->seg[2 * order[i]];
-        seg[2 * i + 1] = C->seg[2 * order[i] + 1];
-        segc[i] = C->segc[order[i]];
-    }
-    free(C->seg);
-    free(C->segc);
-    C->seg = seg;
-    C->segc = segc;
-    free(order);
-    return LB_OK;
-}
-
 static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double bmin[3],
                              const double bmax[3], double *work, lb_error *err) {
     struct lb__curves *C = calloc(1, sizeof *C);
@@ -921,7 +807,7 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
     if (!s && C->nv) s = project(&E, C->nv, C->pts, size);
     if (!s) s = subdivide(&E, C, size);
     if (!s) s = parameters(&E, C, size);
-    if (!s) s = make_bvh(&E, C);
+    if (!s) s = lb__local_bvh(C, in->op->path, err);
     for (int q = 0; q < 2; ++q) {
         lb__cone_free(&E.grp[q]);
         lb__cone_free(&E.sub[q]);
@@ -959,240 +845,6 @@ lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, lb_error *e
         if (s) return s;
     }
     return LB_OK;
-}
-
-/* ---- evaluation ---- */
-
-static double box_dist2(const double lo[3], const double hi[3], const double X[3]) {
-    double s = 0.0;
-    for (int d = 0; d < 3; ++d) {
-        const double e = X[d] < lo[d] ? lo[d] - X[d] : X[d] > hi[d] ? X[d] - hi[d] : 0.0;
-        s += e * e;
-    }
-    return s;
-}
-
-/* the component with the smallest d / R near X (a < 1), the distance and
- * the closest point; returns a = d / R (>= 1: outside every volume) */
-static double nearest(const struct lb__curves *C, const double X[3], uint32_t *comp, double Q[3],
-                      double *dist) {
-    double best = 1.0;
-    if (!C || !C->nseg) return best;
-    uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top) {
-        const bvh_node *N = &C->bvh[stack[--top]];
-        if (box_dist2(N->lo, N->hi, X) >= C->rmax * C->rmax * best * best) continue;
-        if (!N->leaf) {
-            if (top + 2 <= 128) {
-                stack[top++] = N->left;
-                stack[top++] = N->right;
-            }
-            continue;
-        }
-        for (uint32_t i = 0; i < N->right; ++i) {
-            const uint32_t s = N->left + i;
-            const double *a = C->pts + 3 * C->seg[2 * s], *b = C->pts + 3 * C->seg[2 * s + 1];
-            double ab[3], ax[3], ll = 0.0, t = 0.0;
-            for (int d = 0; d < 3; ++d) {
-                ab[d] = b[d] - a[d];
-                ax[d] = X[d] - a[d];
-                ll += ab[d] * ab[d];
-                t += ab[d] * ax[d];
-            }
-            t = ll > 0.0 ? t / ll : 0.0;
-            if (t < 0.0) t = 0.0;
-            if (t > 1.0) t = 1.0;
-            double P[3], dd = 0.0;
-            for (int d = 0; d < 3; ++d) {
-                P[d] = a[d] + t * ab[d];
-                dd += (X[d] - P[d]) * (X[d] - P[d]);
-            }
-            const double R = C->comp[C->segc[s]].R, aa = sqrt(dd) / R;
-            if (aa < best) {
-                best = aa;
-                *comp = C->segc[s];
-                memcpy(Q, P, sizeof P);
-                *dist = sqrt(dd);
-            }
-        }
-    }
-    return best;
-}
-
-/* Wyvill's kernel W(a) = 1 - 4/9 a^6 + 17/9 a^4 - 22/9 a^2 on [0, 1] */
-static double wyvill(double a, double *dw) {
-    const double a2 = a * a;
-    *dw = a * (-24.0 / 9.0 * a2 * a2 + 68.0 / 9.0 * a2 - 44.0 / 9.0);
-    return 1.0 + a2 * (-4.0 / 9.0 * a2 * a2 + 17.0 / 9.0 * a2 - 22.0 / 9.0);
-}
-
-/* does any blending volume reach the box? (conservative) */
-int lb__local_reaches(const struct lb__curves *C, const double bc[3], const double br[3]) {
-    if (!C || !C->nseg) return 0;
-    const bvh_node *N = &C->bvh[0];
-    double s = 0.0;
-    for (int d = 0; d < 3; ++d) {
-        const double lo = bc[d] - br[d], hi = bc[d] + br[d];
-        const double e = hi < N->lo[d] ? N->lo[d] - hi : lo > N->hi[d] ? lo - N->hi[d] : 0.0;
-        s += e * e;
-    }
-    return s < C->rmax * C->rmax;
-}
-
-lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, const double *x,
-                        const double *y, const double *z, double *regs, lb_error *err) {
-    const lb__op *nd = in->op;
-    const lb_convention conv = ev->conv;
-    const double k = conv == LB_CONVENTION_ZERO ? -LB__LOCAL_ISO / nd->lp.zero_scale : 1.0;
-    double *ov = lb__reg(regs, in->dst, 0), *ox = lb__reg(regs, in->dst, 1),
-           *oy = lb__reg(regs, in->dst, 2), *oz = lb__reg(regs, in->dst, 3);
-    const uint32_t r0 = in->src[0], r1 = in->src[1];
-    /* a chunk (spatially compact: the evaluator sorts points) that no
-     * blending volume reaches skips the distance queries */
-    int reach = (lb__op_flags(nd) & LB__R_CURVES) && in->curves && in->curves->nseg;
-    if (reach && n) {
-        double bc[3], br[3];
-        points_box(x, y, z, n, bc, br);
-        reach = lb__local_reaches(in->curves, bc, br);
-    }
-    for (size_t j = 0; j < n; ++j) {
-        const double f[2] = {lb__reg(regs, r0, 0)[j], lb__reg(regs, r1, 0)[j]};
-        double gf[2][3];
-        for (int d = 0; d < 3; ++d) {
-            gf[0][d] = lb__reg(regs, r0, 1 + d)[j];
-            gf[1][d] = lb__reg(regs, r1, 1 + d)[j];
-        }
-        double g[2], guc[2];
-        if (conv == LB_CONVENTION_SOFT) { /* the children as they are (lb__local_in, inline) */
-            g[0] = f[0];
-            g[1] = f[1];
-        } else {
-            lb__local_in(nd, conv, f, g);
-        }
-        if (!(fabs(g[0]) <= LB_MAX_ABS_ARG && fabs(g[1]) <= LB_MAX_ABS_ARG))
-            return lb__fail(err, LB_ERR_NOT_FINITE,
-                            "%s: a child's value %g, %g is not finite or beyond 1e100", nd->path,
-                            f[0], f[1]);
-        const double uc = lb__clean_eval(LB_CLEAN_UC, g, LB__LOCAL_ISO, nd->lp.alpha, guc);
-        double u = uc, du[2] = {guc[0], guc[1]}, dv[3] = {0.0, 0.0, 0.0};
-        if (reach) {
-            const double X[3] = {x[j], y[j], z[j]};
-            uint32_t c = 0;
-            double Q[3] = {0.0, 0.0, 0.0}, dist = 0.0;
-            const double a = nearest(in->curves, X, &c, Q, &dist);
-            if (a < 1.0) {
-                const lb__component *K = &in->curves->comp[c];
-                double dw, gub[2], gm[3];
-                const double v = wyvill(a, &dw);
-                const double ub = lb__barthe_eval(g, K->p, K->q, gub);
-                lb_status s = lb_local_mix(uc, ub, v, nd->lp.exponent, &u, gm, err);
-                if (s) return s;
-                du[0] = gm[0] * guc[0] + gm[1] * gub[0];
-                du[1] = gm[0] * guc[1] + gm[1] * gub[1];
-                /* grad v = W'(a) / R (X - Q) / dist */
-                if (dist > 0.0)
-                    for (int d = 0; d < 3; ++d) dv[d] = gm[2] * dw / K->R * (X[d] - Q[d]) / dist;
-            }
-        }
-        /* back to the scene's convention: zero f = s (1 - U / C) */
-        const double out_k = conv == LB_CONVENTION_ZERO ? -nd->lp.zero_scale / LB__LOCAL_ISO : 1.0;
-        ov[j] = conv == LB_CONVENTION_SOFT ? (u > 0.0 ? u : 0.0) : lb__local_out(nd, conv, u);
-        double gg[3];
-        for (int d = 0; d < 3; ++d)
-            gg[d] = out_k * (k * (du[0] * gf[0][d] + du[1] * gf[1][d]) + dv[d]);
-        ox[j] = gg[0];
-        oy[j] = gg[1];
-        oz[j] = gg[2];
-    }
-    return LB_OK;
-}
-
-/* ---- bounds ---- */
-
-static double ur_val(double a, double b) {
-    return a + b + hypot(a, b);
-}
-
-void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv x[2],
-                      const double bc[3], const double br[3], lb__iv *out) {
-    const lb__op *nd = in->op;
-    const lb_convention conv = ev->conv;
-    double lo[2], hi[2];
-    if (!isfinite(x[0].lo) || !isfinite(x[0].hi) || !isfinite(x[1].lo) || !isfinite(x[1].hi)) {
-        /* a child unbounded on the box: nothing finite is known (the
-         * interval scheme's rule, eval_bounds.c) */
-        out->lo = conv == LB_CONVENTION_SOFT ? 0.0 : -INFINITY;
-        out->hi = INFINITY;
-        return;
-    }
-    for (int a = 0; a < 2; ++a) {
-        double f[2] = {x[a].lo, x[a].hi}, g[2];
-        lb__local_in(nd, conv, f, g);
-        lo[a] = g[0] < g[1] ? g[0] : g[1];
-        hi[a] = g[0] < g[1] ? g[1] : g[0];
-    }
-    const double C = LB__LOCAL_ISO, K = 2.0 - sqrt(2.0);
-    const double w0 = hi[0] - lo[0], w1 = hi[1] - lo[1];
-    if (br[0] == 0.0 && br[1] == 0.0 && br[2] == 0.0 && w0 <= 1e-9 * (1.0 + fabs(lo[0])) &&
-        w1 <= 1e-9 * (1.0 + fabs(lo[1]))) {
-        /* a point, its children known to rounding: the value at the middle,
-         * padded by the slope times the children's widths (the tests' point
-         * boxes are exact; the hull below is for boxes) */
-        const double m[2] = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])};
-        double gu[2], gb[2], u = lb__clean_eval(LB_CLEAN_UC, m, C, nd->lp.alpha, gu);
-        double slope = fabs(gu[0]) * w0 + fabs(gu[1]) * w1;
-        uint32_t c = 0;
-        double Q[3], dist = 0.0;
-        const double a =
-            (lb__op_flags(nd) & LB__R_CURVES) ? nearest(in->curves, bc, &c, Q, &dist) : 1.0;
-        if (a < 1.0) {
-            const lb__component *P = &in->curves->comp[c];
-            double dw, gm[3];
-            const double ub = lb__barthe_eval(m, P->p, P->q, gb);
-            slope += fabs(gb[0]) * w0 + fabs(gb[1]) * w1;
-            if (lb_local_mix(u, ub, wyvill(a, &dw), nd->lp.exponent, &u, gm, NULL)) u = ub;
-        }
-        const double pad = 2.0 * slope + 1e-12 * (1.0 + fabs(u));
-        const double o1 = lb__local_out(nd, conv, u - pad), o2 = lb__local_out(nd, conv, u + pad);
-        out->lo = o1 < o2 ? o1 : o2;
-        out->hi = o1 < o2 ? o2 : o1;
-        return;
-    }
-    /* max is always among the convex combination's ends */
-    double ulo = lo[0] > lo[1] ? lo[0] : lo[1], uhi = hi[0] > hi[1] ? hi[0] : hi[1];
-    /* the clean union's weight is 0 on the whole box (alpha 0 and one child
-     * at most LB_SOFT_MIN_FIELD): UC is max there, exactly */
-    const int wzero = nd->lp.alpha[0] == 0.0 && nd->lp.alpha[1] == 0.0 &&
-                      (hi[0] <= LB_SOFT_MIN_FIELD || hi[1] <= LB_SOFT_MIN_FIELD);
-    if (wzero) {
-    } else if (ulo < C) { /* outside both can occur: UC2 is increasing in both */
-        const double v1 = C + ur_val(lo[0] - C, lo[1] - C) / K;
-        const double v2 = C + ur_val(hi[0] - C, hi[1] - C) / K;
-        if (v1 < ulo) ulo = v1;
-        if (v2 > uhi) uhi = v2;
-    }
-    if (!wzero && hi[0] >= C && hi[1] >= C) { /* inside both can occur */
-        const double v2 = C + hypot(hi[0] - C, hi[1] - C);
-        if (v2 > uhi) uhi = v2;
-    }
-    if ((lb__op_flags(nd) & LB__R_CURVES) && lb__local_reaches(in->curves, bc, br)) {
-        /* UB >= max, increasing in both: its largest value at the top corner */
-        const struct lb__curves *Cv = in->curves;
-        for (size_t c = 0; c < Cv->ncomp; ++c) {
-            const double xy[2] = {hi[0], hi[1]};
-            double ub = 0.0;
-            if (lb_barthe_blend(xy, Cv->comp[c].p, Cv->comp[c].q, &ub, NULL, NULL) == LB_OK &&
-                ub > uhi)
-                uhi = ub;
-        }
-    }
-    ulo -= 1e-9 * (1.0 + fabs(ulo));
-    uhi += 1e-9 * (1.0 + fabs(uhi));
-    const double o1 = lb__local_out(nd, conv, ulo), o2 = lb__local_out(nd, conv, uhi);
-    out->lo = o1 < o2 ? o1 : o2;
-    out->hi = o1 < o2 ? o2 : o1;
 }
 
 /* ---- description (blendtool info) ---- */
