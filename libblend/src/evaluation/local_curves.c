@@ -33,6 +33,7 @@
  * describes them; local_bvh.c builds and queries step 6's hierarchy,
  * local_eval.c evaluates at points, local_bounds.c over boxes. */
 #include "local_internal.h"
+#include "../common/boxtree.h"
 #include "../common/kuhn.h"
 
 #include <float.h>
@@ -265,11 +266,32 @@ typedef struct cellset {
     size_t n, cap;
 } cellset;
 
-/* Cells where both children can cross C. A long cone is reduced cell by
- * cell (cone.c), each cell's from its parent's (E->oc[depth]), so a cell
- * costs what its parent's reduced cone holds, not the whole cone. */
-static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], const uint32_t hi[3],
-                        lb__iv *R, cellset *S, const lb__cone *const cur[2], int depth) {
+/* The descent's context: what each depth's halves start from. */
+#define CELL_DEPTH 64 /* > 3 log2(GRID) + 1 */
+typedef struct cell_walk {
+    child_eval *E;
+    const grid *G;
+    lb__iv *R;
+    cellset *S;
+    const lb__cone *next[CELL_DEPTH][2]; /* each child's cone, reduced over the box at depth */
+} cell_walk;
+
+/* Cells where both children can cross C (a visit of lb__box_descend). A
+ * long cone is reduced cell by cell (cone.c), each cell's from its
+ * parent's (E->oc[depth]), so a cell costs what its parent's reduced cone
+ * holds, not the whole cone. */
+static lb_status cell_visit(void *ctx, const uint32_t lo[3], const uint32_t hi[3], int depth,
+                            int cell, int *split) {
+    cell_walk *W = ctx;
+    child_eval *E = W->E;
+    const grid *G = W->G;
+    lb__iv *R = W->R;
+    cellset *S = W->S;
+    static const lb__cone *const whole[2] = {NULL, NULL};
+    if (depth >= CELL_DEPTH)
+        return lb__fail(E->err, LB_ERR_INTERNAL, "%s: cell octree deeper than %d", E->in->op->path,
+                        CELL_DEPTH);
+    const lb__cone *const *cur = depth ? W->next[depth - 1] : whole;
     double bmin[3], bmax[3], bc[3], br[3];
     for (int d = 0; d < 3; ++d) {
         bmin[d] = G->origin[d] + G->h * lo[d];
@@ -277,7 +299,9 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
     }
     lb__box_centre(bmin, bmax, bc, br);
     const lb__instr *in = E->in;
-    const lb__cone *next[2] = {cur[0], cur[1]};
+    const lb__cone **next = W->next[depth];
+    next[0] = cur[0];
+    next[1] = cur[1];
     /* the cheaper child first: most cells are pruned by it alone */
     const int first = E->wcone[1] < E->wcone[0];
     for (int t = 0; t < 2; ++t) {
@@ -316,28 +340,16 @@ static lb_status octree(child_eval *E, const grid *G, const uint32_t lo[3], cons
         double fl[2] = {f.lo, f.hi}, gl[2];
         lb__local_in(in->op, E->ev->conv, fl, gl);
         const double glo = gl[0] < gl[1] ? gl[0] : gl[1], ghi = gl[0] < gl[1] ? gl[1] : gl[0];
-        if (!(glo <= LB__LOCAL_ISO && ghi >= LB__LOCAL_ISO)) return LB_OK;
+        if (!(glo <= LB__LOCAL_ISO && ghi >= LB__LOCAL_ISO)) return LB_OK; /* pruned */
     }
-    int axis = -1;
-    uint32_t span = 1;
-    for (int d = 0; d < 3; ++d)
-        if (hi[d] - lo[d] > span) {
-            span = hi[d] - lo[d];
-            axis = d;
-        }
-    if (axis < 0) {
+    if (cell) {
         if (lb__grow((void **)&S->c, &S->cap, S->n + 1, 3 * sizeof *S->c))
             return lb__fail(E->err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
         memcpy(S->c + 3 * S->n++, lo, 3 * sizeof *lo);
         return LB_OK;
     }
-    uint32_t mid[3], lo2[3];
-    memcpy(mid, hi, sizeof mid);
-    memcpy(lo2, lo, sizeof lo2);
-    mid[axis] = lo[axis] + span / 2;
-    lo2[axis] = mid[axis];
-    lb_status s = octree(E, G, lo, mid, R, S, next, depth + 1);
-    return s ? s : octree(E, G, lo2, hi, R, S, next, depth + 1);
+    *split = 1;
+    return LB_OK;
 }
 
 /* ---- step 2: segments on the Kuhn tetrahedra ---- */
@@ -755,8 +767,17 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
             G.origin[d] = 0.5 * (bmin[d] + bmax[d]) - 0.5 * G.h * G.cells[d] + 1e-7 * G.h * (d + 1);
         }
         const uint32_t zero[3] = {0, 0, 0};
-        const lb__cone *whole[2] = {NULL, NULL};
-        s = octree(&E, &G, zero, G.cells, R, &S, whole, 0);
+        cell_walk *W = malloc(sizeof *W);
+        if (!W) {
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", in->op->path);
+        } else {
+            W->E = &E;
+            W->G = &G;
+            W->R = R;
+            W->S = &S;
+            s = lb__box_descend(W, cell_visit, zero, G.cells, 0);
+            free(W);
+        }
     }
     /* sample the kept cells' nodes */
     if (!s && S.n) {

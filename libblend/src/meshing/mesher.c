@@ -33,6 +33,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "../common/boxtree.h"
 #include "../common/platform.h"
 
 static const char FN[] = "lb_mesh_create";
@@ -150,6 +151,7 @@ typedef struct sel {
     lb__plan *pool; /* one plan per depth */
     lb__iv *R;
     int keep; /* store each block's plan */
+    lb_error *err;
 } sel;
 
 /* Depths of the octree over nb blocks: each level halves one side. */
@@ -160,8 +162,13 @@ static int sel_depth(const uint32_t nb[3]) {
     return d;
 }
 
-static lb_status select_blocks(sel *S, const uint32_t r0[3], const uint32_t r1[3],
-                               const lb__plan *parent, int depth, lb_error *err) {
+/* One box of blocks [r0, r1) (a visit of lb__box_descend): kept when the
+ * surface may cross it, a kept single block into the list with its plan. */
+static lb_status select_visit(void *ctx, const uint32_t r0[3], const uint32_t r1[3], int depth,
+                              int cell, int *split) {
+    sel *S = ctx;
+    lb_error *err = S->err;
+    const lb__plan *parent = depth ? &S->pool[depth - 1] : NULL;
     const lb__grid *g = S->g;
     uint64_t n0[3], n1[3];
     for (int d = 0; d < 3; ++d) {
@@ -181,15 +188,8 @@ static lb_status select_blocks(sel *S, const uint32_t r0[3], const uint32_t r1[3
     double lo, hi;
     phi_interval(g, bl, bh, S->R[S->ev->out].lo, S->R[S->ev->out].hi, &lo, &hi);
     if (lo >= 0.0 || hi < 0.0) return LB_OK; /* all outside, or all inside */
-    int axis = -1;
-    uint32_t span = 1;
-    for (int d = 0; d < 3; ++d)
-        if (r1[d] - r0[d] > span) {
-            span = r1[d] - r0[d];
-            axis = d;
-        }
     blist *L = S->L;
-    if (axis < 0) {
+    if (cell) {
         if (L->n >= S->max_blocks)
             return lb__fail(err, LB_ERR_NO_MEMORY, "%s: more than %zu blocks", FN, S->max_blocks);
         if (L->n == L->cap) {
@@ -213,13 +213,8 @@ static lb_status select_blocks(sel *S, const uint32_t r0[3], const uint32_t r1[3
         B->id = ((uint64_t)r0[2] * S->nb[1] + r0[1]) * S->nb[0] + r0[0];
         return LB_OK;
     }
-    const uint32_t mid = r0[axis] + span / 2;
-    uint32_t a1[3] = {r1[0], r1[1], r1[2]}, b0[3] = {r0[0], r0[1], r0[2]};
-    a1[axis] = mid;
-    b0[axis] = mid;
-    lb_status s = select_blocks(S, r0, a1, own, depth + 1, err);
-    if (s) return s;
-    return select_blocks(S, b0, r1, own, depth + 1, err);
+    *split = 1;
+    return LB_OK;
 }
 
 static void blist_free(blist *L) {
@@ -241,11 +236,12 @@ static lb_status select_all(const lb_evaluator *ev, const lb__grid *g, const uin
              max_blocks,
              calloc((size_t)depth, sizeof(lb__plan)),
              malloc(lb__ivs_len(ev) * sizeof(lb__iv)),
-             keep};
+             keep,
+             err};
     lb_status s = S.pool && S.R ? LB_OK : lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     for (int d = 0; d < depth && !s && S.pool; ++d) s = lb__plan_alloc(ev, &S.pool[d], err);
     const uint32_t zero[3] = {0, 0, 0};
-    if (!s) s = select_blocks(&S, zero, nb, NULL, 0, err);
+    if (!s) s = lb__box_descend(&S, select_visit, zero, nb, 0);
     for (int d = 0; d < depth && S.pool; ++d) lb__plan_free(&S.pool[d]);
     free(S.pool);
     free(S.R);
