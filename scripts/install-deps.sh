@@ -8,7 +8,6 @@ PACKAGES=(
   clang libclang-rt-14-dev   # libFuzzer and sanitizer runtimes for clang
   libcmocka-dev              # unit-test framework used by tests/
   libcjson-dev               # JSON parser for scene files
-  libjansson-dev             # strict RFC 8259 check of scene files (line:column)
   python3-jsonschema         # tests: scene files against docs/libblend-scene.schema.json
   python3-numpy              # tests: independent mesh readers and checks (tests/mesh/)
   python3-skimage            # tests: marching cubes on the same grid, the mesher's reference

@@ -1,16 +1,15 @@
 #!/usr/bin/env bash
-# The JSON libraries libblend links statically, built from Debian's own
-# source packages, so that libblend.so (and the add-on and SDK that carry it)
-# needs no JSON library at run time:
+# The JSON library libblend links statically, built from Debian's own source
+# package, so that libblend.so (and the add-on and SDK that carry it) needs
+# no JSON library at run time:
 #
 #   third-party.sh DIR [PLATFORM]
-#       build cJSON and jansson for PLATFORM (linux-x64, the default, or
-#       windows-x64) into DIR (DIR/include, DIR/lib/libcjson.a, libjansson.a;
-#       for windows-x64 also cmocka, which the cross-compiled tests use); a
-#       second run with the same recipe does nothing
+#       build cJSON for PLATFORM (linux-x64, the default, or windows-x64)
+#       into DIR (DIR/include, DIR/lib/libcjson.a; for windows-x64 also
+#       cmocka, which the cross-compiled tests use); a second run with the
+#       same recipe does nothing
 #
-# Debian ships no PIC archive of either (libcjson-dev has no .a at all; the
-# libjansson.a of libjansson-dev is not position independent), so they are
+# Debian ships no archive of cJSON (libcjson-dev has no .a at all), so it is
 # built here: the source packages of the Debian release this machine runs
 # (Debian's patches applied, as in its own binary packages) are fetched with
 # `apt-get source` through a private source list and private apt state under
@@ -34,14 +33,14 @@ HERE=$(cd "$(dirname "$0")/.." && pwd)
 COMPAT="$HERE/libblend/src/common/glibc_compat.h"
 case "$PLATFORM" in
 linux-x64)
-  PACKAGES=(cjson jansson)
+  PACKAGES=(cjson)
   CC=gcc
   AR=ar
   CFLAGS_TP="-O2 -g0 -fPIC -fvisibility=hidden -include $COMPAT -DLB_GLIBC_BASELINE=1"
   CMAKE_CROSS=()
   ;;
 windows-x64)
-  PACKAGES=(cjson jansson cmocka)
+  PACKAGES=(cjson cmocka)
   CC=x86_64-w64-mingw32-gcc-posix
   AR=x86_64-w64-mingw32-ar
   # cJSON marks its functions dllexport on Windows unless told otherwise
@@ -114,21 +113,7 @@ $CC $CFLAGS_TP -std=c89 -c "$cj/cJSON.c" -o "$TMP/cJSON.o"
 mkdir -p "$TMP/include/cjson"
 cp "$cj/cJSON.h" "$TMP/include/cjson/"
 
-# jansson: its own CMake build, static only.
-js=$(find "$TMP/src" -maxdepth 1 -type d -name 'jansson-*' | head -1)
-[ -n "$js" ] || die "no jansson source folder"
-cmake -S "$js" -B "$TMP/jansson-build" -G Ninja -DCMAKE_BUILD_TYPE=Release "${CMAKE_CROSS[@]}" \
-  -DCMAKE_C_COMPILER="$CC" -DCMAKE_C_FLAGS="$CFLAGS_TP" \
-  -DJANSSON_BUILD_SHARED_LIBS=OFF -DJANSSON_BUILD_DOCS=OFF -DJANSSON_WITHOUT_TESTS=ON \
-  -DJANSSON_EXAMPLES=OFF -DJANSSON_COVERAGE=OFF -DUSE_URANDOM=ON -DUSE_WINDOWS_CRYPTOAPI=OFF \
-  -DCMAKE_INSTALL_PREFIX="$TMP/jansson-install" >>"$TMP/build.log" 2>&1 ||
-  { cat "$TMP/build.log" >&2; die "jansson configure failed"; }
-cmake --build "$TMP/jansson-build" >>"$TMP/build.log" 2>&1 &&
-  cmake --install "$TMP/jansson-build" >>"$TMP/build.log" 2>&1 ||
-  { cat "$TMP/build.log" >&2; die "jansson build failed"; }
-cp "$TMP/jansson-install/lib/libjansson.a" "$TMP/lib/"
-cp "$TMP/jansson-install/include/"*.h "$TMP/include/"
-for f in "$cj/LICENSE" "$js/LICENSE"; do
+for f in "$cj/LICENSE"; do
   cp "$f" "$TMP/LICENSE.$(basename "$(dirname "$f")" | cut -d- -f1)"
 done
 
@@ -150,7 +135,7 @@ if [[ " ${PACKAGES[*]} " == *" cmocka "* ]]; then
 fi
 
 printf 'recipe %s\nsources %s\n' "$recipe" "$versions" >"$TMP/.stamp"
-rm -rf "$TMP"/{apt,src,jansson-build,jansson-install,cmocka-build,cmocka-install,cJSON.o,apt.log,build.log}
+rm -rf "$TMP"/{apt,src,cmocka-build,cmocka-install,cJSON.o,apt.log,build.log}
 rm -rf "$DIR"
 mv "$TMP" "$DIR"
 trap - EXIT

@@ -12,7 +12,6 @@
 #include <sys/stat.h>
 
 #include <cjson/cJSON.h>
-#include <jansson.h>
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -168,35 +167,6 @@ static void line_col(const char *text, size_t len, size_t off, size_t *line, siz
     }
 }
 
-/* RFC 8259 exactly, after cJSON (whose messages the bad-scene tables pin)
- * accepted the text: cJSON also takes leading zeros (01), a bare fraction
- * point (1.), raw control characters in strings, text after a NUL byte and
- * \u0000 (cutting the string there). Debian's libjansson is strict about all
- * of them and names the line and column (duplicate keys are the
- * validation's: it names the JSON path). */
-static lb_status strict_json(const char *text, size_t length, const char *file, lb_error *err) {
-    json_error_t je;
-    json_t *j = json_loadb(text, length, 0, &je);
-    if (j) {
-        json_decref(j);
-        return LB_OK;
-    }
-    /* 1e999 is valid RFC 8259 syntax: the validation names it as not finite */
-    if (json_error_code(&je) == json_error_numeric_overflow) return LB_OK;
-    size_t line = 1, col = 1;
-    if (je.position >= 0 && je.line >= 0) {
-        size_t off = (size_t)je.position;
-        if (off > length) off = length;
-        /* jansson's position is just past the offending character */
-        line_col(text, length, off ? off - 1 : 0, &line, &col);
-    }
-    return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
-                    "%s:%zu:%zu: invalid JSON: %s; allowed: a JSON document (RFC 8259: no "
-                    "leading zeros, digits after a decimal point, control characters in strings "
-                    "escaped, no \\u0000, nothing after the document)",
-                    file, line, col, je.text);
-}
-
 lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_scene **out,
                          lb_error *err) {
     const char *file = name ? name : "<scene>";
@@ -259,10 +229,10 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
                 --depth;
         }
     }
-    /* the strict check first, alone: its tree is freed before cJSON builds
-     * one, so the peak is one parser's tree, not both; its message is given
-     * only when cJSON accepted the text (cJSON's messages come first) */
-    const lb_status strict = strict_json(text, length, file, err);
+    /* the strict check first (json_strict.c: one pass, nothing allocated);
+     * its message is given only when cJSON accepted the text (cJSON's
+     * messages come first) */
+    const lb_status strict = lb__json_strict(text, length, file, err);
     const char *end = NULL;
     cJSON *doc = cJSON_ParseWithLengthOpts(text, length, &end, 0);
     if (!doc) {

@@ -33,6 +33,12 @@ typedef struct pctx {
     size_t count;
 } pctx;
 
+/* ---- json_strict.c ---- */
+/* text is RFC 8259 JSON exactly (what cJSON accepts beyond it refused with
+ * FILE:line:column) */
+LB_INTERNAL lb_status lb__json_strict(const char *text, size_t length, const char *file,
+                                      lb_error *err);
+
 /* ---- parse_read.c ---- */
 /* the one failure message of a parse: FILE: $.path: what is wrong; allowed: ... (st returned) */
 LB_INTERNAL lb_status lb__perr(pctx *c, lb_status st, const char *fmt, ...) LB_PRINTF(3, 4);

@@ -1,0 +1,236 @@
+/* RFC 8259, exactly, for what cJSON (the one JSON parser the library
+ * links) accepts beyond it: leading zeros (01), a bare decimal point (1.),
+ * a plus sign or an empty exponent, raw control characters in strings,
+ * text after a NUL byte, \u0000 (which would cut the string there), lone
+ * UTF-16 surrogates, and bytes that are not UTF-8. One pass over the text,
+ * nothing allocated; the nesting was bounded by parse.c's pre-scan. The
+ * first violation is named with its line and column. Duplicate keys are
+ * the validation's (it names the JSON path), numbers too large for a
+ * double (1e999) too (it names them as not finite). */
+#include "parse_internal.h"
+
+#include <stdio.h>
+#include <string.h>
+
+typedef struct jscan {
+    const unsigned char *t;
+    size_t n, i;
+    const char *what; /* the first violation, or NULL */
+    size_t at;        /* its offset */
+} jscan;
+
+static int fail_at(jscan *S, size_t at, const char *what) {
+    if (!S->what) {
+        S->what = what;
+        S->at = at;
+    }
+    return 0;
+}
+
+static void ws(jscan *S) {
+    while (S->i < S->n &&
+           (S->t[S->i] == ' ' || S->t[S->i] == '\t' || S->t[S->i] == '\n' || S->t[S->i] == '\r'))
+        ++S->i;
+}
+
+static int digit(jscan *S) {
+    return S->i < S->n && S->t[S->i] >= '0' && S->t[S->i] <= '9';
+}
+
+/* -? (0 | [1-9][0-9]*) (. [0-9]+)? ([eE] [+-]? [0-9]+)? */
+static int number(jscan *S) {
+    const size_t at = S->i;
+    if (S->t[S->i] == '-') ++S->i;
+    if (!digit(S)) return fail_at(S, at, "a number needs a digit after its sign");
+    if (S->t[S->i] == '0') {
+        ++S->i;
+        if (digit(S)) return fail_at(S, at, "a number with a leading zero");
+    } else {
+        while (digit(S)) ++S->i;
+    }
+    if (S->i < S->n && S->t[S->i] == '.') {
+        ++S->i;
+        if (!digit(S)) return fail_at(S, at, "a decimal point without digits after it");
+        while (digit(S)) ++S->i;
+    }
+    if (S->i < S->n && (S->t[S->i] == 'e' || S->t[S->i] == 'E')) {
+        ++S->i;
+        if (S->i < S->n && (S->t[S->i] == '+' || S->t[S->i] == '-')) ++S->i;
+        if (!digit(S)) return fail_at(S, at, "an exponent without digits");
+        while (digit(S)) ++S->i;
+    }
+    return 1;
+}
+
+static int hex4(jscan *S, unsigned *u) {
+    *u = 0;
+    for (int k = 0; k < 4; ++k, ++S->i) {
+        if (S->i >= S->n) return 0;
+        const unsigned char c = S->t[S->i];
+        const int v = c >= '0' && c <= '9'   ? c - '0'
+                      : c >= 'a' && c <= 'f' ? c - 'a' + 10
+                      : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                             : -1;
+        if (v < 0) return 0;
+        *u = *u * 16 + (unsigned)v;
+    }
+    return 1;
+}
+
+/* one UTF-8 sequence at S->i (RFC 3629: shortest form, no surrogates, at
+ * most U+10FFFF) */
+static int utf8(jscan *S) {
+    const unsigned char c = S->t[S->i];
+    size_t len;
+    unsigned cp, min;
+    if (c < 0x80) {
+        ++S->i;
+        return 1;
+    } else if ((c & 0xE0) == 0xC0) {
+        len = 2, cp = c & 0x1Fu, min = 0x80;
+    } else if ((c & 0xF0) == 0xE0) {
+        len = 3, cp = c & 0x0Fu, min = 0x800;
+    } else if ((c & 0xF8) == 0xF0) {
+        len = 4, cp = c & 0x07u, min = 0x10000;
+    } else {
+        return fail_at(S, S->i, "a byte that is not UTF-8");
+    }
+    if (S->i + len > S->n) return fail_at(S, S->i, "a UTF-8 sequence cut short");
+    for (size_t k = 1; k < len; ++k) {
+        const unsigned char d = S->t[S->i + k];
+        if ((d & 0xC0) != 0x80) return fail_at(S, S->i, "a byte that is not UTF-8");
+        cp = cp << 6 | (d & 0x3Fu);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+        return fail_at(S, S->i, "a byte sequence that is not UTF-8");
+    S->i += len;
+    return 1;
+}
+
+static int string(jscan *S) {
+    ++S->i; /* the opening quote */
+    while (S->i < S->n) {
+        const unsigned char c = S->t[S->i];
+        if (c == '"') {
+            ++S->i;
+            return 1;
+        }
+        if (c < 0x20) return fail_at(S, S->i, "a control character in a string (escape it)");
+        if (c != '\\') {
+            if (!utf8(S)) return 0;
+            continue;
+        }
+        const size_t at = S->i++;
+        if (S->i >= S->n) break;
+        const unsigned char e = S->t[S->i++];
+        if (strchr("\"\\/bfnrt", e) && e) continue;
+        if (e != 'u') return fail_at(S, at, "an unknown escape in a string");
+        unsigned u, v;
+        if (!hex4(S, &u)) return fail_at(S, at, "\\u needs four hex digits");
+        if (u == 0) return fail_at(S, at, "\\u0000 is not allowed");
+        if (u >= 0xDC00 && u <= 0xDFFF) return fail_at(S, at, "a lone UTF-16 low surrogate");
+        if (u >= 0xD800 && u <= 0xDBFF) {
+            if (!(S->i + 1 < S->n && S->t[S->i] == '\\' && S->t[S->i + 1] == 'u'))
+                return fail_at(S, at, "a lone UTF-16 high surrogate");
+            S->i += 2;
+            if (!hex4(S, &v) || v < 0xDC00 || v > 0xDFFF)
+                return fail_at(S, at, "a UTF-16 high surrogate without its low one");
+        }
+    }
+    return fail_at(S, S->n, "a string without its closing quote");
+}
+
+static int literal(jscan *S, const char *word) {
+    const size_t len = strlen(word);
+    if (S->n - S->i < len || memcmp(S->t + S->i, word, len) != 0)
+        return fail_at(S, S->i, "an unknown token");
+    S->i += len;
+    return 1;
+}
+
+static int value(jscan *S);
+
+/* members or elements up to close, after the opening bracket */
+static int members(jscan *S, int object) {
+    const unsigned char close = object ? '}' : ']';
+    ++S->i;
+    ws(S);
+    if (S->i < S->n && S->t[S->i] == close) {
+        ++S->i;
+        return 1;
+    }
+    for (;;) {
+        if (object) {
+            if (S->i >= S->n || S->t[S->i] != '"') return fail_at(S, S->i, "a key expected");
+            if (!string(S)) return 0;
+            ws(S);
+            if (S->i >= S->n || S->t[S->i] != ':') return fail_at(S, S->i, "':' expected");
+            ++S->i;
+        }
+        if (!value(S)) return 0;
+        ws(S);
+        if (S->i < S->n && S->t[S->i] == ',') {
+            ++S->i;
+            ws(S);
+            continue;
+        }
+        if (S->i < S->n && S->t[S->i] == close) {
+            ++S->i;
+            return 1;
+        }
+        return fail_at(S, S->i, object ? "',' or '}' expected" : "',' or ']' expected");
+    }
+}
+
+static int value(jscan *S) {
+    ws(S);
+    if (S->i >= S->n) return fail_at(S, S->i, "a value expected at the end of the input");
+    switch (S->t[S->i]) {
+    case '{':
+        return members(S, 1);
+    case '[':
+        return members(S, 0);
+    case '"':
+        return string(S);
+    case 't':
+        return literal(S, "true");
+    case 'f':
+        return literal(S, "false");
+    case 'n':
+        return literal(S, "null");
+    default:
+        if (S->t[S->i] == '-' || digit(S)) return number(S);
+        return fail_at(S, S->i, "an unknown token");
+    }
+}
+
+lb_status lb__json_strict(const char *text, size_t length, const char *file, lb_error *err) {
+    jscan S = {(const unsigned char *)text, length, 0, NULL, 0};
+    if (value(&S)) {
+        ws(&S);
+        if (S.i < S.n)
+            fail_at(&S, S.i,
+                    S.t[S.i] ? "text after the end of the document" : "a NUL byte in the text");
+    }
+    if (!S.what) return LB_OK;
+    size_t line = 1, col = 1;
+    for (size_t i = 0; i < S.at && i < length; ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            col = 1;
+        } else {
+            ++col;
+        }
+    }
+    /* what is there, printable ASCII only, so the message stays one line */
+    char near[16];
+    size_t nl = 0;
+    for (size_t i = S.at; i < length && nl < 8; ++i)
+        near[nl++] = text[i] >= 32 && text[i] < 127 ? text[i] : '?';
+    near[nl] = '\0';
+    return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                    "%s:%zu:%zu: invalid JSON: %s%s%s%s; allowed: a JSON document (RFC 8259: no "
+                    "leading zeros, digits after a decimal point, control characters in strings "
+                    "escaped, no \\u0000, UTF-8 text, nothing after the document)",
+                    file, line, col, S.what, nl ? " near '" : "", near, nl ? "'" : "");
+}
