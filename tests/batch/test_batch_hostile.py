@@ -247,6 +247,24 @@ for k, (extra, where, word) in enumerate(BADJOBS):
         check(r.returncode == 2 and where in r.stderr and word in r.stderr,
               "%r %s: exit 2 naming %s: %d %s" % (extra, args, where, r.returncode, r.stderr))
     check(not os.path.exists(os.path.join(d, "out")), "%r: nothing created" % extra)
+# the JSON rules scenes follow (common/json_check.c): each key once, RFC 8259
+RAWJOBS = [
+    ('"name": "a", "name": "b"', "appears twice"),
+    ('"name": "raw", "outputs": {"mesh": {"resolution": 012}}', "leading zero"),
+    ('"name": "raw\x01"', "control character"),
+    ('"name": "raw\xff"', "not UTF-8"),
+]
+for k, (members, word) in enumerate(RAWJOBS):
+    d = os.path.join(WORK, "raw", str(k))
+    os.makedirs(d, exist_ok=True)
+    p = os.path.join(d, "job.json")
+    with open(p, "wb") as f:
+        f.write(('{"format": "libblend-job", "version": 1, "scene": %s, ' % json.dumps(SCENE)
+                 ).encode() + members.encode("latin-1") + b"}")
+    r = bt("batch", p, "--list")
+    check(r.returncode == 2 and word in r.stderr and "job.json" in r.stderr,
+          "raw job %d: exit 2 naming %r: %d %s" % (k, word, r.returncode, r.stderr))
+    check(not os.path.exists(os.path.join(d, "out")), "raw job %d: nothing created" % k)
 # a job file whose own name is unsafe needs "name"
 d = os.path.join(WORK, "names", "stem")
 p = job_in(d, {k: v for k, v in TINY.items() if k != "name"}, "bad name.json")

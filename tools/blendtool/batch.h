@@ -9,6 +9,8 @@
 
 #include "blendtool.h"
 
+#include "../../libblend/src/common/json_check.h"
+
 #include <cjson/cJSON.h>
 #include <ctype.h>
 #include <dirent.h>

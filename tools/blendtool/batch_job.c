@@ -13,28 +13,19 @@ int batch_bad(const job *J, const char *path, const char *fmt, ...) {
     return BT_EXIT_BAD_INPUT;
 }
 
-static const char *kind(const cJSON *v) {
-    return !v                  ? "nothing"
-           : cJSON_IsNumber(v) ? "a number"
-           : cJSON_IsString(v) ? "a string"
-           : cJSON_IsBool(v)   ? "a boolean"
-           : cJSON_IsArray(v)  ? "an array"
-           : cJSON_IsObject(v) ? "an object"
-                               : "null";
-}
-
+/* every key of o one of keys, once (common/json_check.c, as for scenes) */
 static int check_keys(const job *J, const cJSON *o, const char *path, const char *const *keys) {
-    for (const cJSON *c = o->child; c; c = c->next) {
-        int ok = 0;
-        for (int i = 0; keys[i] && !ok; ++i) ok = strcmp(c->string, keys[i]) == 0;
-        if (!ok) {
-            char allowed[512] = "";
-            size_t o2 = 0;
-            for (int i = 0; keys[i]; ++i)
-                o2 += (size_t)snprintf(allowed + o2, sizeof allowed - o2, "%s%s", i ? ", " : "",
-                                       keys[i]);
-            return batch_bad(J, path, "unknown key \"%s\"; allowed: %s", c->string, allowed);
-        }
+    const cJSON *bad = NULL;
+    const int k = lb__json_keys(o, keys, &bad);
+    if (k == 2)
+        return batch_bad(J, path, "key \"%s\" appears twice; allowed: each key once", bad->string);
+    if (k == 1) {
+        char allowed[512] = "";
+        size_t o2 = 0;
+        for (int i = 0; keys[i] && o2 < sizeof allowed; ++i)
+            o2 +=
+                (size_t)snprintf(allowed + o2, sizeof allowed - o2, "%s%s", i ? ", " : "", keys[i]);
+        return batch_bad(J, path, "unknown key \"%s\"; allowed: %s", bad->string, allowed);
     }
     return 0;
 }
@@ -48,7 +39,7 @@ static int get_int(const job *J, const cJSON *o, const char *key, const char *pa
         char num[64] = "";
         if (cJSON_IsNumber(v)) snprintf(num, sizeof num, " %.17g", v->valuedouble);
         return batch_bad(J, path, "\"%s\" is %s%s; allowed: an integer from %ld to %ld", key,
-                         kind(v), num, lo, hi);
+                         lb__json_kind(v), num, lo, hi);
     }
     *out = (long)v->valuedouble;
     return 0;
@@ -123,7 +114,7 @@ static int parse_axis(const job *J, const cJSON *a, const char *path, axis *X) {
         return batch_bad(J, path,
                          "expected an object {\"path\": ..., \"values\": [...]} or "
                          "{\"path\": ..., \"range\": {...}}, found %s",
-                         kind(a));
+                         lb__json_kind(a));
     int rc = check_keys(J, a, path, keys);
     if (rc) return rc;
     const cJSON *p = cJSON_GetObjectItemCaseSensitive(a, "path");
@@ -131,7 +122,7 @@ static int parse_axis(const job *J, const cJSON *a, const char *path, axis *X) {
         return batch_bad(J, path,
                          "\"path\" is %s; allowed: a JSON path into the scene such as "
                          "\"root.args[0].radius\"",
-                         kind(p));
+                         lb__json_kind(p));
     X->path = batch_dupstr(p->valuestring);
     const cJSON *vals = cJSON_GetObjectItemCaseSensitive(a, "values");
     const cJSON *rg = cJSON_GetObjectItemCaseSensitive(a, "range");
@@ -139,7 +130,7 @@ static int parse_axis(const job *J, const cJSON *a, const char *path, axis *X) {
     if (vals) {
         if (!cJSON_IsArray(vals) || cJSON_GetArraySize(vals) < 1)
             return batch_bad(J, path, "\"values\" is %s; allowed: a non-empty list of JSON values",
-                             kind(vals));
+                             lb__json_kind(vals));
         X->n = (size_t)cJSON_GetArraySize(vals);
         X->values = calloc(X->n, sizeof *X->values);
         size_t i = 0;
@@ -157,7 +148,8 @@ static int parse_axis(const job *J, const cJSON *a, const char *path, axis *X) {
                 *t = cJSON_GetObjectItemCaseSensitive(rg, "to");
     long count = -1;
     if (!cJSON_IsNumber(f) || !cJSON_IsNumber(t))
-        return batch_bad(J, rp, "\"from\" is %s and \"to\" %s; allowed: numbers", kind(f), kind(t));
+        return batch_bad(J, rp, "\"from\" is %s and \"to\" %s; allowed: numbers", lb__json_kind(f),
+                         lb__json_kind(t));
     if ((rc = get_int(J, rg, "count", rp, 1, MAX_TASKS, &count))) return rc;
     if (count < 1)
         return batch_bad(J, rp, "\"count\" is missing; allowed: an integer from 1 to %d",
@@ -201,7 +193,7 @@ static int parse_frames(job *J, const cJSON *fr) {
     if (!cJSON_IsObject(fr))
         return batch_bad(J, "$.frames",
                          "expected {\"first\": A, \"last\": B, \"animate\": [...]}, found %s",
-                         kind(fr));
+                         lb__json_kind(fr));
     int rc = check_keys(J, fr, "$.frames", keys);
     if (rc) return rc;
     J->first = J->last = -1;
@@ -224,22 +216,23 @@ static int parse_frames(job *J, const cJSON *fr) {
         char path[128];
         snprintf(path, sizeof path, "$.frames.animate[%zu]", i);
         static const char *const akeys[] = {"path", "keys", "interpolation", NULL};
-        if (!cJSON_IsObject(a)) return batch_bad(J, path, "expected an object, found %s", kind(a));
+        if (!cJSON_IsObject(a))
+            return batch_bad(J, path, "expected an object, found %s", lb__json_kind(a));
         if ((rc = check_keys(J, a, path, akeys))) return rc;
         const cJSON *p = cJSON_GetObjectItemCaseSensitive(a, "path"),
                     *k = cJSON_GetObjectItemCaseSensitive(a, "keys"),
                     *in = cJSON_GetObjectItemCaseSensitive(a, "interpolation");
         if (!cJSON_IsString(p) || !path_ok(p->valuestring))
             return batch_bad(J, path, "\"path\" is %s; allowed: a JSON path into the scene",
-                             kind(p));
+                             lb__json_kind(p));
         const char *interp = in ? (cJSON_IsString(in) ? in->valuestring : "") : "linear";
         if (strcmp(interp, "linear") && strcmp(interp, "step") && strcmp(interp, "smooth"))
             return batch_bad(J, path,
                              "\"interpolation\" is %s; allowed: \"linear\", \"step\", \"smooth\"",
-                             in && cJSON_IsString(in) ? in->valuestring : kind(in));
+                             in && cJSON_IsString(in) ? in->valuestring : lb__json_kind(in));
         if (!cJSON_IsArray(k) || cJSON_GetArraySize(k) < 1)
             return batch_bad(J, path, "\"keys\" is %s; allowed: a list of [frame, number] pairs",
-                             kind(k));
+                             lb__json_kind(k));
         double lastf = -INFINITY;
         size_t j = 0;
         for (const cJSON *q = k->child; q; q = q->next, ++j) {
@@ -247,7 +240,7 @@ static int parse_frames(job *J, const cJSON *fr) {
             if (!cJSON_IsArray(q) || cJSON_GetArraySize(q) != 2 || !cJSON_IsNumber(f) ||
                 !cJSON_IsNumber(v))
                 return batch_bad(J, path, "keys[%zu] is %s; allowed: a [frame, number] pair", j,
-                                 kind(q));
+                                 lb__json_kind(q));
             if (!(f->valuedouble > lastf))
                 return batch_bad(J, path,
                                  "keys[%zu]: frame %g after %g; allowed: increasing frames", j,
@@ -275,7 +268,7 @@ static int parse_outputs(job *J, const cJSON *o) {
     if (m) {
         static const char *const mk[] = {"format", "resolution", NULL};
         if (!cJSON_IsObject(m))
-            return batch_bad(J, "$.outputs.mesh", "expected an object, found %s", kind(m));
+            return batch_bad(J, "$.outputs.mesh", "expected an object, found %s", lb__json_kind(m));
         if ((rc = check_keys(J, m, "$.outputs.mesh", mk))) return rc;
         J->mesh = 1;
         J->mesh_fmt = LB_MESH_FORMAT_PLY;
@@ -289,7 +282,7 @@ static int parse_outputs(job *J, const cJSON *o) {
             if (J->mesh_fmt == LB_MESH_FORMAT_AUTO)
                 return batch_bad(J, "$.outputs.mesh.format",
                                  "%s; allowed: \"ply\", \"obj\", \"stl\", \"glb\"",
-                                 cJSON_IsString(f) ? f->valuestring : kind(f));
+                                 cJSON_IsString(f) ? f->valuestring : lb__json_kind(f));
         }
         long r = 128;
         if ((rc = get_int(J, m, "resolution", "$.outputs.mesh", 1, LB_MESH_MAX_CELLS_PER_AXIS, &r)))
@@ -300,7 +293,7 @@ static int parse_outputs(job *J, const cJSON *o) {
     if (p) {
         static const char *const pk[] = {"width", "height", NULL};
         if (!cJSON_IsObject(p))
-            return batch_bad(J, "$.outputs.pov", "expected an object, found %s", kind(p));
+            return batch_bad(J, "$.outputs.pov", "expected an object, found %s", lb__json_kind(p));
         if ((rc = check_keys(J, p, "$.outputs.pov", pk))) return rc;
         long w = 640, h = 480;
         if ((rc = get_int(J, p, "width", "$.outputs.pov", 1, 16384, &w)) ||
@@ -315,7 +308,8 @@ static int parse_outputs(job *J, const cJSON *o) {
         static const char *const ik[] = {"format", "bits",   "pixel",   "alpha",
                                          "width",  "height", "quality", NULL};
         if (!cJSON_IsObject(im))
-            return batch_bad(J, "$.outputs.image", "expected an object, found %s", kind(im));
+            return batch_bad(J, "$.outputs.image", "expected an object, found %s",
+                             lb__json_kind(im));
         if ((rc = check_keys(J, im, "$.outputs.image", ik))) return rc;
         const cJSON *f = cJSON_GetObjectItemCaseSensitive(im, "format"),
                     *px = cJSON_GetObjectItemCaseSensitive(im, "pixel"),
@@ -323,7 +317,7 @@ static int parse_outputs(job *J, const cJSON *o) {
         const char *fmt = f ? (cJSON_IsString(f) ? f->valuestring : "") : "png";
         if (strcmp(fmt, "png") && strcmp(fmt, "exr"))
             return batch_bad(J, "$.outputs.image.format", "%s; allowed: \"png\" or \"exr\"",
-                             f && cJSON_IsString(f) ? f->valuestring : kind(f));
+                             f && cJSON_IsString(f) ? f->valuestring : lb__json_kind(f));
         long bits = 8, w = 320, h = 240, q = 9;
         if ((rc = get_int(J, im, "bits", "$.outputs.image", 8, 16, &bits))) return rc;
         if (bits != 8 && bits != 16)
@@ -335,9 +329,10 @@ static int parse_outputs(job *J, const cJSON *o) {
         const char *pix = px ? (cJSON_IsString(px) ? px->valuestring : "") : "half";
         if (strcmp(pix, "half") && strcmp(pix, "float"))
             return batch_bad(J, "$.outputs.image.pixel", "%s; allowed: \"half\" or \"float\"",
-                             px && cJSON_IsString(px) ? px->valuestring : kind(px));
+                             px && cJSON_IsString(px) ? px->valuestring : lb__json_kind(px));
         if (al && !cJSON_IsBool(al))
-            return batch_bad(J, "$.outputs.image.alpha", "is %s; allowed: true or false", kind(al));
+            return batch_bad(J, "$.outputs.image.alpha", "is %s; allowed: true or false",
+                             lb__json_kind(al));
         if ((rc = get_int(J, im, "width", "$.outputs.image", 1, 16384, &w)) ||
             (rc = get_int(J, im, "height", "$.outputs.image", 1, 16384, &h)) ||
             (rc = get_int(J, im, "quality", "$.outputs.image", 0, 11, &q)))
@@ -356,7 +351,7 @@ static int parse_outputs(job *J, const cJSON *o) {
         static const char *const ck[] = {"columns", "cell_width", "cell_height", NULL};
         if (!cJSON_IsObject(cs))
             return batch_bad(J, "$.outputs.contact_sheet", "expected an object, found %s",
-                             kind(cs));
+                             lb__json_kind(cs));
         if ((rc = check_keys(J, cs, "$.outputs.contact_sheet", ck))) return rc;
         if (!J->image)
             return batch_bad(
@@ -487,6 +482,19 @@ static cJSON *read_doc(const char *file) {
         bt_error(CMD,
                  "%s:%ld:%ld: not valid JSON; allowed: a libblend-job document (docs/batch.md)",
                  file, line, col);
+    } else {
+        /* RFC 8259 exactly, as for scenes (common/json_check.c) */
+        size_t line, col;
+        char near[16];
+        const char *what = lb__json_strictness(text, len, &line, &col, near);
+        if (what) {
+            bt_error(CMD,
+                     "%s:%zu:%zu: invalid JSON: %s%s%s%s; allowed: a libblend-job document "
+                     "(RFC 8259, docs/batch.md)",
+                     file, line, col, what, *near ? " near '" : "", near, *near ? "'" : "");
+            cJSON_Delete(doc);
+            doc = NULL;
+        }
     }
     free(text);
     return doc;
@@ -502,12 +510,12 @@ static int parse_header(job *J, const cJSON *doc) {
     if (!cJSON_IsObject(doc))
         return batch_bad(
             J, "$", "expected an object, found %s; allowed: a libblend-job object (docs/batch.md)",
-            kind(doc));
+            lb__json_kind(doc));
     if (!cJSON_IsString(f) || strcmp(f->valuestring, "libblend-job"))
         return batch_bad(J, "$.format", "is %s; allowed: \"libblend-job\"",
-                         cJSON_IsString(f) ? f->valuestring : kind(f));
+                         cJSON_IsString(f) ? f->valuestring : lb__json_kind(f));
     if (!cJSON_IsNumber(v) || v->valuedouble != 1)
-        return batch_bad(J, "$.version", "is %s; allowed: 1", kind(v));
+        return batch_bad(J, "$.version", "is %s; allowed: 1", lb__json_kind(v));
     return check_keys(J, doc, "$", keys);
 }
 
@@ -517,7 +525,7 @@ static int parse_name(job *J, const cJSON *doc) {
     if (nm) {
         if (!cJSON_IsString(nm) || !safe_word(nm->valuestring, 0))
             return batch_bad(J, "$.name", "is %s; allowed: a name of " SAFE_WORD_ALLOWED,
-                             !cJSON_IsString(nm) ? kind(nm) : "not a safe name");
+                             !cJSON_IsString(nm) ? lb__json_kind(nm) : "not a safe name");
         snprintf(J->name, sizeof J->name, "%s", nm->valuestring);
         return 0;
     }
@@ -540,11 +548,11 @@ static int parse_scenes(job *J, const cJSON *doc) {
         return batch_bad(J, "$", "give one of \"scene\" (a file) or \"scenes\" (a list of files)");
     if (sc && !cJSON_IsString(sc))
         return batch_bad(J, "$.scene", "is %s; allowed: a scene file, relative to the job file",
-                         kind(sc));
+                         lb__json_kind(sc));
     if (scs &&
         (!cJSON_IsArray(scs) || cJSON_GetArraySize(scs) < 1 || cJSON_GetArraySize(scs) > 10000))
         return batch_bad(J, "$.scenes", "is %s; allowed: a list of 1 to 10000 scene files",
-                         kind(scs));
+                         lb__json_kind(scs));
     J->nscenes = sc ? 1 : (size_t)cJSON_GetArraySize(scs);
     J->scenes = calloc(J->nscenes, sizeof *J->scenes);
     J->scene_stems = calloc(J->nscenes, sizeof *J->scene_stems);
@@ -554,7 +562,7 @@ static int parse_scenes(job *J, const cJSON *doc) {
         snprintf(path, sizeof path, sc ? "$.scene" : "$.scenes[%zu]", i);
         if (!cJSON_IsString(s) || !*s->valuestring)
             return batch_bad(J, path, "is %s; allowed: a scene file, relative to the job file",
-                             kind(s));
+                             lb__json_kind(s));
         char full[8192];
         if (relative(J, s->valuestring, full, sizeof full))
             return batch_bad(J, path, "the path is too long; allowed: at most %zu bytes",
@@ -578,7 +586,7 @@ static int parse_set(job *J, const cJSON *set) {
     if (!cJSON_IsObject(set) || cJSON_GetArraySize(set) > BT_MAX_SETS / 2)
         return batch_bad(J, "$.set",
                          "is %s; allowed: an object of at most %d {\"path\": value} overrides",
-                         kind(set), BT_MAX_SETS / 2);
+                         lb__json_kind(set), BT_MAX_SETS / 2);
     J->fixed_text = calloc((size_t)cJSON_GetArraySize(set) + 1, sizeof *J->fixed_text);
     for (const cJSON *c = set->child; c; c = c->next) {
         if (!path_ok(c->string))
@@ -602,7 +610,7 @@ static int parse_set(job *J, const cJSON *set) {
 /* "sweep": the axes */
 static int parse_sweep(job *J, const cJSON *sw) {
     if (!cJSON_IsArray(sw) || cJSON_GetArraySize(sw) < 1 || cJSON_GetArraySize(sw) > MAX_AXES)
-        return batch_bad(J, "$.sweep", "is %s; allowed: a list of 1 to %d axes", kind(sw),
+        return batch_bad(J, "$.sweep", "is %s; allowed: a list of 1 to %d axes", lb__json_kind(sw),
                          MAX_AXES);
     size_t i = 0;
     for (const cJSON *a = sw->child; a; a = a->next, ++i) {
@@ -619,7 +627,7 @@ static int parse_names(job *J, const cJSON *doc) {
     const cJSON *od = cJSON_GetObjectItemCaseSensitive(doc, "output_dir");
     if (od && (!cJSON_IsString(od) || !*od->valuestring))
         return batch_bad(J, "$.output_dir", "is %s; allowed: a folder, relative to the job file",
-                         kind(od));
+                         lb__json_kind(od));
     if (relative(J, od ? od->valuestring : "out", J->outdir, sizeof J->outdir))
         return batch_bad(J, "$.output_dir",
                          "the folder's path is too long; allowed: at most %zu bytes",
@@ -631,7 +639,7 @@ static int parse_names(job *J, const cJSON *doc) {
             return batch_bad(J, "$.pattern",
                              "is %s%s; allowed: #### for the frame (zero-padded to the number of "
                              "#), {name}, {scene}, {task}, and " SAFE_WORD_ALLOWED,
-                             cJSON_IsString(pt) ? "a pattern with " : kind(pt), why);
+                             cJSON_IsString(pt) ? "a pattern with " : lb__json_kind(pt), why);
         snprintf(J->pattern, sizeof J->pattern, "%s", pt->valuestring);
     } else {
         snprintf(J->pattern, sizeof J->pattern, "%s%s####",

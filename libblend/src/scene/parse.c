@@ -167,6 +167,19 @@ static void line_col(const char *text, size_t len, size_t off, size_t *line, siz
     }
 }
 
+/* RFC 8259 exactly (common/json_check.c), after cJSON accepted the text */
+static lb_status strict_json(const char *text, size_t length, const char *file, lb_error *err) {
+    size_t line, col;
+    char near[16];
+    const char *what = lb__json_strictness(text, length, &line, &col, near);
+    if (!what) return LB_OK;
+    return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                    "%s:%zu:%zu: invalid JSON: %s%s%s%s; allowed: a JSON document (RFC 8259: no "
+                    "leading zeros, digits after a decimal point, control characters in strings "
+                    "escaped, no \\u0000, UTF-8 text, nothing after the document)",
+                    file, line, col, what, *near ? " near '" : "", near, *near ? "'" : "");
+}
+
 lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_scene **out,
                          lb_error *err) {
     const char *file = name ? name : "<scene>";
@@ -229,10 +242,10 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
                 --depth;
         }
     }
-    /* the strict check first (json_strict.c: one pass, nothing allocated);
+    /* the strict check first (one pass, nothing allocated);
      * its message is given only when cJSON accepted the text (cJSON's
      * messages come first) */
-    const lb_status strict = lb__json_strict(text, length, file, err);
+    const lb_status strict = strict_json(text, length, file, err);
     const char *end = NULL;
     cJSON *doc = cJSON_ParseWithLengthOpts(text, length, &end, 0);
     if (!doc) {

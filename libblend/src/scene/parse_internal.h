@@ -10,6 +10,8 @@
 
 #include "scene_internal.h"
 
+#include "../common/json_check.h"
+
 #include <cjson/cJSON.h>
 #include <stddef.h>
 
@@ -33,12 +35,6 @@ typedef struct pctx {
     size_t count;
 } pctx;
 
-/* ---- json_strict.c ---- */
-/* text is RFC 8259 JSON exactly (what cJSON accepts beyond it refused with
- * FILE:line:column) */
-LB_INTERNAL lb_status lb__json_strict(const char *text, size_t length, const char *file,
-                                      lb_error *err);
-
 /* ---- parse_read.c ---- */
 /* the one failure message of a parse: FILE: $.path: what is wrong; allowed: ... (st returned) */
 LB_INTERNAL lb_status lb__perr(pctx *c, lb_status st, const char *fmt, ...) LB_PRINTF(3, 4);
@@ -48,8 +44,6 @@ LB_INTERNAL size_t lb__push_key(pctx *c, const char *key);
 LB_INTERNAL size_t lb__push_index(pctx *c, size_t i);
 /* cut the current JSON path back to old */
 LB_INTERNAL void lb__pop(pctx *c, size_t old);
-/* "an object", "a string", ... for messages */
-LB_INTERNAL const char *lb__json_kind(const cJSON *j);
 /* the out-of-memory failure */
 LB_INTERNAL lb_status lb__oom(pctx *c);
 /* every member of obj is one of allowed (NULL-terminated) and appears once; what names

@@ -45,17 +45,6 @@ void lb__pop(pctx *c, size_t old) {
     c->path[old] = '\0';
 }
 
-const char *lb__json_kind(const cJSON *j) {
-    if (!j) return "nothing";
-    if (cJSON_IsNumber(j)) return "a number";
-    if (cJSON_IsString(j)) return "a string";
-    if (cJSON_IsBool(j)) return "a boolean";
-    if (cJSON_IsNull(j)) return "null";
-    if (cJSON_IsArray(j)) return "an array";
-    if (cJSON_IsObject(j)) return "an object";
-    return "an invalid value";
-}
-
 lb_status lb__oom(pctx *c) {
     return lb__perr(c, LB_ERR_NO_MEMORY, "out of memory while building the scene");
 }
@@ -65,26 +54,22 @@ lb_status lb__oom(pctx *c) {
 /* Every member of obj must be one of the names in allowed (NULL-terminated),
  * and appear once. */
 lb_status lb__check_keys(pctx *c, const cJSON *obj, const char *const *allowed, const char *what) {
-    for (const cJSON *it = obj->child; it; it = it->next) {
-        int ok = 0;
-        for (const char *const *a = allowed; *a && !ok; ++a) ok = strcmp(*a, it->string) == 0;
-        if (!ok) {
-            char list[320] = "";
-            size_t len = 0;
-            for (const char *const *a = allowed; *a; ++a) {
-                int w = snprintf(list + len, sizeof list - len, "%s%s", len ? ", " : "", *a);
-                if (w < 0 || (size_t)w >= sizeof list - len) break;
-                len += (size_t)w;
-            }
-            return lb__perr(c, LB_ERR_INVALID_ARGUMENT,
-                            "unknown field \"%.60s\" in %s; allowed: %s", it->string, what, list);
+    const cJSON *it = NULL;
+    const int k = lb__json_keys(obj, allowed, &it);
+    if (k == 1) {
+        char list[320] = "";
+        size_t len = 0;
+        for (const char *const *a = allowed; *a; ++a) {
+            int w = snprintf(list + len, sizeof list - len, "%s%s", len ? ", " : "", *a);
+            if (w < 0 || (size_t)w >= sizeof list - len) break;
+            len += (size_t)w;
         }
-        for (const cJSON *o = obj->child; o != it; o = o->next)
-            if (strcmp(o->string, it->string) == 0)
-                return lb__perr(c, LB_ERR_INVALID_ARGUMENT,
-                                "field \"%.60s\" appears twice; allowed: each field once",
-                                it->string);
+        return lb__perr(c, LB_ERR_INVALID_ARGUMENT, "unknown field \"%.60s\" in %s; allowed: %s",
+                        it->string, what, list);
     }
+    if (k == 2)
+        return lb__perr(c, LB_ERR_INVALID_ARGUMENT,
+                        "field \"%.60s\" appears twice; allowed: each field once", it->string);
     return LB_OK;
 }
 

@@ -1,16 +1,34 @@
-/* RFC 8259, exactly, for what cJSON (the one JSON parser the library
- * links) accepts beyond it: leading zeros (01), a bare decimal point (1.),
- * a plus sign or an empty exponent, raw control characters in strings,
- * text after a NUL byte, \u0000 (which would cut the string there), lone
- * UTF-16 surrogates, and bytes that are not UTF-8. One pass over the text,
- * nothing allocated; the nesting was bounded by parse.c's pre-scan. The
- * first violation is named with its line and column. Duplicate keys are
- * the validation's (it names the JSON path), numbers too large for a
- * double (1e999) too (it names them as not finite). */
-#include "parse_internal.h"
+/* JSON checks shared by the scene parser and blendtool's job files
+ * (json_check.h). */
+#include "json_check.h"
 
-#include <stdio.h>
 #include <string.h>
+
+const char *lb__json_kind(const cJSON *j) {
+    if (!j) return "nothing";
+    if (cJSON_IsNumber(j)) return "a number";
+    if (cJSON_IsString(j)) return "a string";
+    if (cJSON_IsBool(j)) return "a boolean";
+    if (cJSON_IsNull(j)) return "null";
+    if (cJSON_IsArray(j)) return "an array";
+    if (cJSON_IsObject(j)) return "an object";
+    return "an invalid value";
+}
+
+int lb__json_keys(const cJSON *obj, const char *const *allowed, const cJSON **bad) {
+    for (const cJSON *it = obj->child; it; it = it->next) {
+        int ok = 0;
+        for (const char *const *a = allowed; *a && !ok; ++a) ok = strcmp(*a, it->string) == 0;
+        *bad = it;
+        if (!ok) return 1;
+        for (const cJSON *o = obj->child; o != it; o = o->next)
+            if (strcmp(o->string, it->string) == 0) return 2;
+    }
+    *bad = NULL;
+    return 0;
+}
+
+/* ---- RFC 8259 strictness: one pass over the text ---- */
 
 typedef struct jscan {
     const unsigned char *t;
@@ -204,7 +222,8 @@ static int value(jscan *S) {
     }
 }
 
-lb_status lb__json_strict(const char *text, size_t length, const char *file, lb_error *err) {
+const char *lb__json_strictness(const char *text, size_t length, size_t *line, size_t *col,
+                                char near[16]) {
     jscan S = {(const unsigned char *)text, length, 0, NULL, 0};
     if (value(&S)) {
         ws(&S);
@@ -212,25 +231,20 @@ lb_status lb__json_strict(const char *text, size_t length, const char *file, lb_
             fail_at(&S, S.i,
                     S.t[S.i] ? "text after the end of the document" : "a NUL byte in the text");
     }
-    if (!S.what) return LB_OK;
-    size_t line = 1, col = 1;
+    *line = *col = 1;
+    near[0] = '\0';
+    if (!S.what) return NULL;
     for (size_t i = 0; i < S.at && i < length; ++i) {
         if (text[i] == '\n') {
-            ++line;
-            col = 1;
+            ++*line;
+            *col = 1;
         } else {
-            ++col;
+            ++*col;
         }
     }
-    /* what is there, printable ASCII only, so the message stays one line */
-    char near[16];
     size_t nl = 0;
     for (size_t i = S.at; i < length && nl < 8; ++i)
         near[nl++] = text[i] >= 32 && text[i] < 127 ? text[i] : '?';
     near[nl] = '\0';
-    return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
-                    "%s:%zu:%zu: invalid JSON: %s%s%s%s; allowed: a JSON document (RFC 8259: no "
-                    "leading zeros, digits after a decimal point, control characters in strings "
-                    "escaped, no \\u0000, UTF-8 text, nothing after the document)",
-                    file, line, col, S.what, nl ? " near '" : "", near, nl ? "'" : "");
+    return S.what;
 }
