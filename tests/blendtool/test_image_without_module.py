@@ -149,6 +149,18 @@ if r.returncode != 1 or "OpenEXR needs the image module" not in err or "x.exr" n
     fail(f"EXR without the module: exit {r.returncode}, {err[-300:]!r}")
 if os.path.exists(exr):
     fail("the refused EXR render wrote a file")
+# a bad scene is a bad scene whatever the output: exit 2 naming it, before
+# the image module is asked about
+bad = os.path.join(WORK, "bad.json")
+with open(bad, "w") as f:
+    f.write('{"format": "libblend-scene", "version": 1, "convention": "zero", "root": {"type": '
+            '"sphere", "radius": -1}}')
+r = run(BARE, "render", bad, "-o", exr, "--width", "40", "--height", "30")
+err = r.stderr.decode(errors="replace")
+if r.returncode != 2 or "bad.json" not in err or "radius" not in err:
+    fail(f"a bad scene with an EXR output without the module: exit {r.returncode}, {err[-300:]!r}")
+if os.path.exists(exr):
+    fail("the bad scene's EXR render wrote a file")
 
 # batch: PNG images work; a contact sheet is refused before any folder exists
 for sheet in (False, True):

@@ -128,7 +128,7 @@ static int run_render(int argc, char **argv) {
     const int fmt = bt_image_format("render", a.out, a.bits, a.pixel);
     if (fmt < 0) return BT_EXIT_BAD_INPUT;
     bt_image_plan plan;
-    if (bt_image_plan_for("render", a.out, fmt, a.alpha, &plan)) return BT_EXIT_INTERNAL;
+    memset(&plan, 0, sizeof plan);
     bt_render_dir R;
     if (bt_render_dir_open(&R)) return BT_EXIT_INTERNAL;
     bt_out w;
@@ -147,6 +147,10 @@ static int run_render(int argc, char **argv) {
             }
         }
     }
+    /* how the image is written (the OpenImageIO module, or POV-Ray's own
+     * PNG): asked once the scene is known to be good, so a bad scene is
+     * exit 2 whatever the output format */
+    if (!rc && bt_image_plan_for("render", a.out, fmt, a.alpha, &plan)) rc = BT_EXIT_INTERNAL;
     if (!rc)
         rc = bt_povray(a.scene, &R, a.width, a.height, a.threads, a.quality, plan.bits16,
                        plan.alpha, 0);

@@ -67,8 +67,11 @@ const bt_imageio *bt_imageio_try(char *why, size_t whylen) {
     return &api;
 }
 
+/* room for why the module did not load: three tried paths and their errors */
+#define WHY_SIZE (3 * (PATH_MAX + 64) + 512)
+
 const bt_imageio *bt_imageio_get(const char *cmd) {
-    char why[3 * (PATH_MAX + 64) + 512];
+    char why[WHY_SIZE];
     const bt_imageio *io = bt_imageio_try(why, sizeof why);
     if (!io)
         bt_error(cmd,
@@ -80,7 +83,7 @@ const bt_imageio *bt_imageio_get(const char *cmd) {
 
 int bt_image_plan_for(const char *cmd, const char *out, int fmt, int alpha, bt_image_plan *p) {
     static int noted; /* one note per process, not one per batch task */
-    char why[3 * (PATH_MAX + 64) + 512];
+    char why[WHY_SIZE];
     p->io = bt_imageio_try(why, sizeof why);
     p->out_alpha = alpha;
     p->alpha = p->io ? 1 : alpha;
