@@ -26,14 +26,6 @@ static int finite_all(const double *v, size_t n) {
     return 1;
 }
 
-/* dual (union-form) argument interval: intersection -x, difference -x_0 */
-lb__iv lb__dual_iv(lb_setop op, size_t i, lb__iv x) {
-    const int neg = op == LB_INTERSECTION || (op == LB_DIFFERENCE && i == 0);
-    if (!neg) return x;
-    iv o = {-x.hi, -x.lo};
-    return o;
-}
-
 static void bulge_bounds(const lb__op *o, const iv *x, iv *out) {
     const lb_bulge_params *bp = &o->bp;
     const int range = (bp->flags & LB_BULGE_RANGE) != 0, slope = (bp->flags & LB_BULGE_SLOPE) != 0;

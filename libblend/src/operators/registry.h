@@ -198,8 +198,14 @@ LB_INTERNAL void lb__op_interval(const lb__op *o, lb_convention conv, const lb__
 /* act receives every argument that can decide o over x (all when the row
  * has no cull rule); returns how many */
 LB_INTERNAL uint16_t lb__op_cull(const lb__op *o, const lb__iv *x, uint16_t *act);
-/* the union-form (dual) interval of argument i: intersection -x, difference -x_0 */
-LB_INTERNAL lb__iv lb__dual_iv(lb_setop op, size_t i, lb__iv x);
+/* the union-form (dual) interval of argument i: intersection -x, difference
+ * -x_0 (inline: the bounds passes call it per argument) */
+static inline lb__iv lb__dual_iv(lb_setop op, size_t i, lb__iv x) {
+    const int neg = op == LB_INTERSECTION || (op == LB_DIFFERENCE && i == 0);
+    if (!neg) return x;
+    const lb__iv o = {-x.hi, -x.lo};
+    return o;
+}
 
 /* local_union / clean_union: children in the soft form the operators take
  * (zero convention: g = C (1 - f / zero_scale), C = 0.5), and the result
