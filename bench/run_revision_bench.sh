@@ -11,15 +11,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 REV=${1:-HEAD}
 ROUNDS=${2:-3}
-tmp=$(mktemp -d /tmp/libblend-rev-bench.XXXXXX)
-cleanup() {
-  git worktree remove --force "$tmp/tree" >/dev/null 2>&1 || true
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
-git worktree add --detach "$tmp/tree" "$REV" >/dev/null 2>&1 ||
-  { echo "run_revision_bench: no revision $REV" >&2; exit 2; }
+# shellcheck source=scripts/revision-tree.sh
+. "$PWD/scripts/revision-tree.sh"
+revision_tree run_revision_bench "$REV"
 build() { # SRC BUILD
   cmake -S "$1" -B "$2" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIBBLEND_TESTS=OFF \
     -DLIBBLEND_BENCH=ON >/dev/null

@@ -9,15 +9,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 REV=${1:-HEAD}
-base=$(mktemp -d /tmp/libblend-unchanged.XXXXXX)
-cleanup() {
-  git worktree remove --force "$base/tree" >/dev/null 2>&1 || true
-  rm -rf "$base"
-}
-trap cleanup EXIT
-trap 'exit 130' INT TERM
-git worktree add --detach "$base/tree" "$REV" >/dev/null 2>&1 ||
-  { echo "check-unchanged: no revision $REV" >&2; exit 2; }
+# shellcheck source=scripts/revision-tree.sh
+. "$PWD/scripts/revision-tree.sh"
+revision_tree check-unchanged "$REV"
+base=$tmp
 build() { # SRC BUILD
   cmake -S "$1" -B "$2" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIBBLEND_TESTS=OFF \
     -DLIBBLEND_BENCH=OFF >/dev/null
