@@ -27,8 +27,8 @@ for ((r = 1; r <= ROUNDS; r++)); do
     b=$tmp/old/bench
     [ "$side" = new ] && b=build-revision-bench/bench
     "$b/bench_operators" --quick >"$tmp/$side.ops.$r"
-    "$b/bench_eval" --quick "$PWD/scenes" >"$tmp/$side.eval.$r"
-    for res in 128 256; do "$b/bench_mesh" "$S2" "$res" 1; done >"$tmp/$side.mesh.$r"
+    "$b/bench_eval" "$PWD/scenes" >"$tmp/$side.eval.$r"
+    for res in 256 384 512; do "$b/bench_mesh" "$S2" "$res" 1; done >"$tmp/$side.mesh.$r"
   done
 done
 /usr/bin/python3 - "$tmp" "$ROUNDS" "$REV" <<'PY'
