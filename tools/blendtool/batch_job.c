@@ -139,8 +139,10 @@ static int parse_axis(const job *J, const cJSON *a, const char *path, axis *X) {
         return X->values ? 0 : BT_EXIT_INTERNAL;
     }
     static const char *const rkeys[] = {"from", "to", "count", NULL};
-    char rp[512];
-    snprintf(rp, sizeof rp, "%s.range", path);
+    lb__jpath rpath;
+    lb__jpath_set(&rpath, path);
+    lb__jpath_key(&rpath, "range");
+    const char *rp = rpath.s;
     if (!cJSON_IsObject(rg))
         return batch_bad(J, rp, "expected {\"from\": A, \"to\": B, \"count\": N}");
     if ((rc = check_keys(J, rg, rp, rkeys))) return rc;
@@ -213,8 +215,11 @@ static int parse_frames(job *J, const cJSON *fr) {
                          MAX_AXES);
     size_t i = 0;
     for (const cJSON *a = an->child; a; a = a->next, ++i) {
-        char path[128];
-        snprintf(path, sizeof path, "$.frames.animate[%zu]", i);
+        lb__jpath jp;
+        lb__jpath_set(&jp, "$.frames");
+        lb__jpath_key(&jp, "animate");
+        lb__jpath_index(&jp, i);
+        const char *path = jp.s;
         static const char *const akeys[] = {"path", "keys", "interpolation", NULL};
         if (!cJSON_IsObject(a))
             return batch_bad(J, path, "expected an object, found %s", lb__json_kind(a));
@@ -614,9 +619,10 @@ static int parse_sweep(job *J, const cJSON *sw) {
                          MAX_AXES);
     size_t i = 0;
     for (const cJSON *a = sw->child; a; a = a->next, ++i) {
-        char path[64];
-        snprintf(path, sizeof path, "$.sweep[%zu]", i);
-        const int rc = parse_axis(J, a, path, &J->axes[J->naxes++]);
+        lb__jpath jp;
+        lb__jpath_set(&jp, "$.sweep");
+        lb__jpath_index(&jp, i);
+        const int rc = parse_axis(J, a, jp.s, &J->axes[J->naxes++]);
         if (rc) return rc;
     }
     return 0;

@@ -5,6 +5,7 @@
  * (a leading `$.` is allowed, as in the library's messages). */
 #define _POSIX_C_SOURCE 200809L
 #include "blendtool.h"
+#include "../../libblend/src/common/json_check.h"
 
 #include <cjson/cJSON.h>
 #include <ctype.h>
@@ -113,8 +114,9 @@ static int apply_one(cJSON *doc, const bt_set *s, char *why, size_t whylen) {
     const char *key = NULL;
     size_t keylen = 0;
     long index = -1;
-    char where[512];
-    int wl = snprintf(where, sizeof where, "$");
+    lb__jpath wp; /* where the walk is, as a JSON path */
+    lb__jpath_set(&wp, "$");
+    const char *where = wp.s;
     while (p < end) {
         if (*p == '.') ++p;
         parent = cur;
@@ -141,8 +143,7 @@ static int apply_one(cJSON *doc, const bt_set *s, char *why, size_t whylen) {
                 return -1;
             }
             cur = cJSON_GetArrayItem(parent, (int)index);
-            if (wl < (int)sizeof where)
-                wl += snprintf(where + wl, sizeof where - (size_t)wl, "[%ld]", index);
+            lb__jpath_index(&wp, (size_t)index);
         } else {
             key = p;
             while (p < end && *p != '.' && *p != '[') ++p;
@@ -163,8 +164,7 @@ static int apply_one(cJSON *doc, const bt_set *s, char *why, size_t whylen) {
             memcpy(k, key, keylen);
             k[keylen] = '\0';
             cur = cJSON_GetObjectItemCaseSensitive(parent, k);
-            if (wl < (int)sizeof where)
-                wl += snprintf(where + wl, sizeof where - (size_t)wl, ".%s", k);
+            lb__jpath_key(&wp, k);
             if (!cur && p < end) {
                 snprintf(why, whylen, "%s does not exist", where);
                 return -1;

@@ -2,7 +2,39 @@
  * (json_check.h). */
 #include "json_check.h"
 
+#include <stdio.h>
 #include <string.h>
+
+/* ---- JSON paths ---- */
+
+void lb__jpath_set(lb__jpath *p, const char *root) {
+    const int n = snprintf(p->s, sizeof p->s, "%s", root);
+    p->len = n > 0 && (size_t)n < sizeof p->s ? (size_t)n : strlen(p->s);
+}
+
+/* after an snprintf of n at old: the new length, or where the cut text ends */
+static size_t jpath_end(const lb__jpath *p, size_t old, int n) {
+    return n > 0 && (size_t)n < sizeof p->s - old ? old + (size_t)n : strlen(p->s);
+}
+
+size_t lb__jpath_key(lb__jpath *p, const char *key) {
+    const size_t old = p->len;
+    p->len = jpath_end(p, old, snprintf(p->s + old, sizeof p->s - old, ".%s", key));
+    return old;
+}
+
+size_t lb__jpath_index(lb__jpath *p, size_t i) {
+    const size_t old = p->len;
+    p->len = jpath_end(p, old, snprintf(p->s + old, sizeof p->s - old, "[%zu]", i));
+    return old;
+}
+
+void lb__jpath_pop(lb__jpath *p, size_t old) {
+    p->len = old;
+    p->s[old] = '\0';
+}
+
+/* ---- values and keys ---- */
 
 const char *lb__json_kind(const cJSON *j) {
     if (!j) return "nothing";

@@ -12,6 +12,23 @@
 #include <cjson/cJSON.h>
 #include <stddef.h>
 
+/* A JSON path being built ($.root.args[2].r): pushed and popped as a
+ * reader walks into objects and arrays; too long a path is cut, never
+ * overrun. */
+#define LB__JPATH_MAX 480
+typedef struct lb__jpath {
+    char s[LB__JPATH_MAX];
+    size_t len;
+} lb__jpath;
+/* the path root (usually "$") */
+LB_INTERNAL void lb__jpath_set(lb__jpath *p, const char *root);
+/* .key appended; returns the old length for lb__jpath_pop */
+LB_INTERNAL size_t lb__jpath_key(lb__jpath *p, const char *key);
+/* [i] appended; returns the old length for lb__jpath_pop */
+LB_INTERNAL size_t lb__jpath_index(lb__jpath *p, size_t i);
+/* back to an old length */
+LB_INTERNAL void lb__jpath_pop(lb__jpath *p, size_t old);
+
 /* "a number", "a string", "an object", ... for messages ("nothing" for NULL) */
 LB_INTERNAL const char *lb__json_kind(const cJSON *j);
 

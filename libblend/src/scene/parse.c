@@ -299,8 +299,7 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
     c.s = s;
     c.file = file;
     c.err = err;
-    strcpy(c.path, "$");
-    c.plen = 1;
+    lb__jpath_set(&c.jp, "$");
     lb_status st = s->name ? parse_document(&c, doc) : lb__oom(&c);
     free(c.defs);
     cJSON_Delete(doc);

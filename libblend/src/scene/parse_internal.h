@@ -15,8 +15,6 @@
 #include <cjson/cJSON.h>
 #include <stddef.h>
 
-#define PATH_MAX_LEN 480
-
 typedef struct def_entry {
     const char *name;
     cJSON *json;
@@ -28,8 +26,7 @@ typedef struct pctx {
     lb_scene *s;
     const char *file;
     lb_error *err;
-    char path[PATH_MAX_LEN];
-    size_t plen;
+    lb__jpath jp; /* where the reader is ($.root.args[1]...) */
     def_entry *defs;
     size_t ndefs;
     size_t count;

@@ -26,12 +26,12 @@ static lb__node *new_node(pctx *c, lb__family fam, const char *type) {
     lb__node *n = calloc(1, sizeof *n);
     if (!n) return NULL;
     n->walk_cost = 1.0;
-    n->path = malloc(c->plen + 1);
+    n->path = malloc(c->jp.len + 1);
     if (!n->path) {
         free(n);
         return NULL;
     }
-    memcpy(n->path, c->path, c->plen + 1);
+    memcpy(n->path, c->jp.s, c->jp.len + 1);
     n->o.family = fam;
     n->type = type;
     n->depth = 1;
@@ -342,17 +342,12 @@ lb_status lb__build_def(pctx *c, def_entry *d, size_t depth, lb__node **out) {
                         "that do not use it",
                         d->name);
     d->state = 1;
-    char saved[PATH_MAX_LEN];
-    const size_t saved_len = c->plen;
-    memcpy(saved, c->path, c->plen + 1);
-    c->plen = 0;
-    c->path[0] = '\0';
-    int w = snprintf(c->path, sizeof c->path, "$.defs.%s", d->name);
-    c->plen = w > 0 && (size_t)w < sizeof c->path ? (size_t)w : strlen(c->path);
+    const lb__jpath saved = c->jp; /* a def is read at its own path */
+    lb__jpath_set(&c->jp, "$.defs");
+    lb__jpath_key(&c->jp, d->name);
     lb__node *n = NULL;
     lb_status s = lb__parse_node(c, d->json, depth, &n);
-    memcpy(c->path, saved, saved_len + 1);
-    c->plen = saved_len;
+    c->jp = saved;
     if (s) return s;
     if (!n->def_name) {
         n->def_name = malloc(strlen(d->name) + 1);

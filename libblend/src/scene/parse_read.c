@@ -20,29 +20,22 @@ lb_status lb__perr(pctx *c, lb_status st, const char *fmt, ...) {
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    if (c->plen > 160) /* deep paths: the start and the end say where */
-        return lb__fail(c->err, st, "%s: %.60s...%s: %s", c->file, c->path, c->path + c->plen - 80,
-                        msg);
-    return lb__fail(c->err, st, "%s: %s: %s", c->file, c->path, msg);
+    if (c->jp.len > 160) /* deep paths: the start and the end say where */
+        return lb__fail(c->err, st, "%s: %.60s...%s: %s", c->file, c->jp.s,
+                        c->jp.s + c->jp.len - 80, msg);
+    return lb__fail(c->err, st, "%s: %s: %s", c->file, c->jp.s, msg);
 }
 
 size_t lb__push_key(pctx *c, const char *key) {
-    const size_t old = c->plen;
-    int n = snprintf(c->path + old, sizeof c->path - old, ".%s", key);
-    c->plen = n > 0 && (size_t)n < sizeof c->path - old ? old + (size_t)n : strlen(c->path);
-    return old;
+    return lb__jpath_key(&c->jp, key);
 }
 
 size_t lb__push_index(pctx *c, size_t i) {
-    const size_t old = c->plen;
-    int n = snprintf(c->path + old, sizeof c->path - old, "[%zu]", i);
-    c->plen = n > 0 && (size_t)n < sizeof c->path - old ? old + (size_t)n : strlen(c->path);
-    return old;
+    return lb__jpath_index(&c->jp, i);
 }
 
 void lb__pop(pctx *c, size_t old) {
-    c->plen = old;
-    c->path[old] = '\0';
+    lb__jpath_pop(&c->jp, old);
 }
 
 lb_status lb__oom(pctx *c) {
