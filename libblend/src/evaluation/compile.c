@@ -65,7 +65,7 @@ static lb_status push(cctx *c, const lb__node *n, lb__instr **out) {
                         "under many different transforms each compile once per transform); "
                         "allowed: at most %d (docs/scene-format.md, \"Cost\"): fewer distinct "
                         "transformed copies",
-                        n->path, LB_SCENE_MAX_INSTRUCTIONS, LB_SCENE_MAX_INSTRUCTIONS);
+                        n->o.path, LB_SCENE_MAX_INSTRUCTIONS, LB_SCENE_MAX_INSTRUCTIONS);
     if (ev->n == c->cap) {
         const size_t ncap = c->cap ? 2 * c->cap : 64;
         lb__instr *ni = realloc(ev->ins, ncap * sizeof *ni);
@@ -310,9 +310,9 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         in->op->r = dup_array(n->o.r, n->o.k, &fail);
         in->op->p = dup_array(n->o.p, n->o.k, &fail);
         in->op->m = dup_array(n->o.m, n->o.k, &fail);
-        in->op->path = malloc(strlen(n->path) + 1);
+        in->op->path = malloc(strlen(n->o.path) + 1);
         if (in->op->path)
-            strcpy(in->op->path, n->path);
+            strcpy(in->op->path, n->o.path);
         else
             fail = 1;
         in->src = src;

@@ -50,7 +50,7 @@ lb_status lb_scene_material_index(const lb_scene *s, const lb_evaluator *ev, siz
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "%s: %s: a local_union needs its intersection curves; allowed: pass "
                             "the scene's compiled evaluator as ev",
-                            FN, s->nodes[i]->path);
+                            FN, s->nodes[i]->o.path);
     if (s->root->walk_cost > LB_SCENE_MAX_COST)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: the walk would visit %.3g nodes per point; allowed: at most %d", FN,

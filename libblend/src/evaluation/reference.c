@@ -124,7 +124,7 @@ static lb_status ref_eval(const lb__node *n, lb_convention conv, const lb__affin
     const size_t k = n->o.k;
     double small[8 * 10];
     double *x = k <= 8 ? small : malloc(k * (2 + 3 + 2 + 3) * sizeof *x);
-    if (!x) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", n->path);
+    if (!x) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", n->o.path);
     double *c = x + k, *ga = c + k, *dx = ga + 3 * k, *dc = dx + k, *gb = dc + k;
     double dg[6] = {0, 0, 0, 0, 0, 0};
     for (size_t i = 0; i < k && !s; ++i) {
@@ -167,7 +167,7 @@ static lb_status walk(const lb_scene *s, const lb_evaluator *ev, const double X[
                             "lb_scene_eval_reference: %s: a local_union needs its intersection "
                             "curves, which the compiled evaluator finds; allowed: scenes without "
                             "local_union (use lb_evaluator_eval)",
-                            s->nodes[i]->path);
+                            s->nodes[i]->o.path);
     if (s->root->walk_cost > LB_SCENE_MAX_COST)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "lb_scene_eval_reference: the plain walk would visit %.3g nodes per "

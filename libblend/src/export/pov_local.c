@@ -104,10 +104,10 @@ lb_status lb__pov_local(pctx *c, const lb__node *n, int id, const char *name, in
         return lb__fail(c->err, LB_ERR_INTERNAL,
                         "%s: %s: the evaluator has no instruction for this "
                         "use of the local union (was ev compiled from this scene?)",
-                        FN, n->path);
+                        FN, n->o.path);
     const struct lb__curves *C = ins ? ins->curves : NULL;
     if ((lb__op_flags(&n->o) & LB__R_CURVES))
-        sb(b, "// %s: local union, %zu blending volume%s\n", n->path[0] ? n->path : "root",
+        sb(b, "// %s: local union, %zu blending volume%s\n", n->o.path[0] ? n->o.path : "root",
            C ? C->ncomp : 0, C && C->ncomp == 1 ? "" : "s");
     if (!C || !C->nseg) { /* no intersection: the clean union everywhere */
         sb(b,
@@ -118,7 +118,7 @@ lb_status lb__pov_local(pctx *c, const lb__node *n, int id, const char *name, in
         lb__affine W; /* node frame -> world, where the curves live */
         if (affine_invert(&ins->A, &W))
             return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT, "%s: %s: a singular transform", FN,
-                            n->path);
+                            n->o.path);
         const int ident = lb__affine_is_identity(&W);
         const size_t K = C->ncomp;
         int next = 0;

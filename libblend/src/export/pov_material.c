@@ -59,7 +59,7 @@ lb_status lb__pov_texture(pctx *c, const lb__node *n, const lb__affine *Ap, size
         fid[i] = lb__pov_written_id(c, n->args[i], &F);
         if (fid[i] < 0) {
             s = lb__fail(c->err, LB_ERR_INTERNAL, "%s: %s: argument %zu was not written", FN,
-                         n->path, i);
+                         n->o.path, i);
             break;
         }
         group[i] = -1;
@@ -75,7 +75,7 @@ lb_status lb__pov_texture(pctx *c, const lb__node *n, const lb__affine *Ap, size
             s = lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
                          "%s: %s: more than %d material textures (a def with materials used "
                          "under many parents); allowed: at most %d",
-                         FN, n->path, LB_POV_MAX_TEXTURES, LB_POV_MAX_TEXTURES);
+                         FN, n->o.path, LB_POV_MAX_TEXTURES, LB_POV_MAX_TEXTURES);
             break;
         }
         if (g == G - 2)

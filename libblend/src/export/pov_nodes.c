@@ -258,13 +258,13 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
         return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
                         "%s: %s: a %s blend of %zu arguments; allowed in POV-Ray: at most %d "
                         "(the include's limit; POV-Ray functions take at most 56 parameters)",
-                        FN, n->path, n->type, n->o.k, LB_POV_MAX_ARITY);
+                        FN, n->o.path, n->type, n->o.k, LB_POV_MAX_ARITY);
     if (n->o.k > LB_MAX_ARITY)
         return lb__fail(c->err, LB_ERR_INVALID_ARGUMENT,
                         "%s: %s: a %s node of %zu arguments; allowed in POV-Ray: at most %d (the "
                         "include's functions run every argument at every point); mesh the scene "
                         "instead (blendtool mesh)",
-                        FN, n->path, n->type, n->o.k, LB_MAX_ARITY);
+                        FN, n->o.path, n->type, n->o.k, LB_MAX_ARITY);
     lb_status s = LB_OK;
     if (n->o.family == LB__F_PRIMITIVE) {
         emit_primitive(b, n, id, name);

@@ -60,7 +60,7 @@ typedef struct lb__op {
     int bulge;           /* bulge elimination on (rows with a bulge family; k = 2) */
     lb_bulge_params bp;  /* bulge */
     lb__local_params lp; /* local_union, clean_union */
-    char *path;          /* the node's JSON path, for messages (a node's: its own path) */
+    char *path;          /* the node's JSON path, for messages (owned by the node or instruction) */
 } lb__op;
 
 /* An interval. */

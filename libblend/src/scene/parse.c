@@ -149,8 +149,6 @@ static lb_status parse_document(pctx *c, const cJSON *root) {
         lb__node *n = NULL;
         s = lb__build_def(c, &c->defs[i], 1, &n);
     }
-    /* every operator names its node in messages */
-    for (size_t i = 0; i < c->s->nnodes && !s; ++i) c->s->nodes[i]->o.path = c->s->nodes[i]->path;
     return s;
 }
 

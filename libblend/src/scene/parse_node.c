@@ -26,12 +26,12 @@ static lb__node *new_node(pctx *c, lb__family fam, const char *type) {
     lb__node *n = calloc(1, sizeof *n);
     if (!n) return NULL;
     n->walk_cost = 1.0;
-    n->path = malloc(c->jp.len + 1);
-    if (!n->path) {
+    n->o.path = malloc(c->jp.len + 1);
+    if (!n->o.path) {
         free(n);
         return NULL;
     }
-    memcpy(n->path, c->jp.s, c->jp.len + 1);
+    memcpy(n->o.path, c->jp.s, c->jp.len + 1);
     n->o.family = fam;
     n->type = type;
     n->depth = 1;
@@ -554,12 +554,12 @@ static lb_status fold_local(pctx *c, lb__node *n) {
         lb__node *m = new_node(c, n->o.family, n->type);
         if (!m) return lb__oom(c);
         /* the fold's inner node: named by the arguments it unites */
-        const size_t pl = strlen(m->path) + 32;
+        const size_t pl = strlen(m->o.path) + 32;
         char *path = malloc(pl);
         if (!path) return lb__oom(c);
-        snprintf(path, pl, "%s (args 0-%zu)", m->path, i);
-        free(m->path);
-        m->path = path;
+        snprintf(path, pl, "%s (args 0-%zu)", m->o.path, i);
+        free(m->o.path);
+        m->o.path = path;
         m->o.lp = n->o.lp;
         m->o.k = 2;
         m->args = malloc(2 * sizeof *m->args);
@@ -809,7 +809,6 @@ static lb_status finish_operator(pctx *c, lb__node *n) {
         cb[i] = 0.5;
     }
     lb_error e = {LB_OK, ""};
-    n->o.path = n->path;
     const lb_status as = lb__op_apply(&n->o, c->s->convention, x, cb, g, &v, NULL, NULL, NULL, &e);
     free(x);
     if (as) return lb__perr(c, LB_ERR_INVALID_ARGUMENT, "%s", e.message);

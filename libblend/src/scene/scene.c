@@ -15,7 +15,7 @@ void lb_scene_free(lb_scene *s) {
         free(n->o.r);
         free(n->o.p);
         free(n->o.m);
-        free(n->path);
+        free(n->o.path);
         free(n->def_name);
         free(n);
     }

@@ -15,7 +15,7 @@ typedef struct lb__affine {
 
 typedef struct lb__node lb__node;
 struct lb__node {
-    lb__op o;          /* the family and its parameters (o.path is path) */
+    lb__op o;          /* the family and its parameters; o.path: the node's JSON path */
     const char *type;  /* the scene's "type" string (stable identifier) */
     lb_primitive prim; /* LB__F_PRIMITIVE */
     lb__node **args;   /* o.k */
