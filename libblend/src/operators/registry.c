@@ -21,8 +21,8 @@ static const char *const K_CYLINDER[] = {"type", "point", "axis", "radius", NULL
 static const char *const K_CAPSULE[] = {"type", "start", "end", "radius", NULL};
 static const char *const K_TORUS[] = {"type",         "center",       "axis",
                                       "major_radius", "minor_radius", NULL};
-/* what only a soft scene's primitives take */
-static const char *const K_SOFT_PRIMITIVE[] = {"kernel", NULL};
+/* what every primitive takes in a soft scene only */
+const char *const lb__primitive_soft_keys[] = {"kernel", NULL};
 static const char *const K_BT[] = {"type", "op", "args", "r", "p", "m", "bulge", NULL};
 static const char *const K_SCALE[] = {"type", "op", "args", "r", "p", "bulge", NULL};
 static const char *const K_BOUNDED[] = {"type", "op", "args", "bounds", "p", NULL};
@@ -128,17 +128,15 @@ const lb__family_row lb__family_rows[LB__F_COUNT] = {
 };
 
 static const lb__primitive_row PRIMS[] = {
-    {"sphere", LB_PRIM_ELLIPSOID, K_SPHERE, K_SOFT_PRIMITIVE,
-     "a sphere (the ellipsoid with equal semi-axes)"},
-    {"ellipsoid", LB_PRIM_ELLIPSOID, K_ELLIPSOID, K_SOFT_PRIMITIVE, "an axis-aligned ellipsoid"},
-    {"lp", LB_PRIM_LP, K_LP, K_SOFT_PRIMITIVE, "an Lp ball (a rounded box for large exponents)"},
-    {"superquadric", LB_PRIM_SUPERQUADRIC, K_SUPERQUADRIC, K_SOFT_PRIMITIVE,
-     "Barr's superquadric (e1, e2)"},
-    {"slab", LB_PRIM_SLAB, K_SLAB, K_SOFT_PRIMITIVE, "the space between two parallel planes"},
-    {"halfspace", LB_PRIM_HALFSPACE, K_HALFSPACE, K_SOFT_PRIMITIVE, "the space below a plane"},
-    {"cylinder", LB_PRIM_CYLINDER, K_CYLINDER, K_SOFT_PRIMITIVE, "an infinite cylinder"},
-    {"capsule", LB_PRIM_CAPSULE, K_CAPSULE, K_SOFT_PRIMITIVE, "a segment swept by a ball"},
-    {"torus", LB_PRIM_TORUS, K_TORUS, K_SOFT_PRIMITIVE, "a torus about an axis"},
+    {"sphere", LB_PRIM_ELLIPSOID, K_SPHERE, "a sphere (the ellipsoid with equal semi-axes)"},
+    {"ellipsoid", LB_PRIM_ELLIPSOID, K_ELLIPSOID, "an axis-aligned ellipsoid"},
+    {"lp", LB_PRIM_LP, K_LP, "an Lp ball (a rounded box for large exponents)"},
+    {"superquadric", LB_PRIM_SUPERQUADRIC, K_SUPERQUADRIC, "Barr's superquadric (e1, e2)"},
+    {"slab", LB_PRIM_SLAB, K_SLAB, "the space between two parallel planes"},
+    {"halfspace", LB_PRIM_HALFSPACE, K_HALFSPACE, "the space below a plane"},
+    {"cylinder", LB_PRIM_CYLINDER, K_CYLINDER, "an infinite cylinder"},
+    {"capsule", LB_PRIM_CAPSULE, K_CAPSULE, "a segment swept by a ball"},
+    {"torus", LB_PRIM_TORUS, K_TORUS, "a torus about an axis"},
 };
 
 const lb__primitive_row *lb__primitive_rows(size_t *n) {

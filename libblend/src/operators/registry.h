@@ -156,15 +156,16 @@ typedef struct lb__family_row {
 /* The keys every node takes besides its own (transforms, material). */
 #define LB__TRANSFORM_KEYS "translate", "rotate", "scale", "material"
 
-/* The primitive rows: JSON name, lb_primitive_kind, keys, the keys only a
- * soft scene takes (the kernel), blurb. */
+/* The primitive rows: JSON name, lb_primitive_kind, keys, blurb. */
 typedef struct lb__primitive_row {
     const char *name;
     lb_primitive_kind kind;
     const char *const *keys;
-    const char *const *soft_keys;
     const char *blurb;
 } lb__primitive_row;
+/* the keys every primitive takes in a soft scene only (its kernel),
+ * NULL-terminated */
+LB_INTERNAL extern const char *const lb__primitive_soft_keys[];
 
 /* every row, indexed by family (row 0, the primitive family, has name
  * NULL); lb__family_info(f) is the row of family f */
@@ -176,7 +177,7 @@ static inline const lb__family_row *lb__family_info(lb__family f) {
 static inline unsigned lb__op_flags(const lb__op *o) {
     return lb__family_info(o->family)->flags;
 }
-/* the rows in order: operators, n = LB__F_COUNT - 1 (from family 1) */
+/* the primitive rows, in order; *n receives their count */
 LB_INTERNAL const lb__primitive_row *lb__primitive_rows(size_t *n);
 /* the row named type, or NULL; *prim receives the primitive row for a
  * primitive type (family LB__F_PRIMITIVE) */

@@ -114,7 +114,7 @@ static cJSON *registry_json(void) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "type", P[i].name);
         cJSON_AddItemToObject(o, "keys", string_list(P[i].keys));
-        cJSON_AddItemToObject(o, "soft_keys", string_list(P[i].soft_keys));
+        cJSON_AddItemToObject(o, "soft_keys", string_list(lb__primitive_soft_keys));
         cJSON_AddStringToObject(o, "description", P[i].blurb);
         cJSON_AddItemToArray(prims, o);
     }

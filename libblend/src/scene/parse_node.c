@@ -837,7 +837,7 @@ static lb_status node_type(pctx *c, const cJSON *j, const lb__family_row **row,
     const char *keys[32];
     /* a kernel in a zero scene is refused by parse_primitive, naming the
      * kernel rather than an unknown key */
-    node_keys(*prim ? (*prim)->keys : t->keys, *prim ? (*prim)->soft_keys : NULL, keys);
+    node_keys(*prim ? (*prim)->keys : t->keys, *prim ? lb__primitive_soft_keys : NULL, keys);
     char what[64];
     snprintf(what, sizeof what, "a %s node", type);
     if ((s = lb__check_keys(c, j, keys, what))) return s;
