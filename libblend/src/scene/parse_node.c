@@ -158,7 +158,7 @@ static void type_list(char *buf, size_t size) {
     size_t np = 0, len = 0;
     const lb__primitive_row *P = lb__primitive_rows(&np);
     buf[0] = '\0';
-    for (size_t i = 0; i < np; ++i)
+    for (size_t i = 0; i < np && len < size; ++i)
         len += (size_t)snprintf(buf + len, size - len, "%s, ", P[i].name);
     for (int f = 1; f < LB__F_COUNT && len < size; ++f) {
         const lb__family_row *row = lb__family_info((lb__family)f);
