@@ -36,6 +36,15 @@ def events(text):
     return [json.loads(l) for l in text.splitlines() if l.startswith("{")]
 
 
+def why(r):
+    """what a run said about its failed tasks, and the end of its stderr: a
+    status check that fails shows the cause, not only the statuses"""
+    errs = ["%s: %s" % (e["name"], e.get("error", "")) for e in events(r.stdout)
+            if e["event"] == "task_end" and e["status"] == "failed"]
+    return "\n  exit %d; failed tasks: %s\n  stderr: %s" % (r.returncode, errs or "none",
+                                                           r.stderr[-1500:])
+
+
 DROP = os.path.join(SRC, "scenes", "bernhardt-compare-local.json")
 BASE = {
     "format": "libblend-job", "version": 1, "name": "cmp",
@@ -83,7 +92,7 @@ check("center[0]=-0.75 alpha=[0,0]" == rows[0][4] and "center[0]=-0.35 alpha=[0.
 # ---- a run: every output, the log, the manifests, the contact sheet
 r = bt("batch", job1, "--log-json")
 ev = events(r.stdout)
-check(r.returncode == 0, "batch run exit %d: %s" % (r.returncode, r.stderr[-800:]))
+check(r.returncode == 0, "batch run" + why(r))
 out1 = os.path.join(d1, "out")
 names = sorted(os.listdir(out1))
 check(len([n for n in names if n.endswith(".png") and "sheet" not in n]) == 6 and
@@ -114,7 +123,7 @@ check(re.search(r"304 x +192", sheet), "contact sheet 3 x 2 cells of 96 x 72 (+ 
 # ---- a second run skips everything; a fresh run elsewhere gives the same bytes
 r = bt("batch", job1, "--log-json")
 check(r.returncode == 0 and all(e["status"] == "skipped" for e in events(r.stdout)
-                                if e["event"] == "task_end"), "rerun skips complete tasks")
+                                if e["event"] == "task_end"), "rerun skips complete tasks" + why(r))
 ref = digest(out1)
 d2 = os.path.join(WORK, "b")
 os.makedirs(d2)
@@ -122,7 +131,7 @@ job2 = write_job(os.path.join(d2, "cmp.json"), BASE)
 time.sleep(1.1)  # a different second: a time stamp would show
 r = bt("batch", job2)
 check(r.returncode == 0 and digest(os.path.join(d2, "out")) == ref,
-      "the same job elsewhere, later: byte-identical outputs and manifests")
+      "the same job elsewhere, later: byte-identical outputs and manifests" + why(r))
 
 # ---- a changed or damaged output is redone, the rest skipped
 victim = os.path.join(out1, "cmp_0002.png")
@@ -134,7 +143,7 @@ r = bt("batch", job1, "--log-json")
 st = {e["name"]: e["status"] for e in events(r.stdout) if e["event"] == "task_end"}
 check(st == {"cmp_0000": "skipped", "cmp_0001": "skipped", "cmp_0002": "done",
              "cmp_0003": "skipped", "cmp_0004": "done", "cmp_0005": "skipped"},
-      "damaged and missing outputs redo their task only: %s" % st)
+      "damaged and missing outputs redo their task only: %s%s" % (st, why(r)))
 check(digest(out1) == ref, "and the redone outputs are the same bytes")
 
 # ---- shards and single tasks: together the same files as the whole run
@@ -145,14 +154,14 @@ seen = []
 for i in range(4):
     r = bt("batch", job3, "--shard", "%d/4" % i, "--log-json")
     seen += [e["task"] for e in events(r.stdout) if e["event"] == "task_end"]
-    check(r.returncode == 0, "shard %d/4: %s" % (i, r.stderr[-500:]))
+    check(r.returncode == 0, "shard %d/4%s" % (i, why(r)))
 check(seen == list(range(6)), "shards 0..3 of 4 cover tasks 0..5 once, in order: %s" % seen)
 r = bt("batch", job3, "--sheet")
 check(r.returncode == 0 and digest(os.path.join(d3, "out")) == ref,
       "shards + --sheet give the whole run's bytes")
 r = bt("batch", job3, "--task", "4", "--log-json")
 check([e["status"] for e in events(r.stdout) if e["event"] == "task_end"] == ["skipped"],
-      "--task 4 alone: complete, skipped")
+      "--task 4 alone: complete, skipped" + why(r))
 
 # ---- frames, keyframes and interpolation; EXR and 16-bit PNG with alpha
 anim = {
@@ -357,7 +366,8 @@ for trial in range(20):
     for n in before:
         if st.get(n[:-5]) == "done":
             redone_complete += 1
-    check(r.returncode == 0 and digest(out) == kref, "trial %d: the rerun completes the job" % trial)
+    check(r.returncode == 0 and digest(out) == kref,
+          "trial %d: the rerun completes the job%s" % (trial, why(r)))
     shutil.rmtree(out) if trial % 2 else None
 check(redone_complete == 0, "a task complete before a kill was redone %d times" % redone_complete)
 left = glob.glob("/tmp/blendtool-render-*") + glob.glob(os.path.join(dk, "out", ".*.lbtmp.*"))
