@@ -11,7 +11,17 @@
  * the same argument above the other over the whole box, so the link
  * returns that argument (the soft form in, the scene's form out: the same
  * value up to rounding of the linear change of form). Such a link is
- * dropped and its readers read its argument. What remains is copied into a
+ * dropped and its readers read its argument.
+ *
+ * Two arguments far from the box and from each other can each be on top
+ * somewhere in it, so that test alone keeps every link whose two intervals
+ * overlap. But where the weight is 0 the links of a chain are one max (of
+ * soft forms, whatever each link's zero_scale): a max group, the links whose
+ * one reader is a max link of the same chain. An argument below the group's
+ * value over the whole box (the interval of the group's top link) is never
+ * the maximum there, so the link that takes it passes its other argument.
+ * Only the top link's value must be exact, and it is: every dropped leaf is
+ * strictly below a kept one at every point. What remains is copied into a
  * sub-tape with its own registers, run by the ordinary runners.
  *
  * Invariant: at every point of the box the sub-tape's value equals the
@@ -32,6 +42,7 @@ void lb__cone_free(lb__cone *S) {
     free(S->reg);
     free(S->prod);
     free(S->last);
+    free(S->grp);
     free(S->freel);
     free(S->R);
     memset(S, 0, sizeof *S);
@@ -52,16 +63,27 @@ static lb__iv soft_iv(const lb__instr *in, lb_convention conv, lb__iv f) {
     return o;
 }
 
+/* the soft forms (g) of a binary local or clean union's argument intervals
+ * fa, fb, when the link is the clean union alone over the box (alpha 0, no
+ * blending volume of its own reaching the box) and both are finite */
+static int plain_link(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
+                      const double bc[3], const double br[3], lb__iv g[2]) {
+    if (in->code != LB__I_OP || (!(lb__op_flags(in->op) & LB__R_CLEAN_UNION))) return 0;
+    if (in->op->lp.alpha[0] != 0.0 || in->op->lp.alpha[1] != 0.0) return 0;
+    if ((lb__op_flags(in->op) & LB__R_CURVES) && lb__local_reaches(in->curves, bc, br)) return 0;
+    g[0] = soft_iv(in, ev->conv, fa);
+    g[1] = soft_iv(in, ev->conv, fb);
+    for (int a = 0; a < 2; ++a)
+        if (!(g[a].lo >= -LB_MAX_ABS_ARG && g[a].hi <= LB_MAX_ABS_ARG)) return 0;
+    return 1;
+}
+
 /* which argument a binary local or clean union passes through over the
  * box, or -1 (see the head of the file) */
 static int passes(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
                   const double bc[3], const double br[3]) {
-    if (in->code != LB__I_OP || (!(lb__op_flags(in->op) & LB__R_CLEAN_UNION))) return -1;
-    if (in->op->lp.alpha[0] != 0.0 || in->op->lp.alpha[1] != 0.0) return -1;
-    if ((lb__op_flags(in->op) & LB__R_CURVES) && lb__local_reaches(in->curves, bc, br)) return -1;
-    const lb__iv g[2] = {soft_iv(in, ev->conv, fa), soft_iv(in, ev->conv, fb)};
-    for (int a = 0; a < 2; ++a)
-        if (!(g[a].lo >= -LB_MAX_ABS_ARG && g[a].hi <= LB_MAX_ABS_ARG)) return -1;
+    lb__iv g[2];
+    if (!plain_link(ev, in, fa, fb, bc, br, g)) return -1;
     for (int a = 0; a < 2; ++a) {
         const lb__iv me = g[a], other = g[1 - a];
         /* the clean union is max = me where the weight is 0 (either
@@ -78,6 +100,34 @@ static int passes(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv
     return -1;
 }
 
+/* Is the link exactly the max of its arguments' soft forms over the box,
+ * and the scene's form of that max again (so a chain of such links is one
+ * max, whatever their zero_scale)? The clean union's weight is 0 there, and
+ * in the soft convention both arguments are >= 0 (no clamp at 0). */
+static int max_link(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
+                    const double bc[3], const double br[3]) {
+    lb__iv g[2];
+    if (!plain_link(ev, in, fa, fb, bc, br, g)) return 0;
+    if (!(g[0].hi <= LB_SOFT_MIN_FIELD || g[1].hi <= LB_SOFT_MIN_FIELD)) return 0;
+    return ev->conv == LB_CONVENTION_ZERO || (g[0].lo >= 0.0 && g[1].lo >= 0.0);
+}
+
+/* Which argument a max link passes through because the other is below the
+ * value of its whole max group over the box (root: the interval of the
+ * group's top link), or -1. Each argument, a leaf of the group or a part of
+ * it, is a max of some of the group's leaves; one that stays below the
+ * group's lower bound is never the maximum anywhere in the box, so the
+ * group's value is the same without it (and at ties, which only leaves at
+ * the maximum can have, the same leaf is first). */
+static int under_group(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
+                       lb__iv root) {
+    const lb__iv g[2] = {soft_iv(in, ev->conv, fa), soft_iv(in, ev->conv, fb)};
+    const lb__iv top = soft_iv(in, ev->conv, root);
+    if (g[1].hi < top.lo) return 0;
+    if (g[0].hi < top.lo) return 1;
+    return -1;
+}
+
 lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n,
                           const double bc[3], const double br[3], lb__cone *S, lb_error *err) {
     const lb__instr *top = n ? &ev->ins[list ? list[n - 1] : n - 1] : NULL;
@@ -87,6 +137,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
         lb__grow((void **)&S->need, &S->cap_need, n, sizeof *S->need) ||
         lb__grow((void **)&S->reg, &S->cap_reg, n, sizeof *S->reg) ||
         lb__grow((void **)&S->last, &S->cap_last, n, sizeof *S->last) ||
+        lb__grow((void **)&S->grp, &S->cap_grp, n, sizeof *S->grp) ||
         lb__grow((void **)&S->freel, &S->cap_freel, n, sizeof *S->freel) ||
         lb__grow((void **)&S->prod, &S->cap_prod, ev->nregs, sizeof *S->prod) ||
         lb__grow((void **)&S->R, &S->cap_R, lb__ivs_len(ev), sizeof *S->R))
@@ -116,17 +167,43 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
         lb__bounds_pass_list(ev, &i, 1, bc, br, S->R);
         S->ivq[q] = S->R[in->dst];
         S->prod[in->dst] = (uint32_t)q;
-        /* 2. pass-through: alias[q] is the list position whose value q takes */
-        S->alias[q] = (uint32_t)q;
-        if (ns == 2) {
-            const int a = passes(ev, in, S->ivq[S->srcq[so]], S->ivq[S->srcq[so + 1]], bc, br);
-            if (a >= 0) S->alias[q] = S->alias[S->srcq[so + a]];
-        }
         S->last[q] = (uint32_t)so; /* the sources' offset, for the steps below */
         so += ns;
     }
+    /* 2. max groups: a max link whose one reader is a max link belongs to
+     * its reader's group; grp[q] is the group's top link (backwards, so a
+     * reader is placed before its sources). need[] holds "max link" and
+     * reg[] the readers' count meanwhile. */
+    for (size_t q = 0; q < n; ++q) S->reg[q] = 0;
+    for (size_t q = 0; q < n; ++q) {
+        const lb__instr *in = &ev->ins[list ? list[q] : q];
+        const size_t ns = nsrc_of(in);
+        for (size_t a = 0; a < ns; ++a) ++S->reg[S->srcq[S->last[q] + a]];
+        S->need[q] = ns == 2 && max_link(ev, in, S->ivq[S->srcq[S->last[q]]],
+                                         S->ivq[S->srcq[S->last[q] + 1]], bc, br);
+        S->grp[q] = UINT32_MAX;
+    }
+    for (size_t q = n; q-- > 0;) {
+        if (!S->need[q]) continue;
+        if (S->grp[q] == UINT32_MAX) S->grp[q] = (uint32_t)q;
+        for (size_t a = 0; a < 2; ++a) {
+            const uint32_t p = S->srcq[S->last[q] + a];
+            if (S->need[p] && S->reg[p] == 1) S->grp[p] = S->grp[q];
+        }
+    }
+    /* 3. pass-through: alias[q] is the list position whose value q takes */
+    for (size_t q = 0; q < n; ++q) {
+        const lb__instr *in = &ev->ins[list ? list[q] : q];
+        S->alias[q] = (uint32_t)q;
+        if (nsrc_of(in) != 2) continue;
+        const uint32_t off = S->last[q];
+        const lb__iv fa = S->ivq[S->srcq[off]], fb = S->ivq[S->srcq[off + 1]];
+        int a = passes(ev, in, fa, fb, bc, br);
+        if (a < 0 && S->need[q]) a = under_group(ev, in, fa, fb, S->ivq[S->grp[q]]);
+        if (a >= 0) S->alias[q] = S->alias[S->srcq[off + a]];
+    }
     if (n) S->root = S->ivq[n - 1];
-    /* 3. what the root needs, backwards */
+    /* 4. what the root needs, backwards */
     memset(S->need, 0, n);
     if (n) S->need[S->alias[n - 1]] = 1;
     for (size_t q = n; q-- > 0;) {
@@ -135,7 +212,7 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
         const size_t ns = nsrc_of(in);
         for (size_t a = 0; a < ns; ++a) S->need[S->alias[S->srcq[S->last[q] + a]]] = 1;
     }
-    /* 4. copy what is needed; registers by last use (reg[q] = last reader
+    /* 5. copy what is needed; registers by last use (reg[q] = last reader
      * first, then the register). Not when more than three quarters of the
      * instructions are kept: the copy would cost more than it saves (the
      * caller runs the source; the pass's interval stands) */

@@ -71,8 +71,13 @@ typedef struct child_eval {
     const lb__instr *in;
     double *regs;
     lb_error *err;
-    double wcone[2];               /* instruction runs of each child's cone per point */
-    double *work;                  /* the evaluator's compile cost so far */
+    double wcone[2];  /* instruction runs of each child's cone per point */
+    double *work;     /* the evaluator's compile cost so far */
+    lb__cone fold[2]; /* each child's cone reduced over the box (fc, fr) of the
+                         fold's kept cells, when has_fold */
+    double fc[3], fr[3];
+    int has_fold;
+    int gfold[2];                  /* the current group's cone was reduced from fold[] */
     lb__cone grp[2];               /* each child's cone reduced over the current group of chunks */
     lb__cone sub[2];               /* and over the current chunk */
     lb__cone oc[2 * OCTREE_DEPTH]; /* each child's cone reduced over the octree's cells */
@@ -108,7 +113,13 @@ static double cone_weight(const lb_evaluator *ev, const uint32_t *cone, size_t n
     return w;
 }
 
-/* the centre and half-size of the box around n points */
+/* is the box (c, r) inside the box (C, R)? */
+static int box_inside(const double c[3], const double r[3], const double C[3], const double R[3]) {
+    for (int d = 0; d < 3; ++d)
+        if (!(c[d] - r[d] >= C[d] - R[d] && c[d] + r[d] <= C[d] + R[d])) return 0;
+    return 1;
+}
+
 /* The tape that computes child a at a chunk of points in box (bc, br): the
  * run, the register of the child's value and the charge per point. A long
  * cone is reduced over the chunk's group of chunks (box (gc, gr), at its
@@ -128,23 +139,36 @@ static lb_status chunk_tape(child_eval *E, int a, int new_group, const double gc
     lb_status st;
     if (in->ncone[a] >= REDUCE_FROM) {
         lb__cone *Gc = &E->grp[a], *S = &E->sub[a];
+        const lb__cone *F = &E->fold[a];
+        /* the group's base: the fold's reduced cone when the group's box
+         * lies in the fold's box, else the whole cone */
+        if (new_group)
+            E->gfold[a] =
+                E->has_fold && F->reduced && F->copied && box_inside(gc, gr, E->fc, E->fr);
+        const lb_evaluator *bev = E->gfold[a] ? &F->ev : E->ev;
+        const uint32_t *blist = E->gfold[a] ? NULL : cone;
+        const size_t bn = E->gfold[a] ? F->ev.n : in->ncone[a];
+        const double bw = E->gfold[a] ? F->weight : E->wcone[a];
         /* a reduction is an interval pass over what it reduces: charged as
          * one run of that */
-        if (new_group && ((st = charge(E, E->wcone[a])) ||
-                          (st = lb__cone_reduce(E->ev, cone, in->ncone[a], gc, gr, Gc, E->err))))
+        if (new_group &&
+            ((st = charge(E, bw)) || (st = lb__cone_reduce(bev, blist, bn, gc, gr, Gc, E->err))))
             return st;
         const int grouped = Gc->reduced && Gc->copied;
         const int chunked = Gc->reduced && (!grouped || Gc->ev.n >= REDUCE_FROM);
-        if (chunked &&
-            ((st = charge(E, grouped ? Gc->weight : E->wcone[a])) ||
-             (st = grouped ? lb__cone_reduce(&Gc->ev, NULL, Gc->ev.n, bc, br, S, E->err)
-                           : lb__cone_reduce(E->ev, cone, in->ncone[a], bc, br, S, E->err))))
+        if (chunked && ((st = charge(E, grouped ? Gc->weight : bw)) ||
+                        (st = grouped ? lb__cone_reduce(&Gc->ev, NULL, Gc->ev.n, bc, br, S, E->err)
+                                      : lb__cone_reduce(bev, blist, bn, bc, br, S, E->err))))
             return st;
         if (grouped && (!chunked || !S->copied)) S = Gc;
         if (Gc->reduced && S->reduced && S->copied) {
             run_ev = &S->ev;
             r = S->out;
             w = S->weight;
+        } else if (E->gfold[a]) {
+            run_ev = &F->ev;
+            r = F->out;
+            w = F->weight;
         }
     }
     const size_t nr = run_ev != E->ev ? run_ev->n : in->ncone[a];
@@ -490,6 +514,37 @@ static lb_status project(child_eval *E, size_t n, double *p, double size) {
 
 /* ---- the whole preparation of one instruction ---- */
 
+/* Each long cone reduced once over the box of the kept cells (one cell more
+ * on every side): the groups of points inside it, nearly all of them, are
+ * reduced from that short cone instead of the whole one, so a fold's
+ * reductions cost what its box meets and not every child before it. */
+static lb_status fold_cones(child_eval *E, const grid *G, const cellset *S) {
+    uint32_t lo[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX}, hi[3] = {0, 0, 0};
+    for (size_t c = 0; c < S->n; ++c)
+        for (int d = 0; d < 3; ++d) {
+            const uint32_t v = S->c[3 * c + d];
+            if (v < lo[d]) lo[d] = v;
+            if (v + 1 > hi[d]) hi[d] = v + 1;
+        }
+    for (int d = 0; d < 3; ++d) {
+        const double a = G->origin[d] + G->h * ((double)lo[d] - 1.0);
+        const double b = G->origin[d] + G->h * ((double)hi[d] + 1.0);
+        E->fc[d] = 0.5 * (a + b);
+        E->fr[d] = 0.5 * (b - a);
+    }
+    for (int a = 0; a < 2; ++a) {
+        const lb__instr *in = E->in;
+        if (in->ncone[a] < REDUCE_FROM) continue;
+        lb_status st = charge(E, E->wcone[a]);
+        if (!st)
+            st = lb__cone_reduce(E->ev, in->cone + (a ? in->ncone[0] : 0), in->ncone[a], E->fc,
+                                 E->fr, &E->fold[a], E->err);
+        if (st) return st;
+    }
+    E->has_fold = 1;
+    return LB_OK;
+}
+
 static double dist3(const double *a, const double *b) {
     const double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
     return sqrt(x * x + y * y + z * z);
@@ -779,6 +834,7 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
             free(W);
         }
     }
+    if (!s && S.n) s = fold_cones(&E, &G, &S);
     /* sample the kept cells' nodes */
     if (!s && S.n) {
         if (hmap_init(&B.nodes, 8 * S.n) || hmap_init(&B.faces, 24 * S.n))
@@ -834,6 +890,8 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
         lb__cone_free(&E.sub[q]);
     }
     for (int q = 0; q < 2 * OCTREE_DEPTH; ++q) lb__cone_free(&E.oc[q]);
+    lb__cone_free(&E.fold[0]);
+    lb__cone_free(&E.fold[1]);
     free(E.ivs);
     free(E.subregs);
     hmap_free(&B.nodes);

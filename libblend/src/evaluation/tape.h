@@ -139,11 +139,11 @@ typedef struct lb__cone {
     int copied;  /* 0: more than 3/4 kept, not copied (ev, out, weight unset): run the source */
     lb__iv root; /* the cone's value over the box (the pass's interval) */
     lb__instr *ins;
-    uint32_t *src, *srcq, *alias, *reg, *prod, *last, *freel;
+    uint32_t *src, *srcq, *alias, *reg, *prod, *last, *freel, *grp;
     uint8_t *need;
     lb__iv *ivq, *R;
     size_t cap_ins, cap_src, cap_srcq, cap_alias, cap_reg, cap_prod, cap_last, cap_freel, cap_need,
-        cap_q, cap_R;
+        cap_q, cap_R, cap_grp;
 } lb__cone;
 /* Reduce instructions list[0..n) of ev (list NULL: ev's first n; tape
  * order, the cone's value last) over the box centre bc, half-size br, into
