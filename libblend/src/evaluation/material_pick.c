@@ -18,7 +18,7 @@ static lb_status pick(const lb__node *n, lb_convention conv, const lb__affine *A
         return LB_OK;
     }
     lb__affine A = *Ap;
-    if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
+    if (n->has_transform) lb__affine_compose(n->to_local, Ap, &A);
     size_t best = 0;
     double bs = INFINITY;
     for (size_t i = 0; i < n->o.k && n->o.k > 1; ++i) {

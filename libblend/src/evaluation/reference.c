@@ -112,7 +112,7 @@ static lb_status ref_eval(const lb__node *n, lb_convention conv, const lb__affin
                           const lb_evaluator *ev, const double X[3], double *v, double g[3],
                           lb_error *err) {
     lb__affine A = *Ap;
-    if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
+    if (n->has_transform) lb__affine_compose(n->to_local, Ap, &A);
     lb_status s = LB_OK;
     if (n->o.family == LB__F_PRIMITIVE) {
         double L[3], gl[3];

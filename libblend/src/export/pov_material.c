@@ -45,7 +45,7 @@ lb_status lb__pov_texture(pctx *c, const lb__node *n, const lb__affine *Ap, size
         return LB_OK;
     }
     lb__affine A = *Ap;
-    if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
+    if (n->has_transform) lb__affine_compose(n->to_local, Ap, &A);
     if (n->o.k == 1) return lb__pov_texture(c, n->args[0], &A, eff, name);
     const size_t k = n->o.k;
     char(*sub)[24] = malloc(k * sizeof *sub);
@@ -55,7 +55,7 @@ lb_status lb__pov_texture(pctx *c, const lb__node *n, const lb__affine *Ap, size
     for (size_t i = 0; i < k && !s; ++i) {
         if ((s = lb__pov_texture(c, n->args[i], &A, eff, sub[i]))) break;
         lb__affine F = A;
-        if (n->args[i]->has_transform) lb__affine_compose(&n->args[i]->to_local, &A, &F);
+        if (n->args[i]->has_transform) lb__affine_compose(n->args[i]->to_local, &A, &F);
         fid[i] = lb__pov_written_id(c, n->args[i], &F);
         if (fid[i] < 0) {
             s = lb__fail(c->err, LB_ERR_INTERNAL, "%s: %s: argument %zu was not written", FN,

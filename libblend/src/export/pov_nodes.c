@@ -80,7 +80,7 @@ void lb__pov_affine_args(sbuf *b, const lb__affine *A) {
 lb_status lb__pov_emit(pctx *c, const lb__node *n, int *out) {
     const lb__affine saved = c->A;
     lb__affine A = saved;
-    if (n->has_transform) lb__affine_compose(&n->to_local, &saved, &A);
+    if (n->has_transform) lb__affine_compose(n->to_local, &saved, &A);
     const int known = lb__pov_written_id(c, n, &A);
     if (known >= 0) {
         *out = known;
@@ -282,7 +282,7 @@ static lb_status emit_node(pctx *c, const lb__node *n, int id) {
     }
     if (n->has_transform) {
         sb(b, "#declare LBn%d = function(x, y, z) { LBl%d(", id, id);
-        affine_args(b, &n->to_local);
+        affine_args(b, n->to_local);
         sb(b, ") }\n");
     }
     return LB_OK;

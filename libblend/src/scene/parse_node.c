@@ -35,8 +35,6 @@ static lb__node *new_node(pctx *c, lb__family fam, const char *type) {
     n->o.family = fam;
     n->type = type;
     n->depth = 1;
-    lb__affine_identity(&n->to_local);
-    lb__affine_identity(&n->to_parent);
     s->nodes[s->nnodes++] = n;
     return n;
 }
@@ -134,7 +132,6 @@ static lb_status get_transform(pctx *c, const cJSON *obj, lb__node *n) {
         lb__affine_compose(&b, &a, &a);
     }
     memcpy(a.t, t, sizeof t);
-    n->to_parent = a;
     /* inverse: S^-1 R^T (x - t) */
     lb__affine inv;
     for (int i = 0; i < 3; ++i)
@@ -144,7 +141,9 @@ static lb_status get_transform(pctx *c, const cJSON *obj, lb__node *n) {
         }
     for (int i = 0; i < 3; ++i)
         inv.t[i] = -(inv.M[3 * i] * t[0] + inv.M[3 * i + 1] * t[1] + inv.M[3 * i + 2] * t[2]);
-    n->to_local = inv;
+    n->to_local = malloc(sizeof *n->to_local);
+    if (!n->to_local) return lb__oom(c);
+    *n->to_local = inv;
     return LB_OK;
 }
 
@@ -390,16 +389,18 @@ static lb_status parse_ref(pctx *c, const cJSON *j, size_t depth, lb__node **out
     }
     /* a ref with its own transform or material is a group over the def */
     lb__node *g = new_node(c, LB__F_GROUP, "ref");
-    if (!g) return lb__oom(c);
+    if (!g) {
+        free(tmp.to_local);
+        return lb__oom(c);
+    }
+    g->has_transform = tmp.has_transform;
+    g->to_local = tmp.to_local; /* the group owns it now */
     g->o.k = 1;
     g->args = malloc(sizeof *g->args);
     if (!g->args) return lb__oom(c);
     g->args[0] = target;
     if ((s = node_material(c, j, g))) return s;
     g->mat_below = target->mat || target->mat_below;
-    g->has_transform = tmp.has_transform;
-    g->to_local = tmp.to_local;
-    g->to_parent = tmp.to_parent;
     g->depth = target->depth + 1;
     g->bulge_depth = target->bulge_depth;
     g->walk_cost = 1.0 + target->walk_cost;
@@ -442,10 +443,15 @@ static lb_status parse_args(pctx *c, const cJSON *j, const char *key, const lb__
                 s = lb__oom(c);
             } else {
                 size_t i = 0;
-                for (const cJSON *e = a->child; e && !s; e = e->next, ++i) {
+                for (cJSON *e = a->child, *next; e && !s; e = next, ++i) {
+                    next = e->next;
                     const size_t o2 = lb__push_index(c, i);
                     s = lb__parse_node(c, e, depth + 1, &v[i]);
                     lb__pop(c, o2);
+                    /* nothing reads an argument's JSON again once its node
+                     * exists (a def is built once): freed now, so that the
+                     * document and the nodes are not both held whole */
+                    if (!s) cJSON_Delete(cJSON_DetachItemViaPointer((cJSON *)a, e));
                 }
                 if (s)
                     free(v);

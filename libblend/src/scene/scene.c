@@ -17,6 +17,7 @@ void lb_scene_free(lb_scene *s) {
         free(n->o.m);
         free(n->o.path);
         free(n->def_name);
+        free(n->to_local);
         free(n);
     }
     free(s->nodes);

@@ -21,9 +21,9 @@ struct lb__node {
     lb__node **args;   /* o.k */
     lb__node **bounds; /* o.k (LB__R_BOUNDING) */
     int has_transform;
-    lb__affine to_local; /* parent coordinates -> this node's coordinates */
-    lb__affine to_parent;
-    char *path;         /* JSON path of the node, for messages */
+    /* parent coordinates -> this node's coordinates; allocated only with
+     * has_transform (most nodes of a large scene have none), else NULL */
+    lb__affine *to_local;
     char *def_name;     /* name when the node is a def, else NULL */
     size_t depth;       /* height: 1 for a leaf */
     size_t bulge_depth; /* bulge nodes on the longest path down (4 re-evaluations each) */
