@@ -4,11 +4,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A def compiled at a transform: the slot of an open-addressing table
+ * (node NULL: empty); the transform is keys[key], stored once per entry
+ * rather than once per slot. */
 typedef struct memo_entry {
     const lb__node *node;
-    lb__affine A;
-    uint32_t idx;
-    int used;
+    uint32_t idx, key;
 } memo_entry;
 
 typedef struct cctx {
@@ -20,6 +21,8 @@ typedef struct cctx {
     size_t costliest; /* the instruction with the largest cost so far */
     memo_entry *memo;
     size_t mcap, mcount;
+    lb__affine *keys; /* mcount of them */
+    size_t kcap;
     lb_convention conv;
     lb_error *err;
 } cctx;
@@ -33,14 +36,17 @@ static uint64_t memo_hash(const lb__node *n, const lb__affine *A) {
 
 static memo_entry *memo_find(cctx *c, const lb__node *n, const lb__affine *A) {
     size_t i = (size_t)memo_hash(n, A) & (c->mcap - 1);
-    while (c->memo[i].used) {
-        if (c->memo[i].node == n && memcmp(&c->memo[i].A, A, sizeof *A) == 0) return &c->memo[i];
+    while (c->memo[i].node) {
+        if (c->memo[i].node == n && memcmp(&c->keys[c->memo[i].key], A, sizeof *A) == 0)
+            return &c->memo[i];
         i = (i + 1) & (c->mcap - 1);
     }
     return &c->memo[i];
 }
 
 static lb_status memo_grow(cctx *c) {
+    if (lb__grow((void **)&c->keys, &c->kcap, c->mcount + 1, sizeof *c->keys))
+        return lb__fail(c->err, LB_ERR_NO_MEMORY, "lb_evaluator_create: out of memory");
     if (2 * (c->mcount + 1) <= c->mcap) return LB_OK;
     const size_t ncap = c->mcap ? 2 * c->mcap : 256;
     memo_entry *old = c->memo;
@@ -52,7 +58,7 @@ static lb_status memo_grow(cctx *c) {
     }
     c->mcap = ncap;
     for (size_t i = 0; i < ocap; ++i)
-        if (old[i].used) *memo_find(c, old[i].node, &old[i].A) = old[i];
+        if (old[i].node) *memo_find(c, old[i].node, &c->keys[old[i].key]) = old[i];
     free(old);
     return LB_OK;
 }
@@ -236,14 +242,18 @@ static lb_status charge(cctx *c, uint32_t idx) {
 
 static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, uint32_t *out) {
     lb__affine A = *Ap;
-    if (n->has_transform) lb__affine_compose(&n->to_local, Ap, &A);
+    if (n->has_transform) lb__affine_compose(n->to_local, Ap, &A);
     if (n->o.family == LB__F_GROUP) return compile_node(c, n->args[0], &A, out);
     lb_status s;
-    if ((s = memo_grow(c))) return s;
-    memo_entry *e = memo_find(c, n, &A);
-    if (e->used) {
-        *out = e->idx;
-        return LB_OK;
+    /* Only a def's node has more than one parent (every other node is
+     * reached through its one parent, once per distinct transform of the
+     * nearest def above it): only defs are looked up and remembered, so the
+     * table stays small beside a tape of many primitives. */
+    const int shared = n->def_name != NULL;
+    memo_entry *e = NULL;
+    if (shared && ((s = memo_grow(c)) || (e = memo_find(c, n, &A), e->node))) {
+        if (!s) *out = e->idx;
+        return s;
     }
     uint32_t *src = NULL, *srci = NULL, *srcb = NULL;
     if (n->o.family != LB__F_PRIMITIVE) {
@@ -322,12 +332,14 @@ static lb_status compile_node(cctx *c, const lb__node *n, const lb__affine *Ap, 
         if ((s = precompute_op(c, in, n, &A))) return s;
     }
     if ((s = charge(c, idx))) return s;
-    e = memo_find(c, n, &A); /* the table may have grown during recursion */
-    e->node = n;
-    e->A = A;
-    e->idx = idx;
-    e->used = 1;
-    c->mcount++;
+    if (shared) {
+        if ((s = memo_grow(c))) return s; /* room for this entry after the recursion's */
+        e = memo_find(c, n, &A);
+        c->keys[c->mcount] = A;
+        e->node = n;
+        e->idx = idx;
+        e->key = (uint32_t)c->mcount++;
+    }
     *out = idx;
     return LB_OK;
 }
@@ -434,6 +446,7 @@ lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_erro
     lb_status s = compile_node(&c, scene->root, &id, &root);
     if (!s && ev->cost > (double)LB_SCENE_MAX_COST_FACTOR * (double)ev->n) s = cost_error(&c);
     free(c.memo);
+    free(c.keys);
     free(c.mark);
     free(c.stack);
     if (!s) s = allocate_registers(ev, root, err);
