@@ -423,6 +423,15 @@ static void test_limits(void **state) {
     expect(arrays, strlen(arrays), LB_ERR_INVALID_ARGUMENT,
            (const char *const[3]){"big.json:1:", "JSON nested deeper than 208 levels"});
     free(arrays);
+    /* a list longer than any scene's, refused before a tree is built (its
+     * 3 M values once took 21 times the file's size in memory) */
+    char *longr = repeat(HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"displacement\", "
+                              "\"op\": \"union\", \"r\": [0.5",
+                         ",0.5", 4 * 65535, "], \"args\": [" SPH ", " SPH "]}}");
+    expect(longr, strlen(longr), LB_ERR_INVALID_ARGUMENT,
+           (const char *const[3]){"big.json:1:", "a JSON array of more than 262140 elements",
+                                  "at most 65535 arguments"});
+    free(longr);
     /* more than LB_SCENE_MAX_NODES nodes (refs count) */
     char *inner =
         repeat("{\"type\": \"min\", \"args\": [{\"ref\": \"s\"}", ", {\"ref\": \"s\"}", 255, "]}");

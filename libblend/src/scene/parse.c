@@ -190,11 +190,13 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
                         LB_SCENE_MAX_BYTES);
     /* Pre-scan, outside strings, allocating nothing: the nesting, and the
      * number of objects, arrays and values (commas), each capped at what a
-     * scene of LB_SCENE_MAX_NODES nodes can hold (scene.h), so a file that
-     * cannot be a scene (63 MB of []) is refused before any parser builds a
-     * tree of it. */
+     * scene of LB_SCENE_MAX_NODES nodes can hold, and the length of every
+     * array (scene.h), so a file that cannot be a scene (63 MB of [], an r
+     * list of millions) is refused before any parser builds a tree of it. */
     {
         size_t depth = 0, line = 1, col = 1, nobj = 0, narr = 0, nval = 0;
+        /* per open bracket: its array's commas so far, or UINT32_MAX for an object */
+        uint32_t commas[JSON_MAX_NESTING + 2];
         int in_str = 0, esc = 0;
         for (size_t i = 0; i < length; ++i) {
             const char ch = text[i];
@@ -236,8 +238,17 @@ lb_status lb_scene_parse(const char *text, size_t length, const char *name, lb_s
                                     "at most %d levels of nodes (use defs and refs to share "
                                     "subtrees)",
                                     file, line, col - 1, JSON_MAX_NESTING, LB_SCENE_MAX_DEPTH);
-            } else if ((ch == ']' || ch == '}') && depth)
+                commas[depth] = ch == '[' ? 0 : UINT32_MAX;
+            } else if ((ch == ']' || ch == '}') && depth) {
                 --depth;
+            } else if (ch == ',' && depth && commas[depth] != UINT32_MAX &&
+                       ++commas[depth] >= LB_SCENE_MAX_JSON_ARRAY) {
+                return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                                "%s:%zu:%zu: a JSON array of more than %d elements; allowed: at "
+                                "most %d arguments of an operator, and as many values in its "
+                                "r, p and m lists",
+                                file, line, col - 1, LB_SCENE_MAX_JSON_ARRAY, LB_MAX_ARITY_WIDE);
+            }
         }
     }
     /* the strict check first (one pass, nothing allocated);
