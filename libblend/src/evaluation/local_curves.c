@@ -95,9 +95,10 @@ static lb_status charge(child_eval *E, double runs) {
     if (*E->work <= LB_SCENE_MAX_COMPILE_COST) return LB_OK;
     return lb__fail(E->err, LB_ERR_INVALID_ARGUMENT,
                     "%s: finding the local unions' intersection curves takes more than %.3g "
-                    "instruction runs (the compile-cost limit); allowed: fewer or simpler "
-                    "children under local unions (a local_union of k children folds left, so "
-                    "each fold evaluates every child before it), or clean_union or min where "
+                    "instruction runs (the compile-cost limit); allowed: fewer children within "
+                    "reach of each other under one local union (each fold evaluates every "
+                    "earlier child whose field reaches its curves: a smaller zero_scale, or "
+                    "kernels of finite support, keep them apart), or clean_union or min where "
                     "no local blend is needed",
                     E->in->op->path, LB_SCENE_MAX_COMPILE_COST);
 }
