@@ -150,9 +150,16 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
             lb_pov_options o = {0, 0, (double)J->img_w / (double)J->img_h, 0.0, threads};
             if ((s = lb_scene_write_pov(sc, ev, &o, R.pov, NULL, &e)))
                 rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
-            if (!rc)
-                rc = bt_povray(J->scenes[T->scene], &R, J->img_w, J->img_h, threads ? threads : 1,
-                               J->img_quality, J->img_plan.bits16, J->img_plan.alpha, 1);
+            if (!rc) {
+                const bt_pov_run P = {.width = J->img_w,
+                                      .height = J->img_h,
+                                      .threads = threads ? threads : 1,
+                                      .quality = J->img_quality,
+                                      .bits16 = J->img_plan.bits16,
+                                      .alpha = J->img_plan.alpha,
+                                      .quiet = 1};
+                rc = bt_povray(J->scenes[T->scene], &R, &P);
+            }
             if (!rc) {
                 char hex[33], settings[128], err[1024] = "";
                 bt_hash_hex(scene_hash, hex);

@@ -158,13 +158,18 @@ typedef struct bt_render_dir {
 int bt_render_dir_open(bt_render_dir *r); /* exit code */
 void bt_render_dir_close(bt_render_dir *r);
 
-/* povray on R's scene into R's image, a PNG of 16 bits per channel (else 8)
- * with an alpha channel (else RGB) as bits16 and alpha say, through R's INI
- * file; its messages stream to stderr, or (quiet) go to R's log and are
- * shown only when it fails. Returns an exit code, after printing a message
- * naming scene_name on failure. */
-int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int height, int threads,
-              int quality, int bits16, int alpha, int quiet);
+/* How povray renders: image size, threads (0: one per CPU), quality 0..11,
+ * a PNG of 16 bits per channel (else 8) with an alpha channel (else RGB);
+ * quiet: its messages go to the render folder's log and are shown only when
+ * it fails (else they stream to stderr); antialias: adaptive antialiasing,
+ * without jitter (the same bytes run to run at one thread). */
+typedef struct bt_pov_run {
+    int width, height, threads, quality, bits16, alpha, quiet, antialias;
+} bt_pov_run;
+/* povray on R's scene into R's image as P says, through R's INI file.
+ * Returns an exit code, after printing a message naming scene_name on
+ * failure. */
+int bt_povray(const char *scene_name, const bt_render_dir *R, const bt_pov_run *P);
 
 /* The lbi_format for an image name (.png: --bits 8|16, .exr: --pixel
  * half|float; 0 / NULL: the defaults), or -1 after printing why. */

@@ -16,7 +16,7 @@ static int parse_int(const char *cmd, const char *opt, const char *v, long lo, l
 
 typedef struct povargs {
     const char *scene, *out;
-    int include_only, width, height, threads, quality, silhouette, bits, alpha;
+    int include_only, width, height, threads, quality, silhouette, bits, alpha, quiet, antialias;
     const char *pixel;
     bt_set sets[BT_MAX_SETS];
     size_t nsets;
@@ -54,6 +54,10 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
             a->pixel = v;
         } else if (render && strcmp(argv[i], "--alpha") == 0) {
             a->alpha = 1;
+        } else if (render && strcmp(argv[i], "--quiet") == 0) {
+            a->quiet = 1;
+        } else if (render && strcmp(argv[i], "--antialias") == 0) {
+            a->antialias = 1;
         } else if (!render && strcmp(argv[i], "--include-only") == 0) {
             a->include_only = 1;
         } else if ((r = bt_option(cmd, argc, argv, &i, "--set", &v))) {
@@ -151,16 +155,18 @@ static int run_render(int argc, char **argv) {
      * PNG): asked once the scene is known to be good, so a bad scene is
      * exit 2 whatever the output format */
     if (!rc && bt_image_plan_for("render", a.out, fmt, a.alpha, &plan)) rc = BT_EXIT_INTERNAL;
-    if (!rc)
-        rc = bt_povray(a.scene, &R, a.width, a.height, a.threads, a.quality, plan.bits16,
-                       plan.alpha, 0);
+    if (!rc) {
+        const bt_pov_run P = {a.width,     a.height,   a.threads, a.quality,
+                              plan.bits16, plan.alpha, a.quiet,   a.antialias};
+        rc = bt_povray(a.scene, &R, &P);
+    }
     unsigned char *img = NULL;
     size_t len = 0;
     if (!rc) {
         char hex[33], settings[128], params[4096], err[1024] = "";
         bt_hash_hex(hash, hex);
-        snprintf(settings, sizeof settings, "%dx%d quality %d%s", a.width, a.height, a.quality,
-                 a.silhouette ? " silhouette" : "");
+        snprintf(settings, sizeof settings, "%dx%d quality %d%s%s", a.width, a.height, a.quality,
+                 a.silhouette ? " silhouette" : "", a.antialias ? " antialias" : "");
         size_t o = 0;
         params[0] = '\0';
         for (size_t i = 0; i < a.nsets && o + 1 < sizeof params; ++i) {
@@ -214,15 +220,16 @@ const bt_command bt_cmd_render = {
     "render", "render the scene with POV-Ray into a PNG",
     "usage: blendtool render SCENE -o OUT.{png,exr} [--width W] [--height H] [--threads N]\n"
     "                        [--quality Q] [--silhouette] [--bits 8|16] [--pixel half|float]\n"
-    "                        [--alpha] [--set PATH=VALUE]...\n\n"
+    "                        [--alpha] [--antialias] [--quiet] [--set PATH=VALUE]...\n\n"
     "Exports the scene (as blendtool pov) and runs povray on it; povray's progress\n"
-    "streams to standard error. The image is written by OpenImageIO: PNG (8 or 16\n"
-    "bits) or OpenEXR (half or float), RGB or with --alpha RGBA, with the scene's\n"
-    "hash, libblend's version and the render settings as metadata and no time\n"
-    "stamp: the same scene and options give the same bytes at --threads 1 (POV-Ray's\n"
-    "threads share out the area light's jitter differently from run to run). OUT\n"
-    "appears only when the render succeeded. Without OpenImageIO (its module cannot be loaded),\n"
-    "POV-Ray writes the PNG itself, with the same metadata; EXR then fails.\n"
+    "streams to standard error (--quiet: into a log, shown only if povray fails).\n"
+    "The image is written by OpenImageIO: PNG (8 or 16 bits) or OpenEXR (half or\n"
+    "float), RGB or with --alpha RGBA, with the scene's hash, libblend's version and\n"
+    "the render settings as metadata and no time stamp: the same scene and options\n"
+    "give the same bytes at --threads 1 (POV-Ray's threads share out the area\n"
+    "light's jitter differently from run to run). OUT appears only when the render\n"
+    "succeeded. Without OpenImageIO (its module cannot be loaded), POV-Ray writes\n"
+    "the PNG itself, with the same metadata; EXR then fails.\n"
     "libblend.inc is taken from the folder $LIBBLEND_POVRAY_INCLUDE, else from the\n"
     "copy installed with blendtool (share/libblend/povray beside its bin/).\n"
     "  --width, --height  image size (640 x 480)\n"
@@ -232,6 +239,8 @@ const bt_command bt_cmd_render = {
     "  --bits 8|16        PNG channel depth (8)\n"
     "  --pixel half|float EXR pixel type (half)\n"
     "  --alpha            keep the alpha channel (transparent background)\n"
+    "  --antialias        POV-Ray's adaptive antialiasing (smooth edges; slower), no jitter\n"
+    "  --quiet            no POV-Ray banner or progress (shown only when povray fails)\n"
     "  --set PATH=VALUE   override a scene value first (VALUE is JSON); repeatable\n"
     "A signal (SIGINT, SIGTERM, SIGHUP) ends povray too and removes the temporary\n"
     "folder ($TMPDIR or /tmp/blendtool-render-PID-*); a folder left by a killed run is\n"

@@ -49,14 +49,13 @@ static void remove_stale_renders(void) {
     closedir(d);
 }
 
-int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int height, int threads,
-              int quality, int bits16, int alpha, int quiet) {
+int bt_povray(const char *scene_name, const bt_render_dir *R, const bt_pov_run *P) {
     char outw[64], outh[64], th[64], q[32], dir[4096];
     if (bt_povray_include("render", dir, sizeof dir)) return BT_EXIT_INTERNAL;
     /* POV-Ray splits its command line at spaces, even inside one argument
      * (+L/a b fails): the paths go into an INI file as quoted strings, and
      * povray runs in the render folder, given the INI file by its bare name */
-    const char *const log = quiet ? R->log : NULL;
+    const char *const log = P->quiet ? R->log : NULL;
     const char *const paths[3] = {R->pov, R->png, dir};
     for (int i = 0; i < 3; ++i)
         if (strpbrk(paths[i], "\"\n\r")) {
@@ -74,10 +73,11 @@ int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int hei
         bt_error("render", "%s: cannot write: %s", R->ini, strerror(errno));
         return BT_EXIT_INTERNAL;
     }
-    snprintf(outw, sizeof outw, "+W%d", width);
-    snprintf(outh, sizeof outh, "+H%d", height);
-    snprintf(th, sizeof th, "+WT%d", threads > 0 ? threads : (int)sysconf(_SC_NPROCESSORS_ONLN));
-    snprintf(q, sizeof q, "+Q%d", quality);
+    snprintf(outw, sizeof outw, "+W%d", P->width);
+    snprintf(outh, sizeof outh, "+H%d", P->height);
+    snprintf(th, sizeof th, "+WT%d",
+             P->threads > 0 ? P->threads : (int)sysconf(_SC_NPROCESSORS_ONLN));
+    snprintf(q, sizeof q, "+Q%d", P->quality);
     const char *const ini_name = R->ini + strlen(R->dir) + 1; /* run in R->dir */
     const pid_t pid = fork();
     if (pid == 0) {
@@ -94,8 +94,11 @@ int bt_povray(const char *scene_name, const bt_render_dir *R, int width, int hei
             }
         }
         if (chdir(R->dir) != 0) _exit(127);
-        execlp("povray", "povray", ini_name, outw, outh, th, q, "-D", bits16 ? "+FN16" : "+FN8",
-               alpha ? "+UA" : "-UA", "-V", (char *)NULL);
+        /* antialiasing: adaptive (method 2, 3 levels) where neighbours
+         * differ by more than 0.3, no jitter */
+        execlp("povray", "povray", ini_name, outw, outh, th, q, "-D", P->bits16 ? "+FN16" : "+FN8",
+               P->alpha ? "+UA" : "-UA", "-V", P->antialias ? "+A0.3" : "-A", "+AM2", "+R3", "-J",
+               (char *)NULL);
         fprintf(stderr,
                 "blendtool render: cannot run povray (%s); allowed: install POV-Ray 3.7 (Debian "
                 "package povray)\n",
