@@ -78,12 +78,13 @@ static int plain_link(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb
     return 1;
 }
 
-/* which argument a binary local or clean union passes through over the
- * box, or -1 (see the head of the file) */
-static int passes(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
-                  const double bc[3], const double br[3]) {
-    lb__iv g[2];
-    if (!plain_link(ev, in, fa, fb, bc, br, g)) return -1;
+/* what step 2 learns of a link (need[] meanwhile): plain_link holds, and
+ * max_link too */
+enum { LINK_PLAIN = 1, LINK_MAX = 2 };
+
+/* which argument a plain link (its arguments' soft forms g) passes through
+ * over the box, or -1 (see the head of the file) */
+static int passes(const lb_evaluator *ev, const lb__iv g[2]) {
     for (int a = 0; a < 2; ++a) {
         const lb__iv me = g[a], other = g[1 - a];
         /* the clean union is max = me where the weight is 0 (either
@@ -100,14 +101,12 @@ static int passes(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv
     return -1;
 }
 
-/* Is the link exactly the max of its arguments' soft forms over the box,
- * and the scene's form of that max again (so a chain of such links is one
- * max, whatever their zero_scale)? The clean union's weight is 0 there, and
- * in the soft convention both arguments are >= 0 (no clamp at 0). */
-static int max_link(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
-                    const double bc[3], const double br[3]) {
-    lb__iv g[2];
-    if (!plain_link(ev, in, fa, fb, bc, br, g)) return 0;
+/* Is a plain link (its arguments' soft forms g) exactly the max of them
+ * over the box, and the scene's form of that max again (so a chain of such
+ * links is one max, whatever their zero_scale)? The clean union's weight is
+ * 0 there, and in the soft convention both arguments are >= 0 (no clamp at
+ * 0). */
+static int max_link(const lb_evaluator *ev, const lb__iv g[2]) {
     if (!(g[0].hi <= LB_SOFT_MIN_FIELD || g[1].hi <= LB_SOFT_MIN_FIELD)) return 0;
     return ev->conv == LB_CONVENTION_ZERO || (g[0].lo >= 0.0 && g[1].lo >= 0.0);
 }
@@ -119,9 +118,8 @@ static int max_link(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__
  * group's lower bound is never the maximum anywhere in the box, so the
  * group's value is the same without it (and at ties, which only leaves at
  * the maximum can have, the same leaf is first). */
-static int under_group(const lb_evaluator *ev, const lb__instr *in, lb__iv fa, lb__iv fb,
+static int under_group(const lb_evaluator *ev, const lb__instr *in, const lb__iv g[2],
                        lb__iv root) {
-    const lb__iv g[2] = {soft_iv(in, ev->conv, fa), soft_iv(in, ev->conv, fb)};
     const lb__iv top = soft_iv(in, ev->conv, root);
     if (g[1].hi < top.lo) return 0;
     if (g[0].hi < top.lo) return 1;
@@ -172,34 +170,38 @@ lb_status lb__cone_reduce(const lb_evaluator *ev, const uint32_t *list, size_t n
     }
     /* 2. max groups: a max link whose one reader is a max link belongs to
      * its reader's group; grp[q] is the group's top link (backwards, so a
-     * reader is placed before its sources). need[] holds "max link" and
-     * reg[] the readers' count meanwhile. */
+     * reader is placed before its sources). need[] holds LINK_* and reg[]
+     * the readers' count meanwhile. */
     for (size_t q = 0; q < n; ++q) S->reg[q] = 0;
     for (size_t q = 0; q < n; ++q) {
         const lb__instr *in = &ev->ins[list ? list[q] : q];
         const size_t ns = nsrc_of(in);
         for (size_t a = 0; a < ns; ++a) ++S->reg[S->srcq[S->last[q] + a]];
-        S->need[q] = ns == 2 && max_link(ev, in, S->ivq[S->srcq[S->last[q]]],
-                                         S->ivq[S->srcq[S->last[q] + 1]], bc, br);
+        lb__iv g[2];
+        S->need[q] = 0;
+        if (ns == 2 && plain_link(ev, in, S->ivq[S->srcq[S->last[q]]],
+                                  S->ivq[S->srcq[S->last[q] + 1]], bc, br, g))
+            S->need[q] = LINK_PLAIN | (max_link(ev, g) ? LINK_MAX : 0);
         S->grp[q] = UINT32_MAX;
     }
     for (size_t q = n; q-- > 0;) {
-        if (!S->need[q]) continue;
+        if (!(S->need[q] & LINK_MAX)) continue;
         if (S->grp[q] == UINT32_MAX) S->grp[q] = (uint32_t)q;
         for (size_t a = 0; a < 2; ++a) {
             const uint32_t p = S->srcq[S->last[q] + a];
-            if (S->need[p] && S->reg[p] == 1) S->grp[p] = S->grp[q];
+            if ((S->need[p] & LINK_MAX) && S->reg[p] == 1) S->grp[p] = S->grp[q];
         }
     }
     /* 3. pass-through: alias[q] is the list position whose value q takes */
     for (size_t q = 0; q < n; ++q) {
-        const lb__instr *in = &ev->ins[list ? list[q] : q];
         S->alias[q] = (uint32_t)q;
-        if (nsrc_of(in) != 2) continue;
+        if (!(S->need[q] & LINK_PLAIN)) continue;
+        const lb__instr *in = &ev->ins[list ? list[q] : q];
         const uint32_t off = S->last[q];
-        const lb__iv fa = S->ivq[S->srcq[off]], fb = S->ivq[S->srcq[off + 1]];
-        int a = passes(ev, in, fa, fb, bc, br);
-        if (a < 0 && S->need[q]) a = under_group(ev, in, fa, fb, S->ivq[S->grp[q]]);
+        const lb__iv g[2] = {soft_iv(in, ev->conv, S->ivq[S->srcq[off]]),
+                             soft_iv(in, ev->conv, S->ivq[S->srcq[off + 1]])};
+        int a = passes(ev, g);
+        if (a < 0 && (S->need[q] & LINK_MAX)) a = under_group(ev, in, g, S->ivq[S->grp[q]]);
         if (a >= 0) S->alias[q] = S->alias[S->srcq[off + a]];
     }
     if (n) S->root = S->ivq[n - 1];
