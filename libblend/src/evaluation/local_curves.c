@@ -74,9 +74,9 @@ typedef struct child_eval {
     double wcone[2];  /* instruction runs of each child's cone per point */
     double *work;     /* the evaluator's compile cost so far */
     lb__cone fold[2]; /* each child's cone reduced over the box (fc, fr) of the
-                         fold's kept cells, when has_fold */
+                         fold's kept cells (zeroed, so not reduced, until
+                         fold_cones runs) */
     double fc[3], fr[3];
-    int has_fold;
     int gfold[2];                  /* the current group's cone was reduced from fold[] */
     lb__cone grp[2];               /* each child's cone reduced over the current group of chunks */
     lb__cone sub[2];               /* and over the current chunk */
@@ -143,9 +143,7 @@ static lb_status chunk_tape(child_eval *E, int a, int new_group, const double gc
         const lb__cone *F = &E->fold[a];
         /* the group's base: the fold's reduced cone when the group's box
          * lies in the fold's box, else the whole cone */
-        if (new_group)
-            E->gfold[a] =
-                E->has_fold && F->reduced && F->copied && box_inside(gc, gr, E->fc, E->fr);
+        if (new_group) E->gfold[a] = F->reduced && F->copied && box_inside(gc, gr, E->fc, E->fr);
         const lb_evaluator *bev = E->gfold[a] ? &F->ev : E->ev;
         const uint32_t *blist = E->gfold[a] ? NULL : cone;
         const size_t bn = E->gfold[a] ? F->ev.n : in->ncone[a];
@@ -542,7 +540,6 @@ static lb_status fold_cones(child_eval *E, const grid *G, const cellset *S) {
                                  E->fr, &E->fold[a], E->err);
         if (st) return st;
     }
-    E->has_fold = 1;
     return LB_OK;
 }
 
