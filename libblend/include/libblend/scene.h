@@ -20,6 +20,7 @@
 #define LIBBLEND_SCENE_H
 
 #include "common.h"
+#include "operators.h" /* LB_MAX_ARITY_WIDE */
 
 #ifdef __cplusplus
 extern "C" {
@@ -37,9 +38,9 @@ extern "C" {
 #define LB_SCENE_MAX_JSON_ARRAYS (8 * LB_SCENE_MAX_NODES + 64)
 #define LB_SCENE_MAX_JSON_VALUES (40 * LB_SCENE_MAX_NODES + 1024)
 /* Elements of one JSON array, checked the same way: 4 times the longest
- * list a scene holds (an operator's 65535 arguments, or its r, p, m lists),
- * so a list a little too long still gets the node's own message. */
-#define LB_SCENE_MAX_JSON_ARRAY (4 * 65535)
+ * list a scene holds (an operator's arguments, or its r, p, m lists), so a
+ * list a little too long still gets the node's own message. */
+#define LB_SCENE_MAX_JSON_ARRAY (4 * LB_MAX_ARITY_WIDE)
 #define LB_SCENE_MAX_LIGHTS 16
 /* Bulge-eliminated blends nested inside each other's arguments: each level
  * re-evaluates its arguments 4 times for the Hessian terms of its gradient. */
