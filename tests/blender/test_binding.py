@@ -157,7 +157,11 @@ with lib.load_scene(fig7) as sc, sc.compile() as ev7:
     check('#include "libblend.inc"' in text and "isosurface" in text, "a POV-Ray scene")
     inc_only = os.path.join(WORK, "fig7-functions.inc")
     sc.write_pov(ev7, inc_only, include_only=True)
-    check("isosurface" not in open(inc_only).read(), "include only")
+    inc_text = open(inc_only).read()
+    check("\nisosurface {" not in inc_text and "\ncamera {" not in inc_text
+          and "#declare LB_Surface = LB_Field;" in inc_text
+          and "#declare LB_FieldMaxGradient = " in inc_text,
+          "include only: the field and what a hand-written scene needs, no object or camera")
 
 # ---- errors
 raises(lambda: lib.parse_scene('{"format": "libblend-scene",\n "version": 1, }', "a.json"),

@@ -37,7 +37,10 @@ extern "C" {
 #define LB_POV_GRADIENT_SAFETY 1.25
 
 typedef struct lb_pov_options {
-    int include_only;    /* 1: only the #declare'd functions (the root is LB_Field) */
+    int include_only;    /* 1: only the #declare'd functions: the root is LB_Field, and
+                            LB_Surface (< 0 inside), LB_FieldMin, LB_FieldMax,
+                            LB_FieldMaxGradient, LB_FieldAccuracy are declared for a
+                            hand-written scene */
     int silhouette;      /* 1: white object, black background, no shading (for comparisons) */
     double aspect;       /* image width / height for the camera (0: 4/3) */
     double max_gradient; /* > 0: use this instead of computing it */

@@ -179,6 +179,123 @@ static lb_status max_gradient(const lb_evaluator *ev, const double lo[3], const 
     return s;
 }
 
+/* The camera, lights, floor, textures and the isosurface of a whole scene
+ * after the field's declarations (c->b holds them); g is max_gradient. */
+static lb_status whole_scene(pctx *c, const lb_pov_options *opt, double g, double diag) {
+    const lb_pov_options o = *opt;
+    const lb_scene *scene = c->sc;
+    const lb_evaluator *ev = c->ev;
+    const double *lo = scene->bmin, *hi = scene->bmax;
+    sbuf *b = c->b;
+    const lb_render *R = &scene->render;
+    const double aspect = o.aspect > 0.0 ? o.aspect : 4.0 / 3.0;
+    double loc[3], at[3], up[3], angle;
+    lb_pov_camera(scene, aspect, loc, at, up, &angle);
+    /* the camera's distance to its target (the key light's size) */
+    const double F[3] = {at[0] - loc[0], at[1] - loc[1], at[2] - loc[2]};
+    const double L = sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+    const double *bg = R->background;
+    /* POV-Ray is left-handed: a negated right vector makes the image the
+     * right-handed view; sky is the scene's up (the look_at keeps both) */
+    sb(b,
+       "\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb <%.17g, %.17g, %.17g> }\n"
+       "camera { perspective location <%.17g, %.17g, %.17g> sky <%.17g, %.17g, %.17g> up y "
+       "right -x * %.17g angle %.17g look_at <%.17g, %.17g, %.17g> }\n",
+       o.silhouette ? 0.0 : bg[0], o.silhouette ? 0.0 : bg[1], o.silhouette ? 0.0 : bg[2], loc[0],
+       loc[1], loc[2], up[0], up[1], up[2], aspect, angle, at[0], at[1], at[2]);
+    if (o.silhouette) {
+        /* no lights: the object is its ambient white */
+    } else if (R->light_count) {
+        for (size_t i = 0; i < R->light_count; ++i)
+            sb(b, "light_source { <%.17g, %.17g, %.17g> rgb <%.17g, %.17g, %.17g> }\n",
+               R->lights[i].location[0], R->lights[i].location[1], R->lights[i].location[2],
+               R->lights[i].color[0], R->lights[i].color[1], R->lights[i].color[2]);
+    } else {
+        /* three-point lighting around the camera: a key light above and
+         * to the left with soft shadows, a dim fill from the right and a
+         * rim light from behind, both without shadows. The key's area
+         * light is 3 x 3, not adaptive: every shadow sample is an
+         * isosurface intersection, and a soft-object scene took 7x a
+         * hard shadow's time at 5 x 5 adaptive (4x at 3 x 3). */
+        lb_render_light key[3];
+        lb_render_three_point(loc, at, up, key);
+        for (int k = 0; k < 3; ++k) {
+            const double *X = key[k].location;
+            if (k == 0)
+                sb(b,
+                   "light_source { <%.17g, %.17g, %.17g> rgb %.17g area_light <%.17g, 0, 0>, "
+                   "<0, %.17g, 0>, 3, 3 adaptive 0 jitter circular orient }\n",
+                   X[0], X[1], X[2], key[k].color[0], 0.2 * L, 0.2 * L);
+            else
+                sb(b, "light_source { <%.17g, %.17g, %.17g> rgb %.17g shadowless }\n", X[0], X[1],
+                   X[2], key[k].color[0]);
+        }
+    }
+    if (R->floor && !o.silhouette) {
+        double h = 0.0;
+        lb_render_floor_height(ev, scene->bmin, scene->bmax, up, o.threads, &h, NULL);
+        sb(b,
+           "plane { <%.17g, %.17g, %.17g>, %.17g pigment { rgb <%.17g, %.17g, %.17g> } "
+           "finish { ambient 0.15 diffuse 0.75 } }\n",
+           up[0], up[1], up[2], h, R->floor_color[0], R->floor_color[1], R->floor_color[2]);
+    }
+    const int soft = scene->convention == LB_CONVENTION_SOFT;
+    char texname[24] = "";
+    if (!o.silhouette && lb_scene_material_count(scene) > 1) {
+        sb(b, "\n");
+        for (size_t i = 0; i < lb_scene_material_count(scene); ++i) {
+            lb_material m;
+            lb_scene_material(scene, i, &m);
+            sb(b, "#declare LBmat%zu = ", i);
+            lb__pov_material_texture(b, &m);
+            sb(b, "\n");
+        }
+        lb__affine id;
+        lb__affine_identity(&id);
+        const lb_status s = lb__pov_texture(c, scene->root, &id, 0, texname);
+        if (s) return s;
+    }
+    sb(b,
+       "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
+       "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
+       "  max_gradient %.17g\n  accuracy %.17g\n  ",
+       soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
+       1e-4 * diag);
+    if (texname[0]) {
+        sb(b, "texture { %s }", texname);
+    } else {
+        /* one material (the silhouette: its ambient white) */
+        const lb_material white = {{1.0, 1.0, 1.0}, 1.0, 0.0, 0.0};
+        lb_material m0;
+        lb_scene_material(scene, 0, &m0);
+        lb__pov_material_texture(b, o.silhouette ? &white : &m0);
+    }
+    sb(b, "\n}\n");
+    return LB_OK;
+}
+
+/* What a hand-written scene needs beside LB_Field (include_only): the
+ * surface as a function negative inside, the box, a max_gradient and an
+ * accuracy, under fixed names (povray_include/README.md, "Your own scene
+ * around a libblend field"). */
+static void include_tail(sbuf *b, const lb_scene *scene, double g, double diag) {
+    const int soft = scene->convention == LB_CONVENTION_SOFT;
+    const double *lo = scene->bmin, *hi = scene->bmax;
+    sb(b,
+       "\n// For your own scene: LB_Surface is < 0 inside, 0 on the surface; use it as\n"
+       "// isosurface { function { LB_Surface(x, y, z) } threshold 0\n"
+       "//   contained_by { box { LB_FieldMin, LB_FieldMax } } max_gradient LB_FieldMaxGradient\n"
+       "//   accuracy LB_FieldAccuracy texture { ... } }\n");
+    if (soft)
+        sb(b, "#declare LB_Surface = function(x, y, z) { 0.5 - LB_Field(x, y, z) }\n");
+    else
+        sb(b, "#declare LB_Surface = LB_Field;\n");
+    sb(b,
+       "#declare LB_FieldMin = <%.17g, %.17g, %.17g>;\n#declare LB_FieldMax = <%.17g, %.17g, "
+       "%.17g>;\n#declare LB_FieldMaxGradient = %.17g;\n#declare LB_FieldAccuracy = %.17g;\n",
+       lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g, 1e-4 * diag);
+}
+
 /* The whole .pov text into b (freed by the caller). */
 static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const lb_pov_options *opt,
                           sbuf *out, double *out_gradient, lb_error *err) {
@@ -208,93 +325,10 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
         sb(&b, "#declare LB_Field = LBn%d;\n", root);
         if (!(g > 0.0)) s = max_gradient(ev, lo, hi, o.threads, &g, err);
     }
-    if (!s && !o.include_only) {
-        const lb_render *R = &scene->render;
-        const double aspect = o.aspect > 0.0 ? o.aspect : 4.0 / 3.0;
-        double loc[3], at[3], up[3], angle;
-        lb_pov_camera(scene, aspect, loc, at, up, &angle);
-        /* the camera's distance to its target (the key light's size) */
-        const double F[3] = {at[0] - loc[0], at[1] - loc[1], at[2] - loc[2]};
-        const double L = sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
-        const double *bg = R->background;
-        /* POV-Ray is left-handed: a negated right vector makes the image the
-         * right-handed view; sky is the scene's up (the look_at keeps both) */
-        sb(&b,
-           "\nglobal_settings { assumed_gamma 1.0 }\nbackground { rgb <%.17g, %.17g, %.17g> }\n"
-           "camera { perspective location <%.17g, %.17g, %.17g> sky <%.17g, %.17g, %.17g> up y "
-           "right -x * %.17g angle %.17g look_at <%.17g, %.17g, %.17g> }\n",
-           o.silhouette ? 0.0 : bg[0], o.silhouette ? 0.0 : bg[1], o.silhouette ? 0.0 : bg[2],
-           loc[0], loc[1], loc[2], up[0], up[1], up[2], aspect, angle, at[0], at[1], at[2]);
-        if (o.silhouette) {
-            /* no lights: the object is its ambient white */
-        } else if (R->light_count) {
-            for (size_t i = 0; i < R->light_count; ++i)
-                sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb <%.17g, %.17g, %.17g> }\n",
-                   R->lights[i].location[0], R->lights[i].location[1], R->lights[i].location[2],
-                   R->lights[i].color[0], R->lights[i].color[1], R->lights[i].color[2]);
-        } else {
-            /* three-point lighting around the camera: a key light above and
-             * to the left with soft shadows, a dim fill from the right and a
-             * rim light from behind, both without shadows. The key's area
-             * light is 3 x 3, not adaptive: every shadow sample is an
-             * isosurface intersection, and a soft-object scene took 7x a
-             * hard shadow's time at 5 x 5 adaptive (4x at 3 x 3). */
-            lb_render_light key[3];
-            lb_render_three_point(loc, at, up, key);
-            for (int k = 0; k < 3; ++k) {
-                const double *X = key[k].location;
-                if (k == 0)
-                    sb(&b,
-                       "light_source { <%.17g, %.17g, %.17g> rgb %.17g area_light <%.17g, 0, 0>, "
-                       "<0, %.17g, 0>, 3, 3 adaptive 0 jitter circular orient }\n",
-                       X[0], X[1], X[2], key[k].color[0], 0.2 * L, 0.2 * L);
-                else
-                    sb(&b, "light_source { <%.17g, %.17g, %.17g> rgb %.17g shadowless }\n", X[0],
-                       X[1], X[2], key[k].color[0]);
-            }
-        }
-        if (R->floor && !o.silhouette) {
-            double h = 0.0;
-            lb_render_floor_height(ev, scene->bmin, scene->bmax, up, o.threads, &h, NULL);
-            sb(&b,
-               "plane { <%.17g, %.17g, %.17g>, %.17g pigment { rgb <%.17g, %.17g, %.17g> } "
-               "finish { ambient 0.15 diffuse 0.75 } }\n",
-               up[0], up[1], up[2], h, R->floor_color[0], R->floor_color[1], R->floor_color[2]);
-        }
-        const int soft = scene->convention == LB_CONVENTION_SOFT;
-        char texname[24] = "";
-        if (!o.silhouette && lb_scene_material_count(scene) > 1) {
-            sb(&b, "\n");
-            for (size_t i = 0; i < lb_scene_material_count(scene); ++i) {
-                lb_material m;
-                lb_scene_material(scene, i, &m);
-                sb(&b, "#declare LBmat%zu = ", i);
-                lb__pov_material_texture(&b, &m);
-                sb(&b, "\n");
-            }
-            lb__affine id;
-            lb__affine_identity(&id);
-            s = lb__pov_texture(&c, scene->root, &id, 0, texname);
-        }
-        if (s) goto out;
-        sb(&b,
-           "isosurface {\n  function { %sLB_Field(x, y, z) }\n  threshold %s\n"
-           "  contained_by { box { <%.17g, %.17g, %.17g>, <%.17g, %.17g, %.17g> } }\n"
-           "  max_gradient %.17g\n  accuracy %.17g\n  ",
-           soft ? "-" : "", soft ? "-0.5" : "0", lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g,
-           1e-4 * diag);
-        if (texname[0]) {
-            sb(&b, "texture { %s }", texname);
-        } else {
-            /* one material (the silhouette: its ambient white) */
-            const lb_material white = {{1.0, 1.0, 1.0}, 1.0, 0.0, 0.0};
-            lb_material m0;
-            lb_scene_material(scene, 0, &m0);
-            lb__pov_material_texture(&b, o.silhouette ? &white : &m0);
-        }
-        sb(&b, "\n}\n");
-    }
-out:
+    if (!s && o.include_only)
+        include_tail(&b, scene, g, diag);
+    else if (!s)
+        s = whole_scene(&c, &o, g, diag);
     free(c.done);
     free(c.ids);
     free(c.doneA);
