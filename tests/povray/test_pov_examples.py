@@ -49,7 +49,8 @@ for path in scenes:
     name = os.path.basename(path)[:-4]
     out = os.path.join(WORK, name + ".ppm")
     r = subprocess.run(["povray", "+I" + path, "+O" + out, "+FP", "+W96", "+H72", "-D", "-V",
-                        "+L" + INC], capture_output=True, text=True, cwd=WORK)
+                        "+L" + INC, "+L" + os.path.join(INC, "examples")],
+                       capture_output=True, text=True, cwd=WORK)
     log = " ".join((r.stdout + r.stderr).split())
     problems = []
     if r.returncode != 0 or not os.path.exists(out):
