@@ -87,7 +87,11 @@ def children(obj, role="ARG", depsgraph=None):
 #: operators whose result no later blend's values can see through: a sharp
 #: min / max (or a complement) of values keeps each argument's zero set
 #: whatever the scale of its values, so m below them changes nothing
-VALUE_BLIND = ("min", "max", "complement")
+# blends whose surface depends only on where their arguments are inside, not
+# on their values (the registry's "uses_argument_values": false; the C
+# library's lb_scene_unused_m asks the same question; tests/schema/
+# test_registry.py holds this list to the registry)
+VALUE_BLIND = ("min", "max", "complement", "rfunction", "clean_union")
 
 
 def m_has_effect(blend):

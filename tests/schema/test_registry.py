@@ -14,7 +14,8 @@ with it:
   convention as the registry splits them) and the r / p / m / n property
   limits inside the registry's ranges; tree.py's keys per blend (only keys
   the node takes, the required parameters written, "op" as the row's set
-  operations allow);
+  operations allow), and its VALUE_BLIND (the blends that use only their
+  arguments' zero sets, where an m below has no effect);
 - the fuzz dictionary (tests/fuzz/scene.dict): every type and key;
 - the human form of `info --families` names every type.
 Fails with one line per disagreement.
@@ -253,6 +254,13 @@ for o in ops_rows:
     if got_op != ([want_op] if want_op else []):
         fail("tree.py: %s set operation setting %s, registry ops %s" % (o["type"], got_op,
                                                                         o["ops"]))
+
+blind = sorted(o["type"] for o in ops_rows if not o["uses_argument_values"])
+if sorted(tree_lists["VALUE_BLIND"]) != blind:
+    fail("tree.py: VALUE_BLIND %s; registry (uses_argument_values false) %s" %
+         (sorted(tree_lists["VALUE_BLIND"]), blind))
+if blind != ["clean_union", "complement", "max", "min", "rfunction"]:
+    fail("registry: the operators that use only their arguments' zero sets are %s" % blind)
 
 # ---- the fuzz dictionary ----
 words = set()

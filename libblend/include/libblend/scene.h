@@ -168,6 +168,23 @@ LB_API lb_status lb_scene_material_index(const lb_scene *scene, const lb_evaluat
                                          const double *x, const double *y, const double *z,
                                          uint32_t *index, lb_error *err);
 
+/* ---- the subsequent-blend parameter m (docs/operators.md, section 4) ------
+ * A blend's m never moves its own surface: away from its blending region it
+ * divides the blend's values by m, which changes a surface only through an
+ * operator above the blend that uses values (a blend, a level, a local
+ * union). min, max, complement, transforms, R-functions and clean unions
+ * depend only on where their arguments are inside, and pass this on. */
+
+/* The nodes that set an m other than 1 that can change nothing: no path
+ * from the root reaches them through a value-using operator. There m only
+ * steepens the field (by up to 1 / m where m < 1: a POV-Ray max_gradient
+ * must grow with it, and the render slows). Writes the JSON paths of the
+ * first max of them, in scene order, into paths (caller-owned; the strings
+ * belong to the scene and live as long as it; paths may be NULL to count)
+ * and returns how many there are. Linear in the scene's size; returns 0 for
+ * NULL and when memory is short (it only informs). */
+LB_API size_t lb_scene_unused_m(const lb_scene *scene, const char **paths, size_t max);
+
 /* Write the tree as indented text (one node per line, shared defs printed
  * once and referenced by name afterwards) into buf, NUL-terminated and
  * truncated to size. Returns the length the whole text needs (without the

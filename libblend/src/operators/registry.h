@@ -88,7 +88,12 @@ enum {
     LB__R_POV16 = 4u,        /* the POV-Ray macro takes at most LB_POV_MAX_ARITY arguments */
     LB__R_NO_PARSE = 8u,     /* made by the parser, never named in a scene (a transformed ref) */
     LB__R_FOLD_BINARY = 16u, /* k > 2 is folded into nested binary nodes by the parser */
-    LB__R_CLEAN_UNION = 32u  /* built on the clean union UC: bounded by evaluation/local_bounds.c */
+    LB__R_CLEAN_UNION = 32u, /* built on the clean union UC: bounded by evaluation/local_bounds.c */
+    /* its surface depends only on where its arguments are inside, never on
+     * their values away from their surfaces (min, max, complement, a
+     * transform, R-functions, the clean union): a subsequent-blend m below
+     * it acts only through a value-using operator above it */
+    LB__R_ZERO_SETS_ONLY = 64u
 };
 
 /* A per-argument parameter ("r", "p", "m"): a number for every argument

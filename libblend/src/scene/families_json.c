@@ -90,6 +90,7 @@ static cJSON *operator_json(const lb__family_row *row) {
     cJSON_AddBoolToObject(o, "bulge", row->bulge_family >= 0);
     cJSON_AddBoolToObject(o, "bounding_solids", (row->flags & LB__R_BOUNDING) != 0);
     cJSON_AddBoolToObject(o, "folds_to_binary", (row->flags & LB__R_FOLD_BINARY) != 0);
+    cJSON_AddBoolToObject(o, "uses_argument_values", !(row->flags & LB__R_ZERO_SETS_ONLY));
     cJSON_AddNumberToObject(o, "pov_max_args",
                             row->flags & LB__R_POV16 ? LB_POV_MAX_ARITY : LB_MAX_ARITY);
     cJSON *pov = cJSON_AddArrayToObject(o, "pov_macros");
