@@ -132,6 +132,10 @@ int bt_fail(const char *cmd, const char *scene_path, lb_status s, const lb_error
 /* Compile a loaded scene into *ev: an exit code, after the message naming
  * scene_path when the scene cannot be compiled (*ev is then NULL). */
 int bt_compile(const char *cmd, const char *scene_path, const lb_scene *sc, lb_evaluator **ev);
+/* Warn on stderr (a warning: the exit status stays 0) about every m that can
+ * change nothing in the scene (lb_scene_unused_m): the first few paths, the
+ * count of the rest, and the fix. Returns how many there are. */
+size_t bt_warn_unused_m(const char *cmd, const char *scene_path, const lb_scene *sc);
 
 /* signals.c: SIGINT / SIGTERM / SIGHUP end the command with 128 + N, after
  * ending the child, removing the registered temporary files and folder. */

@@ -95,6 +95,7 @@ static int export(const char *cmd, const povargs *a, FILE *f, const char *out_na
     int rc = bt_load_scene_set(cmd, a->scene, a->sets, a->nsets, &sc, hash);
     if (rc) return rc;
     lb_evaluator *ev = NULL;
+    bt_warn_unused_m(cmd, a->scene, sc);
     if ((rc = bt_compile(cmd, a->scene, sc, &ev))) {
         lb_scene_free(sc);
         return rc;

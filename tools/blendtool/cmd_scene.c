@@ -39,6 +39,7 @@ static int run_validate(int argc, char **argv) {
             if (rc > worst || worst == 0) worst = rc;
             continue;
         }
+        if (!quiet) bt_warn_unused_m(cmd, argv[i], sc);
         lb_scene_stats st;
         lb_scene_stats_get(sc, &st);
         if (!quiet)

@@ -215,6 +215,23 @@ int bt_compile(const char *cmd, const char *scene_path, const lb_scene *sc, lb_e
     return s ? bt_fail(cmd, scene_path, s, &e) : BT_EXIT_OK;
 }
 
+size_t bt_warn_unused_m(const char *cmd, const char *scene_path, const lb_scene *sc) {
+    enum { SHOWN = 4 };
+    const char *paths[SHOWN];
+    const size_t n = lb_scene_unused_m(sc, paths, SHOWN);
+    for (size_t i = 0; i < n && i < SHOWN; ++i)
+        fprintf(stderr,
+                "blendtool %s: warning: %s: %s sets m other than 1, which has no effect there: no "
+                "operator above it uses its values (min, max, complement, R-functions and clean "
+                "unions do not), so m changes nothing in the surface and only steepens the "
+                "field. Fix: leave m at 1, or blend this node with something\n",
+                cmd, scene_path, paths[i]);
+    if (n > SHOWN)
+        fprintf(stderr, "blendtool %s: warning: %s: and %zu more nodes like it\n", cmd, scene_path,
+                n - SHOWN);
+    return n;
+}
+
 int bt_wants_help(int argc, char **argv) {
     for (int i = 1; i < argc; ++i)
         if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) return 1;

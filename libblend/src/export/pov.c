@@ -43,6 +43,23 @@ void lb__pov_comment(sbuf *b, const char *label, const char *text) {
     sb(b, "\n");
 }
 
+/* A #warning for each m that can change nothing (lb_scene_unused_m), so a
+ * POV-Ray user who renders the file later sees it too; the path is printed
+ * with only the characters a POV-Ray string takes as they are. */
+static void unused_m_warnings(sbuf *b, const lb_scene *scene) {
+    enum { SHOWN = 4 };
+    const char *paths[SHOWN];
+    const size_t n = lb_scene_unused_m(scene, paths, SHOWN);
+    for (size_t i = 0; i < n && i < SHOWN; ++i) {
+        sb(b, "#warning \"libblend: m at ");
+        for (const char *c = paths[i]; *c && b->n < ((size_t)1 << 30); ++c)
+            sb(b, "%c", *c >= 32 && *c < 127 && *c != '"' && *c != '\\' ? *c : '?');
+        sb(b, " has no effect (no blend above uses its values); it only steepens the field. "
+              "Fix: m = 1\"\n");
+    }
+    if (n > SHOWN) sb(b, "#warning \"libblend: and %zu more nodes like it\"\n", n - SHOWN);
+}
+
 void lb__pov_array(sbuf *b, size_t k, const double *v, double fallback) {
     sb(b, "array[%zu] {", k);
     for (size_t i = 0; i < k; ++i) sb(b, "%s%.17g", i ? ", " : "", v ? v[i] : fallback);
@@ -317,7 +334,9 @@ static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const l
     sb(&b, "// written by libblend %d.%d.%d (blendtool pov)\n", LB_VERSION_MAJOR, LB_VERSION_MINOR,
        LB_VERSION_PATCH);
     lb__pov_comment(&b, "scene", scene->name);
-    sb(&b, "#version 3.7;\n#include \"libblend.inc\"\n\n");
+    sb(&b, "#version 3.7;\n#include \"libblend.inc\"\n");
+    unused_m_warnings(&b, scene);
+    sb(&b, "\n");
     int root = 0;
     lb_status s = lb__pov_emit(&c, scene->root, &root);
     double g = o.max_gradient;
