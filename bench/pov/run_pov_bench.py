@@ -3,12 +3,17 @@
 
 For hsu2006 Fig. 7 (m2 = 0.6) and S1 (three spheres), 640 x 480: the scene as
 blendtool pov writes it (root-solved k-ary blends), the same primitives with a
-plain min()/max() (no blend), and with a hand-written polynomial smooth-min.
+plain min()/max() (no blend), and with a hand-written polynomial smooth-min;
+for S1 also POV-Ray's native `blob` of three sphere components whose blend
+reaches as far as libblend's (range 0.25: each component's radius 1.25,
+strength 1, threshold (1 - 0.8^2)^2 = 0.1296, so that a lone component's
+surface is the unit sphere), in place of the isosurface.
 Times are povray's user CPU seconds (robust on a shared machine); the ratio is
 against the plain min() render of the same scene, in the same run. Also the
 max_gradient libblend computed against the largest gradient POV-Ray reports.
 
-usage: run_pov_bench.py BLENDTOOL SOURCE_DIR WORK_DIR
+usage: run_pov_bench.py BLENDTOOL SOURCE_DIR WORK_DIR [SCENE...]
+(SCENE: a file name of VARIANTS' keys; default all)
 """
 import os
 import re
@@ -17,6 +22,7 @@ import subprocess
 import sys
 
 bt, src, work = sys.argv[1:4]
+only = sys.argv[4:]
 os.makedirs(work, exist_ok=True)
 inc = os.path.join(src, "povray_include")
 
@@ -33,6 +39,19 @@ VARIANTS = {
         "smooth-min": "LBsmin(LBsmin(P0(x,y,z), P1(x,y,z), 0.25), P2(x,y,z), 0.25)",
     },
 }
+BLOB_RADIUS, BLOB_THRESHOLD = 1.25, (1 - 0.8 ** 2) ** 2
+
+
+def blob_variant(text):
+    """the exported scene with its isosurface replaced by a native blob of
+    the unit spheres' centres (S1's primitives are unit ellipsoids)"""
+    centres = re.findall(r"LB_Ellipsoid\(<([^>]*)>, <1, 1, 1>\)", text)
+    tex = re.search(r"  (texture \{.*\})\n\}\n$", text).group(1)
+    comps = "".join("  sphere { <%s>, %g, 1 }\n" % (c, BLOB_RADIUS) for c in centres)
+    blob = "blob {\n  threshold %.6g\n%s  %s\n}\n" % (BLOB_THRESHOLD, comps, tex)
+    return text[:text.index("isosurface {")] + blob
+
+
 SMIN = ("#declare LBsmin = function(a, b, k) { min(a, b) - pow(max(k - abs(a - b), 0), 2) / "
         "(4 * k) }\n")
 
@@ -52,6 +71,8 @@ def render(pov):
 print("| scene | field | povray CPU s | vs plain min | max_gradient set | found by POV-Ray |")
 print("|---|---|---|---|---|---|")
 for scene, variants in VARIANTS.items():
+    if only and scene not in only:
+        continue
     base = os.path.join(work, scene.replace(".json", ".pov"))
     subprocess.run([bt, "pov", os.path.join(src, "scenes", scene), "-o", base], check=True)
     text = open(base).read()
@@ -68,6 +89,10 @@ for scene, variants in VARIANTS.items():
         path = base[:-4] + "-" + name.replace(" ", "-") + ".pov"
         open(path, "w").write(t)
         results.append((name, render(path)))
+    if scene.startswith("bench-s1"):
+        path = base[:-4] + "-blob.pov"
+        open(path, "w").write(blob_variant(text))
+        results.append(("POV-Ray blob", render(path)))
     plain = dict(results)["plain min"][0]
     for name, (cpu, found) in results:
         print("| %s | %s | %.2f | %.2f | %s | %s |" % (
