@@ -259,6 +259,38 @@ LB_API lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const doubl
 LB_API lb_status lb_evaluator_bounds(const lb_evaluator *ev, const double bmin[3],
                                      const double bmax[3], double *lo, double *hi, lb_error *err);
 
+/* ---- the solid's extent (evaluation/extent.c) ---- */
+enum {
+    LB_EXTENT_EMPTY = 1,   /* no part of the solid in the search box */
+    LB_EXTENT_TOUCHES = 2, /* it may reach a face of the search box: unbounded (a slab, a
+                              half-space, a complement) or the search box is too small */
+    LB_EXTENT_COARSE = 4   /* the pass cap was reached: sound, but looser than tol */
+};
+/* Interval passes one extent query makes at most (a sixth per face); then
+ * it stops refining. */
+#define LB_EXTENT_MAX_BOXES 200000
+
+/* A box [out_min, out_max] that contains every point of the solid (f < 0;
+ * soft convention: f > 0.5) inside the search box [smin, smax], found by
+ * interval bounds alone (no sampling can miss a thin part): boxes the
+ * bounds cannot prove outside, refined until at most tol across (the
+ * result is at most about tol larger than the solid's own box on each side,
+ * more where the bounds are loose, never smaller). *flags receives
+ * LB_EXTENT_* bits; with LB_EXTENT_EMPTY the box is smin..smin; with
+ * LB_EXTENT_TOUCHES the sides not refined when the touch was found are the
+ * search box's. tol > 0 and
+ * at least 1e-12 of the search box's longest side; search box finite with
+ * min < max and |coordinate| <= LB_SCENE_MAX_COORD. Cost: a few passes per
+ * level where the solid's extreme on a side is a point; where it is a
+ * ridge or a flat face, about (size / tol)^1.5 or (size / tol)^2 passes, so
+ * choose tol as coarse as the use allows; at most LB_EXTENT_MAX_BOXES
+ * interval passes (each the cost of one lb_evaluator_bounds); runs on the
+ * calling thread. Used by the Blender add-on to fit a field's region to the
+ * field (tol: about a mesh cell). */
+LB_API lb_status lb_evaluator_extent(const lb_evaluator *ev, const double smin[3],
+                                     const double smax[3], double tol, double out_min[3],
+                                     double out_max[3], int *flags, lb_error *err);
+
 #ifdef __cplusplus
 }
 #endif
