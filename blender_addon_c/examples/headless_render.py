@@ -23,6 +23,10 @@ import sys
 
 import bpy
 
+# the add-on's package: libblend_blender (the 3.x zip) or bl_ext.<repository>.libblend (4.2+)
+lbb = next(m for n, m in list(sys.modules.items())
+           if n.endswith(("libblend_blender", ".libblend")) and hasattr(m, "live"))
+
 out_dir = os.path.abspath(sys.argv[sys.argv.index("--") + 1] if "--" in sys.argv else "out")
 os.makedirs(out_dir, exist_ok=True)
 scene = bpy.context.scene
@@ -39,6 +43,8 @@ bpy.ops.libblend.add_field(convention="zero", with_sphere=False)
 field = active()
 field.name = "field"
 s = field.libblend
+# Fit Region is on for a new field: the region follows the spheres; the box
+# below is only where it looks for them (and the region when it is off)
 s.bounds_min, s.bounds_max = (-1.6, -1.3, -1.3), (2.9, 1.3, 1.3)
 s.preview_resolution, s.render_resolution = 32, 64
 bpy.ops.libblend.add_blend(blend_type="displacement", op="union")
@@ -90,8 +96,12 @@ for frame in (1, 3):
 bpy.app.handlers.render_post.remove(rendered)
 summary["triangles after the render (viewport mesh)"] = len(field.data.polygons)
 
-# the scene of frame 3, for blendtool (mesh, pov, batch jobs)
+# the scene of frame 3, for blendtool (mesh, pov, batch jobs). A new field
+# fits its region to itself (Fit Region): the export's bounds are that
+# region, and the grid's cell (as `blendtool mesh --cell-size`) is the fifth
+# value of scene_text
 bpy.ops.libblend.export_scene(filepath=os.path.join(out_dir, "frame_0003.json"))
+summary["frame 3 cell (render)"] = lbb.live.scene_text(field)[4]
 
 # bake: saved first (the cache goes next to the .blend), then every frame
 bpy.ops.wm.save_as_mainfile(filepath=os.path.join(out_dir, "example.blend"))

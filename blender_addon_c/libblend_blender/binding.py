@@ -100,6 +100,9 @@ _D = ctypes.POINTER(ctypes.c_double)
 _ERR = ctypes.POINTER(_Error)
 _U32 = ctypes.POINTER(ctypes.c_uint32)
 
+# lb_evaluator_extent's flags
+EXTENT_EMPTY, EXTENT_TOUCHES, EXTENT_COARSE = 1, 2, 4
+
 # name: (restype, argtypes)
 _SIGNATURES = {
     "lb_version": (ctypes.c_int, []),
@@ -121,6 +124,8 @@ _SIGNATURES = {
     "lb_evaluator_eval": (ctypes.c_int, [_P, ctypes.c_size_t, _D, _D, _D, _D, _D, _D, _D,
                                          ctypes.c_int, _ERR]),
     "lb_evaluator_bounds": (ctypes.c_int, [_P, _D, _D, _D, _D, _ERR]),
+    "lb_evaluator_extent": (ctypes.c_int, [_P, _D, _D, ctypes.c_double, _D, _D,
+                                           ctypes.POINTER(ctypes.c_int), _ERR]),
     "lb_mesh_options_init": (None, [ctypes.POINTER(_MeshOptions)]),
     "lb_mesh_create": (ctypes.c_int, [_P, ctypes.POINTER(_MeshOptions),
                                       ctypes.POINTER(ctypes.POINTER(_Mesh)), _ERR]),
@@ -418,6 +423,20 @@ class Evaluator(_Handle):
                                              ctypes.byref(err))
         self.lib._check(st, err, "bounds")
         return lo.value, hi.value
+
+    def extent(self, smin, smax, tol):
+        """((x, y, z), (x, y, z), flags): a box holding every part of the solid
+        inside the search box [smin, smax], from interval bounds, to about tol;
+        flags are EXTENT_EMPTY, EXTENT_TOUCHES (it may reach the search box:
+        unbounded), EXTENT_COARSE (lb_evaluator_extent)."""
+        a = (ctypes.c_double * 3)(*map(float, smin))
+        b = (ctypes.c_double * 3)(*map(float, smax))
+        lo, hi = (ctypes.c_double * 3)(), (ctypes.c_double * 3)()
+        flags, err = ctypes.c_int(0), _Error()
+        st = self.lib._c.lb_evaluator_extent(self.ptr, a, b, float(tol), lo, hi,
+                                             ctypes.byref(flags), ctypes.byref(err))
+        self.lib._check(st, err, "extent")
+        return tuple(lo), tuple(hi), flags.value
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
              max_memory=0, cancel=None, edges=False):

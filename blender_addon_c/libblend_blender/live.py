@@ -21,6 +21,7 @@ library never calls back into Python.
 """
 import hashlib
 import json
+import math
 import os
 import threading
 import time
@@ -36,6 +37,9 @@ SYNC_BELOW = 0.02     # a field whose last run took less is meshed in the timer
 CANCEL_AFTER = 0.2    # a run this old is cancelled when newer edits wait
 NORMALS_IDLE = 0.3    # seconds without edits before analytic normals are set
 AUTO_ANALYTIC = 250000  # "Auto" normals: analytic below this many triangles
+FIT_SEARCH = 64       # Fit Region looks for the solid within this many times the box
+FIT_MARGIN = 0.02     # and grows its extent by this much of its longest side
+FIT_MAX_CELLS = 4     # cells along a fitted side: at most this many times the resolution
 
 _states = {}   # output name -> _State
 _timer_on = False
@@ -53,6 +57,8 @@ class _State:
         self.t_applied = 0.0
         self.applied_key = None  # mesh_key of the mesh in the Blender mesh now
         self.expect = None  # how long the last run took (predicts the next one)
+        self.region = None  # (bmin, bmax) the last mesh was made in (Fit Region: the fitted box)
+        self.clip_warning = ""  # why the surface is cut flat at the region, if it is
 
 
 class _Job:
@@ -60,11 +66,17 @@ class _Job:
     is made (the library included: loading it reads the preferences), so
     run() touches no Blender data and may run on a worker thread."""
 
-    def __init__(self, lib, text, name, bmin, bmax, resolution, open_boundary, threads, paths):
+    def __init__(self, lib, text, name, bmin, bmax, resolution, open_boundary, threads, paths,
+                 fit=False):
         self.lib, self.text, self.name = lib, text, name
         self.bmin, self.bmax, self.resolution = bmin, bmax, resolution
         self.open_boundary, self.threads, self.paths = open_boundary, threads, paths
-        self.key = mesh_key(text, bmin, bmax, resolution, open_boundary)
+        self.fit = fit
+        self.key = mesh_key(text, "fit" if fit else bmin, "fit" if fit else bmax, resolution,
+                            open_boundary)
+        self.cell = 0.0        # Fit Region's cell size (0: not fitted)
+        self.region_note = ""  # why the fit fell back to the box, if it did
+        self.clipped = ""      # the region faces the surface reaches ("+z -x"), if any
         self.cancel = binding.CancelToken()
         self.mesh = None
         self.error = None
@@ -77,10 +89,16 @@ class _Job:
         import numpy as np
         t0 = time.perf_counter()
         try:
-            with self.lib.parse_scene(self.text, self.name) as scene, scene.compile() as ev:
+            text = self.text
+            if self.fit:
+                with self.lib.parse_scene(text, self.name) as scene, scene.compile() as ev:
+                    text = self._fit(ev, text)
+            with self.lib.parse_scene(text, self.name) as scene, scene.compile() as ev:
                 self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
-                                    open_boundary=self.open_boundary, threads=self.threads,
+                                    cell_size=self.cell, open_boundary=self.open_boundary,
+                                    threads=self.threads,
                                     cancel=self.cancel, edges=compat.takes_libblend_edges())
+                self.clipped = clipped_faces(self.mesh.positions, self.bmin, self.bmax)
                 mats = scene.materials()
                 if len(mats) > 1 and len(self.mesh.triangles):
                     # each triangle takes the material at its centroid
@@ -95,6 +113,101 @@ class _Job:
             self.error = "internal error: %r" % (e,)
         self.seconds = time.perf_counter() - t0
         self.done.set()
+
+    def _fit(self, ev, text):
+        # only local unions read the bounds when meshing: other scenes keep
+        # their text (no JSON round trip on a live update)
+        text, self.bmin, self.bmax, self.cell, self.region_note = fit_text(
+            ev, text, self.bmin, self.bmax, self.resolution, rewrite='"local_union"' in text)
+        return text
+
+
+def fit_grid(lo, hi, box_min, box_max, resolution):
+    """Fit Region's grid: (bmin, bmax, cell) covering lo..hi. The cell is the
+    Region box's (its longest side / resolution, as without Fit Region),
+    doubled while the covered box would need more than FIT_MAX_CELLS times
+    resolution cells along a side (a field far larger than the box: the cost
+    stays bounded); the corners are on the box's grid (box_min + whole
+    cells). So where the box held the whole field the mesh is the one the
+    box gives, a part that does not move is meshed the same in every frame
+    while the field around it moves or grows, and `blendtool mesh
+    --cell-size CELL` of the exported scene makes the same grid."""
+    cell = max(max(b - a for a, b in zip(box_min, box_max)), 1e-9) / max(resolution, 1)
+    while max(b - a for a, b in zip(lo, hi)) > FIT_MAX_CELLS * resolution * cell:
+        cell *= 2.0
+    bmin = tuple(o + math.floor((x - o) / cell) * cell for x, o in zip(lo, box_min))
+    bmax = tuple(o + math.ceil((x - o) / cell) * cell for x, o in zip(hi, box_min))
+    return bmin, bmax, cell
+
+
+def fit_text(ev, text, bmin, bmax, resolution, rewrite=True):
+    """Fit Region: (text, bmin, bmax, cell, note). The solid's extent
+    (searched within FIT_SEARCH times the box bmin..bmax around its centre)
+    grown by FIT_MARGIN of its longest side, on fit_grid's grid, and the
+    scene text with those bounds (local unions look for their curves inside
+    the bounds); with rewrite=False the
+    text is returned as it came. When the solid is unbounded or not found:
+    the box as it was, cell 0 (mesh by resolution) and a note saying why."""
+    c = [(a + b) / 2 for a, b in zip(bmin, bmax)]
+    box = max(max(b - a for a, b in zip(bmin, bmax)), 2e-3)
+    h = FIT_SEARCH * box / 2
+    smin, smax = [x - h for x in c], [x + h for x in c]
+    # to about a cell (the grid snaps to cells anyway; a finer tol costs
+    # (size / tol)^2 interval passes along a flat side)
+    lo, hi, flags = ev.extent(smin, smax, box / min(max(resolution, 1), 128))
+    if flags & binding.EXTENT_EMPTY:
+        return text, tuple(bmin), tuple(bmax), 0.0, (
+            "no surface within %g of the region's centre: meshed in the region box" % h)
+    if flags & binding.EXTENT_TOUCHES:
+        return text, tuple(bmin), tuple(bmax), 0.0, (
+            "the field is unbounded (a slab, a half-space or a complement reaches out of any "
+            "box): meshed in the region box")
+    if flags & binding.EXTENT_COARSE:
+        return text, tuple(bmin), tuple(bmax), 0.0, (
+            "the field's extent needed more work than Fit Region allows: meshed in the region "
+            "box")
+    m = max(FIT_MARGIN * max(b - a for a, b in zip(lo, hi)), 1e-6)
+    bmin, bmax, cell = fit_grid([x - m for x in lo], [x + m for x in hi], bmin, bmax, resolution)
+    if not rewrite:
+        return text, bmin, bmax, cell, ""
+    scene = json.loads(text)
+    scene["bounds"] = {"min": list(bmin), "max": list(bmax)}
+    indent = None if text.startswith('{"') else 2
+    return (json.dumps(scene, indent=indent, separators=(",", ":") if indent is None else None),
+            bmin, bmax, cell, "")
+
+
+def scene_text(output, depsgraph=None, render=True, resolution=None):
+    """(text, paths, bmin, bmax, cell) of the scene as the field is meshed at
+    resolution (default: its render resolution): with Fit Region, compiled
+    once and its bounds fitted (fit_text; `blendtool mesh --cell-size CELL`
+    makes the same grid), else the Region box (cell 0: `--resolution`).
+    What Export writes."""
+    text, paths = tree.to_json(output, depsgraph, render=render)
+    s = output.libblend
+    bmin, bmax = _region(output)
+    cell = 0.0
+    if s.fit_region:
+        res = s.render_resolution if resolution is None else resolution
+        with libhandle.library().parse_scene(text, output.name + ".json") as sc, \
+                sc.compile() as ev:
+            text, bmin, bmax, cell, _note = fit_text(ev, text, bmin, bmax, res)
+    return text, paths, bmin, bmax, cell
+
+
+def clipped_faces(positions, bmin, bmax):
+    """The faces of the region box ("-x +z") the mesh has vertices on: where the
+    region cut the solid flat (a closed mesh of a solid inside the box has none)."""
+    if not len(positions):
+        return ""
+    faces = []
+    for d in range(3):
+        tol = 1e-7 * max(bmax[d] - bmin[d], 1e-12)
+        if (positions[:, d] <= bmin[d] + tol).any():
+            faces.append("-" + "xyz"[d])
+        if (positions[:, d] >= bmax[d] - tol).any():
+            faces.append("+" + "xyz"[d])
+    return " ".join(faces)
 
 
 # --------------------------------------------------------------------------- mesh data
@@ -193,6 +306,15 @@ def _region(output):
     return tuple(s.bounds_min), tuple(s.bounds_max)
 
 
+def region_of(output):
+    """The region the field's mesh was last made in (Fit Region: the fitted
+    box), else its Region Min / Max box."""
+    st = _states.get(output.name)
+    if output.libblend.fit_region and st is not None and st.region is not None:
+        return st.region
+    return _region(output)
+
+
 def prepare(output, resolution, depsgraph=None):
     """Read the tree (main thread) into a _Job; raises tree.TreeError or
     binding.LibraryError. With a depsgraph the values are that depsgraph's
@@ -201,7 +323,8 @@ def prepare(output, resolution, depsgraph=None):
     text, paths = tree.to_json(output, depsgraph, render=False, compact=True)
     bmin, bmax = _region(output)
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
-                output.libblend.open_boundary, libhandle.threads(), paths)
+                output.libblend.open_boundary, libhandle.threads(), paths,
+                fit=output.libblend.fit_region)
 
 
 def _finish(output, st, job, t_start, defer_normals=False):
@@ -220,10 +343,30 @@ def _finish(output, st, job, t_start, defer_normals=False):
     st.last = {"mesh": job.seconds, "apply": time.perf_counter() - t0,
                "total": time.perf_counter() - t_start}
     st.expect = job.seconds
-    st.status = "%d triangles, %d cells, %.0f ms (libblend %.0f ms)" % (
-        len(job.mesh.triangles), job.resolution, 1000 * st.last["total"], 1000 * job.seconds)
+    cells = "%d cells" % job.resolution if not job.cell else \
+        "fitted region, cell %g" % job.cell
+    st.status = "%d triangles, %s, %.0f ms (libblend %.0f ms)" % (
+        len(job.mesh.triangles), cells,
+        1000 * st.last["total"], 1000 * job.seconds)
     st.error = False
+    note_region(output, st, job)
     return True
+
+
+def note_region(output, st, job):
+    """Keep the region a run used, and say (panel and console, once per
+    change) when the surface reached the region's boundary and was cut flat."""
+    st.region = (tuple(job.bmin), tuple(job.bmax))
+    warn = ""
+    if job.clipped and not job.open_boundary:  # Open at Region: cut on purpose
+        warn = ("field '%s': the surface reaches the region's boundary (%s) and is cut flat "
+                "there%s. Fix: %s" % (
+                    output.name, job.clipped, "; " + job.region_note if job.region_note else "",
+                    "enlarge Region Min / Max" if job.fit or output.libblend.fit_region
+                    else "turn on Fit Region, or enlarge Region Min / Max"))
+    if warn and warn != st.clip_warning:
+        print("libblend: " + warn)
+    st.clip_warning = warn
 
 
 def update_now(output, final=False, depsgraph=None, force=True):
@@ -258,7 +401,7 @@ def cached_key(output, depsgraph=None):
     needs no library."""
     s = output.libblend
     text, _paths = tree.to_json(output, depsgraph, render=False, compact=True)
-    bmin, bmax = _region(output)
+    bmin, bmax = ("fit", "fit") if s.fit_region else _region(output)
     return mesh_key(text, bmin, bmax, s.render_resolution, s.open_boundary)
 
 

@@ -91,6 +91,7 @@ class LIBBLEND_OT_add_field(bpy.types.Operator):
         s.kind = "OUTPUT"
         s.live = False
         s.convention = self.convention
+        s.fit_region = True  # a new field's region follows it (imported scenes keep theirs)
         if self.with_sphere:
             sph = _new_node(context, out, "sphere", "SPHERE")
             sph.libblend.kind = "PRIMITIVE"
@@ -364,7 +365,7 @@ class LIBBLEND_OT_export_scene(bpy.types.Operator, ExportHelper):
         if out is None:
             return {"CANCELLED"}
         try:
-            text, paths = tree.to_json(out)
+            text, paths, _lo, _hi, _cell = live.scene_text(out)
             libhandle.library().parse_scene(text, os.path.basename(self.filepath)).close()
             _atomic_write(self.filepath, text + "\n")
         except (tree.TreeError, binding.LibblendError) as e:
@@ -509,7 +510,7 @@ class LIBBLEND_OT_export_pov(bpy.types.Operator, ExportHelper):
             return {"CANCELLED"}
         paths = {}
         try:
-            text, paths = tree.to_json(out)
+            text, paths, _lo, _hi, _cell = live.scene_text(out)
             lib = libhandle.library()
             with lib.parse_scene(text, out.name) as scene, scene.compile() as ev:
                 g = scene.write_pov(ev, self.filepath, include_only=self.include_only,

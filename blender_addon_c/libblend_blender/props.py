@@ -87,6 +87,11 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
     convention: EnumProperty(name="Convention", items=[
         ("zero", "Zero (distance-like)", "inside f < 0, surface f = 0"),
         ("soft", "Soft (kernels)", "inside f > 0.5, surface f = 0.5")], update=_changed)
+    fit_region: BoolProperty(name="Fit Region", description="mesh in a box fitted to the field "
+                             "(libblend's interval bounds of the solid, grown by a margin, found "
+                             "again whenever the tree changes); off: the Region Min / Max box. On "
+                             "for fields made with Add, off for imported scenes (their bounds)",
+                             default=False, update=_changed)
     bounds_min: FloatVectorProperty(name="Region Min", default=(-2, -2, -2), subtype="XYZ",
                                     update=_changed)
     bounds_max: FloatVectorProperty(name="Region Max", default=(2, 2, 2), subtype="XYZ",

@@ -156,17 +156,18 @@ def floor_height(output, up):
     """The floor's height along up (world): libblend's lb_render_floor_height
     (as the POV-Ray writer) over the field's region, with up taken into the
     field's frame, or the region's lowest corner when the tree is broken."""
-    s = output.libblend
+    from . import live
     M = output.matrix_world
-    corners = [Vector((x, y, z)) for x in (s.bounds_min[0], s.bounds_max[0])
-               for y in (s.bounds_min[1], s.bounds_max[1]) for z in (s.bounds_min[2], s.bounds_max[2])]
+    bmin, bmax = live.region_of(output)
+    corners = [Vector((x, y, z)) for x in (bmin[0], bmax[0])
+               for y in (bmin[1], bmax[1]) for z in (bmin[2], bmax[2])]
     h = min((M @ c).dot(Vector(up)) for c in corners)
     # up . (A p + t) = (A^T up) . p + up . t
     local_up = M.to_3x3().transposed() @ Vector(up)
     try:
-        text, _ = tree.to_json(output, render=False)
+        text, _paths, bmin, bmax, _cell = live.scene_text(output, render=False)
         with libhandle.library().parse_scene(text, output.name + ".json") as sc, sc.compile() as ev:
-            return ev.floor_height(s.bounds_min, s.bounds_max, local_up, libhandle.threads()) + \
+            return ev.floor_height(bmin, bmax, local_up, libhandle.threads()) + \
                 M.translation.dot(Vector(up))
     except Exception:  # no library or a tree error: the region's corner, as documented
         return h
@@ -177,8 +178,9 @@ def _floor(output, section, collection):
     floor colour."""
     up = Vector(section.get("camera", {}).get("up", [0, 0, 1])).normalized()
     h = floor_height(output, up)
-    s = output.libblend
-    size = 20.0 * max((Vector(s.bounds_max) - Vector(s.bounds_min)).length, 1e-3)
+    from . import live
+    bmin, bmax = live.region_of(output)
+    size = 20.0 * max((Vector(bmax) - Vector(bmin)).length, 1e-3)
     me = bpy.data.meshes.new(output.name + " floor")
     me.from_pydata([(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)], [], [(0, 1, 2, 3)])
     obj = bpy.data.objects.new(output.name + " floor", me)

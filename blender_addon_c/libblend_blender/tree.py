@@ -398,6 +398,7 @@ def from_scene(scene, collection, name="libblend field"):
     s.convention = scene["convention"]
     if "bounds" in scene:
         s.bounds_min, s.bounds_max = scene["bounds"]["min"], scene["bounds"]["max"]
+    s.fit_region = False  # the file's bounds are its author's region (as blendtool meshes it)
     s.title = scene.get("title", "")
     s.description = scene.get("description", "")
     s.render_json = json.dumps(scene["render"]) if "render" in scene else ""

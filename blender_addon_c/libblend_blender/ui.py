@@ -96,6 +96,7 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
             box.alert = st.error
             for line in _wrap(st.status, 50):
                 box.label(text=line, icon="ERROR" if st.error else "NONE")
+        _note(layout, getattr(st, "clip_warning", ""))
         row = layout.row(align=True)
         row.operator("libblend.update_mesh", icon="FILE_REFRESH").final = False
         row.operator("libblend.update_mesh", text="Render Resolution").final = True
@@ -107,7 +108,14 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
         s = obj.libblend
         layout.label(text="Field: " + obj.name, icon="META_BALL")
         layout.prop(s, "convention")
+        layout.prop(s, "fit_region")
+        st = live.state_of(obj)
+        if s.fit_region and st.region is not None:
+            lo, hi = st.region
+            layout.label(text="fitted: (%s) to (%s)" % (", ".join("%.3g" % v for v in lo),
+                                                         ", ".join("%.3g" % v for v in hi)))
         col = layout.column(align=True)
+        col.label(text="Search Around (Fit Region)" if s.fit_region else "Region")
         col.prop(s, "bounds_min")
         col.prop(s, "bounds_max")
         row = layout.row(align=True)

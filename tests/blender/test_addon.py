@@ -86,6 +86,9 @@ bpy.ops.libblend.add_field(convention="zero", with_sphere=False)
 out = active()
 check(out.libblend.kind == "OUTPUT", "add_field made an output")
 out.libblend.live = False
+# the wheel keeps the box it sets: its round trips compare meshes on that
+# box's grid (Fit Region has its own checks at the end)
+out.libblend.fit_region = False
 out.libblend.bounds_min = (-1.9, -1.9, -0.6)
 out.libblend.bounds_max = (1.9, 1.9, 0.6)
 out.libblend.preview_resolution = 64
@@ -160,8 +163,17 @@ def blendtool_volume(res):
     return meshcheck.check(Vb, Fb)["volume"]
 
 
-# the preview mesh moved into Blender loses nothing (float32 positions aside)
-vol64 = blendtool_volume(64)
+# the preview mesh moved into Blender loses nothing (float32 positions aside):
+# blendtool meshes the scene as the preview meshed it (Fit Region: the fitted
+# region at preview resolution and its cell)
+text64, _p, _lo, _hi, cell64 = live.scene_text(out, resolution=64)
+check(out.libblend.preview_resolution == 64, "the wheel's preview resolution is 64")
+wheel64 = os.path.join(WORK, "wheel-preview.json")
+open(wheel64, "w").write(text64)
+ply64 = os.path.join(WORK, "wheel-preview.ply")
+subprocess.run([BLENDTOOL, "mesh", wheel64, "-o", ply64, "--quiet"] +
+               (["--cell-size", repr(cell64)] if cell64 else ["--resolution", "64"]), check=True)
+vol64 = meshcheck.check(*meshcheck.read(ply64)[::2])["volume"]
 print("volume at 64 cells: blender %.7f, blendtool %.7f" % (info["volume"], vol64))
 check(abs(info["volume"] - vol64) < 1e-5 * vol64, "Blender's preview mesh = blendtool's at 64")
 # the render-resolution mesh against an independent finer blendtool run
@@ -669,10 +681,11 @@ check(back is not None and back.libblend.kind == "OUTPUT" and
       len([o for o in back.children_recursive if tree.is_node(o)]) == n_nodes, "undo brings the field back")
 out = back
 exp = os.path.join(WORK, "applied.json")
-text, _ = tree.to_json(out)
+text, _p, _lo, _hi, cell = live.scene_text(out, resolution=48)  # what Export writes
 open(exp, "w").write(text)
 ply = os.path.join(WORK, "applied.ply")
-subprocess.run([BLENDTOOL, "mesh", exp, "-o", ply, "--resolution", "48", "--quiet"], check=True)
+subprocess.run([BLENDTOOL, "mesh", exp, "-o", ply, "--quiet"] +
+               (["--cell-size", repr(cell)] if cell else ["--resolution", "48"]), check=True)
 Vb, _Nb, Fb = meshcheck.read(ply)
 ib = meshcheck.check(Vb, Fb)
 check(ipl["vertices"] == ib["vertices"] and abs(ipl["volume"] - ib["volume"]) < 1e-5 * ib["volume"],
@@ -746,14 +759,15 @@ bpy.app.handlers.render_post.remove(grab)
 check(sorted(rendered) == [1, 2, 3], "three frames rendered: %s" % sorted(rendered))
 for f in (1, 2, 3):
     sc.frame_set(f)
-    text, _ = tree.to_json(anim, bpy.context.evaluated_depsgraph_get())
+    text, _p, _lo, _hi, cell = live.scene_text(anim, bpy.context.evaluated_depsgraph_get())
     js = os.path.join(WORK, "anim-%d.json" % f)
     open(js, "w").write(text)
     r_f = json.loads(text)["root"]["r"]
     check(abs(r_f - {1: 0.05, 2: 0.775, 3: 1.5}[f]) < 1e-6, "frame %d's export holds the keyed r: %s"
           % (f, r_f))
     ply = os.path.join(WORK, "anim-%d.ply" % f)
-    subprocess.run([BLENDTOOL, "mesh", js, "-o", ply, "--resolution", "40", "--quiet"], check=True)
+    subprocess.run([BLENDTOOL, "mesh", js, "-o", ply, "--quiet"] +
+                   (["--cell-size", repr(cell)] if cell else ["--resolution", "40"]), check=True)
     Vb, _Nb, Fb = meshcheck.read(ply)
     ib, ir = meshcheck.check(Vb, Fb), rendered[f]
     print("animation frame %d: rendered %d vertices, volume %.7f; blendtool %d, %.7f"
@@ -967,6 +981,76 @@ print("materials seen: %d pixels on both, POV-Ray grey/red/blue %s, same class %
       % (both.sum(), classes, same))
 check(min(classes) > 0.03 * both.sum(), "POV-Ray shows all three materials")
 check(same > 0.98, "Blender and POV-Ray colour the same pixels by material (%.4f)" % same)
+
+# ---------------------------------------------------------------- Fit Region
+# A new field's region fits the field: a capsule reaching past the default
+# box (-2..2) is whole, its top within a cell of the true top; off, the box
+# cuts it flat and the panel and the console say so; inside the box, the
+# fitted mesh is the box's mesh (same grid); an unbounded field falls back
+# to the box, saying why.
+bpy.ops.libblend.add_field(convention="zero", with_sphere=False)
+ff = active()
+ff.name = "fit field"
+ff.libblend.live = False
+ff.libblend.preview_resolution = 32
+check(ff.libblend.fit_region, "Add makes a field that fits its region")
+bpy.ops.libblend.add_primitive(prim_type="capsule")
+cap = active()
+cap.libblend.start, cap.libblend.end, cap.libblend.radius = (0, 0, 0), (0, 0, 3.5), 0.5
+ok, msg = live.update_now(ff)
+check(ok, "fitted mesh: " + msg)
+st = live.state_of(ff)
+Vf, Ff = blender_mesh(ff)
+cell = 4.0 / 32  # the Region box's cell
+top = float(Vf[:, 2].max())
+print("Fit Region: top vertex z = %.4f (true 4.0), region %s, %s" % (top, st.region, st.status))
+check(abs(top - 4.0) <= cell, "the capsule is whole: its top vertex %.4f within a cell of 4.0" % top)
+ic = meshcheck.check(Vf.astype(np.float64), Ff.astype(np.int64))
+check(ic["closed"] and ic["manifold"], "the fitted mesh is closed and manifold")
+check(st.clip_warning == "", "nothing is cut: %r" % st.clip_warning)
+check(st.region[1][2] > 4.0 and st.region[1][2] <= 4.0 + 3 * cell and
+      st.region[0][2] < -0.5 and st.region[0][2] >= -0.5 - 3 * cell,
+      "the region reaches just past the capsule, within 3 cells: %s" % (st.region,))
+# the tree changes: the region follows
+cap.libblend.end = (0, 0, 5.0)
+live.update_now(ff)
+Vf2, _F2 = blender_mesh(ff)
+check(abs(float(Vf2[:, 2].max()) - 5.5) <= cell, "a longer capsule: the region follows (%.4f)"
+      % Vf2[:, 2].max())
+cap.libblend.end = (0, 0, 3.5)
+# off: the box cuts it, and says so
+ff.libblend.fit_region = False
+live.update_now(ff)
+Vc, _Fc = blender_mesh(ff)
+st = live.state_of(ff)
+check(abs(float(Vc[:, 2].max()) - 2.0) < 1e-6, "without Fit Region the box cuts the capsule at z = 2")
+check("+z" in st.clip_warning and "cut flat" in st.clip_warning and "Fit Region" in st.clip_warning,
+      "the cut is flagged with its fix: %r" % st.clip_warning)
+Recorder.drawn = []
+draw(lbb.ui.LIBBLEND_PT_panel, ff)
+check(any("cut flat" in d for d in Recorder.drawn), "the panel shows the cut")
+# inside the box: the fitted mesh is the box's mesh
+cap.libblend.end = (0, 0, 1.0)
+live.update_now(ff)
+Vb, Fb = blender_mesh(ff)
+check(live.state_of(ff).clip_warning == "", "inside the box: nothing to flag")
+ff.libblend.fit_region = True
+live.update_now(ff)
+Vi, Fi = blender_mesh(ff)
+check(len(Vi) == len(Vb) and len(Fi) == len(Fb) and
+      np.abs(np.unique(Vi, axis=0) - np.unique(Vb, axis=0)).max() < 1e-5,
+      "inside the box the fitted region meshes on the box's grid: the same mesh (%d / %d vertices)"
+      % (len(Vi), len(Vb)))
+# unbounded: a slab cannot be fitted; the box is used and the cut flagged
+bpy.ops.libblend.add_field(convention="zero", with_sphere=False)
+fu = active()
+fu.libblend.live = False
+fu.libblend.preview_resolution = 16
+bpy.ops.libblend.add_primitive(prim_type="slab")
+ok, msg = live.update_now(fu)
+st = live.state_of(fu)
+check(ok and "unbounded" in st.clip_warning and "cut flat" in st.clip_warning,
+      "an unbounded field falls back to the box, and says why: %r" % st.clip_warning)
 
 addon_utils.disable(ADDON_NAME)
 print("test_addon: %d checks passed" % addon_env.checks)

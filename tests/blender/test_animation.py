@@ -161,7 +161,8 @@ bpy.ops.wm.save_as_mainfile(filepath=blend_path)
 exports = {}
 for f in FRAMES:
     sc.frame_set(f)
-    text, _ = tree.to_json(out, bpy.context.evaluated_depsgraph_get())
+    # what Export writes: with Fit Region (Add's fields) the fitted region as the bounds
+    text, _p, _lo, _hi, cell = live.scene_text(out, bpy.context.evaluated_depsgraph_get())
     js = json.loads(text)
     e = expected(f)
     b = js["root"]["args"][0]["args"][0]
@@ -173,8 +174,8 @@ for f in FRAMES:
     with open(path, "w") as fh:
         fh.write(text)
     ply = path[:-5] + ".ply"
-    subprocess.run([BLENDTOOL, "mesh", path, "-o", ply, "--resolution", "44", "--quiet"],
-                   check=True)
+    grid = ["--cell-size", repr(cell)] if cell else ["--resolution", "44"]
+    subprocess.run([BLENDTOOL, "mesh", path, "-o", ply, "--quiet"] + grid, check=True)
     V, _N, F = meshcheck.read(ply)
     exports[f] = meshcheck.check(V, F)
 sc.frame_set(1)
@@ -338,9 +339,10 @@ sc.frame_set(3)
 check(live.state_of(out).dirty, "a frame change marks the live field dirty")
 while live.tick() is not None:
     time.sleep(0.002)
-text2, _ = tree.to_json(out, bpy.context.evaluated_depsgraph_get())
+text2, _p, lo2, hi2, c2 = live.scene_text(out, bpy.context.evaluated_depsgraph_get(),
+                                             resolution=s.preview_resolution)
 with libhandle.library().parse_scene(text2) as scn, scn.compile() as ev:
-    ref2 = ev.mesh(tuple(s.bounds_min), tuple(s.bounds_max), resolution=s.preview_resolution)
+    ref2 = ev.mesh(lo2, hi2, resolution=s.preview_resolution, cell_size=c2)
 check(len(out.data.vertices) == len(ref2.positions) != n_before and
       abs(json.loads(text2)["root"]["args"][0]["args"][0]["r"] - expected(3)["r"]) < 2e-6,
       "scrubbing from frame 2 to 3 shows frame 3 at preview resolution")
@@ -360,10 +362,10 @@ while live.tick() is not None:
     time.sleep(0.002)
 st = live.state_of(out)
 check(not st.error and not st.dirty, st.status)
-text, _ = tree.to_json(out)
+text, _p, lo4, hi4, c4 = live.scene_text(out, resolution=s.preview_resolution)
 check(abs(json.loads(text)["root"]["args"][0]["args"][0]["m"] - 0.55) < 1e-6, "exported m follows")
 with libhandle.library().parse_scene(text) as scn, scn.compile() as ev:
-    ref = ev.mesh(tuple(s.bounds_min), tuple(s.bounds_max), resolution=s.preview_resolution)
+    ref = ev.mesh(lo4, hi4, resolution=s.preview_resolution, cell_size=c4)
 check(len(out.data.vertices) == len(ref.positions), "the live mesh is the driven state's")
 # an update that changes nothing is not meshed again
 t_applied = st.t_applied
@@ -387,8 +389,10 @@ print("example:", summ)
 img1, img3 = (addon_env.image_pixels(os.path.join(ex, "frame_%04d.png" % f)) for f in (1, 3))
 check(np.abs(img1 - img3).max() > 0.1, "its two frames differ")
 ply = os.path.join(ex, "frame_0003.ply")
-subprocess.run([BLENDTOOL, "mesh", os.path.join(ex, "frame_0003.json"), "-o", ply, "--resolution",
-                "64", "--quiet"], check=True)
+cell = summ.get("frame 3 cell (render)", 0)
+check(cell > 0, "the example's field fits its region (Fit Region): cell %r" % cell)
+subprocess.run([BLENDTOOL, "mesh", os.path.join(ex, "frame_0003.json"), "-o", ply, "--cell-size",
+                repr(cell), "--quiet"], check=True)
 V, _N, F = meshcheck.read(ply)
 check(len(F) == summ["frame 3 triangles (render)"], "frame 3 rendered the exported scene's mesh")
 check(summ["frame 1 triangles (render)"] == summ["frame 1 triangles (update_mesh)"],
