@@ -256,6 +256,22 @@ static lb_status c_bounds(unsigned mask, int size, lb_error *err, int *hs) {
     const double bmin[3] = {-1, -1, -1}, bmax[3] = {1, 1, 1};
     return lb_evaluator_bounds(P(0, C.ev), P(1, bmin), P(2, bmax), P(3, &lo), P(4, &hi), P(5, err));
 }
+static lb_status c_extent(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    double lo[3], hi[3];
+    int flags;
+    const double smin[3] = {-4, -4, -4}, smax[3] = {4, 4, 4};
+    return lb_evaluator_extent(P(0, C.ev), P(1, smin), P(2, smax), 0.5, P(3, lo), P(4, hi),
+                               P(5, &flags), P(6, err));
+}
+static lb_status c_unused_m(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)err;
+    *hs = 0;
+    const char *paths[2];
+    (void)lb_scene_unused_m(P(0, C.scene), P(1, paths), (size_t)size);
+    return LB_OK;
+}
 /* the test scene's bounds, 8 cells, one thread */
 static void small_options(lb_mesh_options *o) {
     lb_mesh_options_init(o);
@@ -367,6 +383,8 @@ static const fn_case CASES[] = {
     {"lb_evaluator_create", 3, 0x03, c_evaluator},
     {"lb_evaluator_eval", 9, 0x1f, c_eval},
     {"lb_evaluator_bounds", 6, 0x1f, c_bounds},
+    {"lb_evaluator_extent", 7, 0x3f, c_extent},
+    {"lb_scene_unused_m", 2, 0x00, c_unused_m},
     {"lb_mesh_create", 4, 0x07, c_mesh},
     {"lb_mesh_write / _stream", 4, 0x07, c_mesh_write},
     {"lb_mesh_edges", 5, 0x0f, c_mesh_edges},
