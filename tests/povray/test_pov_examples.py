@@ -12,35 +12,15 @@ import os
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from checks import read_ppm  # noqa: E402
+
 SRC, WORK = sys.argv[1:3]
 os.makedirs(WORK, exist_ok=True)
 INC = os.path.join(SRC, "povray_include")
 BG = (0.92, 0.93, 0.95)
 scenes = sorted(glob.glob(os.path.join(INC, "examples", "*.pov")))
 failures = []
-
-
-def read_ppm(path):
-    """Binary PPM (P6): header tokens with # comments, then RGB samples."""
-    data = open(path, "rb").read()
-    parts, pos = [], 0
-    while len(parts) < 4:  # magic, width, height, maxval
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        if data[pos:pos + 1] == b"#":
-            pos = data.index(b"\n", pos) + 1
-            continue
-        end = pos
-        while not data[end:end + 1].isspace():
-            end += 1
-        parts.append(data[pos:end])
-        pos = end
-    pos += 1
-    w, h, mx = int(parts[1]), int(parts[2]), int(parts[3])
-    step = 2 if mx > 255 else 1
-    px = data[pos:]
-    vals = [int.from_bytes(px[i:i + step], "big") / mx for i in range(0, len(px), step)]
-    return w, h, [vals[i:i + 3] for i in range(0, len(vals), 3)]
 
 
 if len(scenes) < 10:

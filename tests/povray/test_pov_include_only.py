@@ -22,7 +22,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from checks import check, failures  # noqa: E402
+from checks import check, failures, read_ppm  # noqa: E402
 
 BT, SRC, WORK = (os.path.abspath(a) for a in sys.argv[1:4])
 shutil.rmtree(WORK, ignore_errors=True)
@@ -58,25 +58,10 @@ def same_text(a, b):
     return None
 
 
-def read_ppm(path):
-    data = open(path, "rb").read()
-    fields, pos = [], 0
-    while len(fields) < 4:  # P6 width height maxval (# comments), then one whitespace byte
-        while data[pos:pos + 1].isspace():
-            pos += 1
-        if data[pos:pos + 1] == b"#":
-            pos = data.index(b"\n", pos) + 1
-            continue
-        end = pos
-        while not data[end:end + 1].isspace():
-            end += 1
-        fields.append(data[pos:end])
-        pos = end
-    w, h, mx = int(fields[1]), int(fields[2]), int(fields[3])
-    step = 2 if mx > 255 else 1
-    px = data[pos + 1:]
-    grey = [int.from_bytes(px[i:i + step], "big") / mx for i in range(0, 3 * w * h * step, step)]
-    return w, h, [g > 0.5 for g in grey[0::3]]
+def read_mask(path):
+    """the image's pixels as object (True: brighter than half) or not"""
+    w, h, px = read_ppm(path)
+    return w, h, [p[0] > 0.5 for p in px]
 
 
 # ---- the shipped include is today's output
@@ -134,8 +119,8 @@ def compare(name, scene):
         return
     tool_ppm = os.path.join(d, "tool.ppm")
     subprocess.run(["oiiotool", png, "--ch", "R,G,B", "-o", tool_ppm], check=True)
-    w1, h1, a = read_ppm(ppm)
-    w2, h2, b = read_ppm(tool_ppm)
+    w1, h1, a = read_mask(ppm)
+    w2, h2, b = read_mask(tool_ppm)
     if not check((w1, h1) == (w2, h2) == (W, H), "%s: image sizes %dx%d and %dx%d" %
                  (name, w1, h1, w2, h2)):
         return
