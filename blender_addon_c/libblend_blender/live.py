@@ -145,9 +145,9 @@ def fit_text(ev, text, bmin, bmax, resolution, rewrite=True):
     (searched within FIT_SEARCH times the box bmin..bmax around its centre)
     grown by FIT_MARGIN of its longest side, on fit_grid's grid, and the
     scene text with those bounds (local unions look for their curves inside
-    the bounds); with rewrite=False the
-    text is returned as it came. When the solid is unbounded or not found:
-    the box as it was, cell 0 (mesh by resolution) and a note saying why."""
+    the bounds; with rewrite=False the text is returned as it came). When the
+    solid is unbounded, not found, or too costly to bound: the box as it
+    was, cell 0 (mesh by resolution) and a note saying why."""
     c = [(a + b) / 2 for a, b in zip(bmin, bmax)]
     box = max(max(b - a for a, b in zip(bmin, bmax)), 2e-3)
     h = FIT_SEARCH * box / 2
