@@ -982,6 +982,41 @@ print("materials seen: %d pixels on both, POV-Ray grey/red/blue %s, same class %
 check(min(classes) > 0.03 * both.sum(), "POV-Ray shows all three materials")
 check(same > 0.98, "Blender and POV-Ray colour the same pixels by material (%.4f)" % same)
 
+# ---------------------------------------------------------------- the look
+# An imported shipped scene rendered by Cycles looks as POV-Ray renders it:
+# the same camera and lights, the mean luminance (sRGB decoded, Rec. 709
+# weights) of the two images within 10 %, on two scenes; the view
+# transform is Standard.
+def mean_luminance(png):
+    px = addon_env.image_pixels(png)[:, :, :3].astype(np.float64)
+    lin = np.where(px <= 0.04045, px / 12.92, ((px + 0.055) / 1.055) ** 2.4)
+    return float((lin @ np.array([0.2126, 0.7152, 0.0722])).mean())
+
+
+for name in ("default", "hsu-bounded-fig8-round"):
+    for o in list(bpy.context.scene.objects):
+        bpy.data.objects.remove(o)
+    path = os.path.join(SRC, "scenes", name + ".json")
+    check(bpy.ops.libblend.import_scene(filepath=path, with_render=True) == {"FINISHED"},
+          "import %s with its render section" % name)
+    check(bpy.context.scene.view_settings.view_transform == "Standard",
+          "the import sets the Standard view transform")
+    live.update_now(active(), final=True)
+    bl_png = cycles_render(os.path.join(WORK, "look-%s-blender.png" % name), 32, False)
+    pov_file, pov_png = (os.path.join(WORK, "look-%s.%s" % (name, e)) for e in ("pov", "png"))
+    r = subprocess.run([BLENDTOOL, "pov", path, "-o", pov_file, "--width", str(SW), "--height",
+                        str(SH)], capture_output=True, text=True)
+    check(r.returncode == 0, "%s exports: %s" % (name, r.stderr[-300:]))
+    r = subprocess.run(["povray", "+I" + pov_file, "+O" + pov_png, "+W%d" % SW, "+H%d" % SH,
+                        "+FN", "-D", "+L" + os.path.join(SRC, "povray_include")],
+                       capture_output=True, text=True)
+    check(r.returncode == 0, "POV-Ray renders %s: %s" % (name, r.stderr[-300:]))
+    lb, lp = mean_luminance(bl_png), mean_luminance(pov_png)
+    print("the look of %s: mean luminance Cycles %.4f, POV-Ray %.4f (ratio %.3f)"
+          % (name, lb, lp, lb / lp))
+    check(abs(lb / lp - 1) <= 0.10, "%s: Cycles' mean luminance %.4f within 10 %% of POV-Ray's %.4f"
+          % (name, lb, lp))
+
 # ---------------------------------------------------------------- Fit Region
 # A new field's region fits the field: a capsule reaching past the default
 # box (-2..2) is whole, its top within a cell of the true top; off, the box
