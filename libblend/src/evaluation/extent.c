@@ -75,19 +75,17 @@ static double reach(const box *b, int face) {
 /* One face's search: *answer is the farthest reach of the solid (as
  * reach() measures it); returns 1 when the solid is not in the box at all,
  * -1 when memory is short, else 0. */
-static int face_search(const lb_evaluator *ev, lb__iv *R, heap *h, const double smin[3],
-                       const double smax[3], double tol, int face, size_t *passes, double *answer,
-                       int *flags) {
+static int face_search(const lb_evaluator *ev, lb__iv *R, heap *h, const box *search, double tol,
+                       int face, double *answer, int *flags) {
     const int soft = ev->conv == LB_CONVENTION_SOFT;
-    box b;
-    memcpy(b.lo, smin, sizeof b.lo);
-    memcpy(b.hi, smax, sizeof b.hi);
+    size_t passes = 0;
+    box b = *search;
     b.key = reach(&b, face);
     h->n = 0;
     if (heap_push(h, &b)) return -1;
     while (h->n) {
         b = heap_pop(h);
-        if (*passes >= LB_EXTENT_MAX_BOXES / 6) { /* this face's share: sound, not tight */
+        if (passes >= LB_EXTENT_MAX_BOXES / 6) { /* this face's share: sound, not tight */
             *flags |= LB_EXTENT_COARSE;
             *answer = b.key;
             return 0;
@@ -96,7 +94,7 @@ static int face_search(const lb_evaluator *ev, lb__iv *R, heap *h, const double 
         lb__box_centre(b.lo, b.hi, bc, br);
         for (int d = 0; d < 3; ++d) size = fmax(size, b.hi[d] - b.lo[d]);
         lb__bounds_pass(ev, bc, br, R, NULL);
-        ++*passes;
+        ++passes;
         const lb__iv v = R[ev->out];
         if (soft ? v.hi < 0.5 : v.lo > 0.0) continue; /* outside (NaN: not proven) */
         if ((soft ? v.lo > 0.5 : v.hi < 0.0) || size <= tol) {
@@ -142,14 +140,17 @@ lb_status lb_evaluator_extent(const lb_evaluator *ev, const double smin[3], cons
     lb__iv *R = malloc(lb__ivs_len(ev) * sizeof *R);
     if (!R) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", fn);
     int f = 0, rc = 0;
-    double far[6];
-    for (int face = 0; face < 6; ++face) far[face] = face & 1 ? smax[face / 2] : -smin[face / 2];
+    box search;
+    memcpy(search.lo, smin, sizeof search.lo);
+    memcpy(search.hi, smax, sizeof search.hi);
+    double far[6]; /* each face's answer; until searched, the search box's own */
+    for (int face = 0; face < 6; ++face) far[face] = reach(&search, face);
     for (int face = 0; face < 6 && !rc; ++face) {
-        size_t passes = 0;
-        rc = face_search(ev, R, &h, smin, smax, tol, face, &passes, &far[face], &f);
+        const double edge = far[face];
+        rc = face_search(ev, R, &h, &search, tol, face, &far[face], &f);
         /* it reaches the search box: unbounded for the caller's purpose; the
          * faces not searched yet keep the search box's (sound) */
-        if (!rc && far[face] >= (face & 1 ? smax[face / 2] : -smin[face / 2])) break;
+        if (!rc && far[face] >= edge) break;
     }
     free(h.a);
     free(R);
