@@ -86,25 +86,15 @@ class _Job:
         self.done = threading.Event()
 
     def run(self):
-        import numpy as np
         t0 = time.perf_counter()
         try:
-            text = self.text
-            if self.fit:
+            with self.lib.parse_scene(self.text, self.name) as scene, scene.compile() as ev:
+                text = self._fit(ev, self.text) if self.fit else self.text
+                if text is self.text:  # the compiled scene is the one to mesh
+                    self._mesh(scene, ev)
+            if text is not self.text:  # a local union: its curves inside the fitted bounds
                 with self.lib.parse_scene(text, self.name) as scene, scene.compile() as ev:
-                    text = self._fit(ev, text)
-            with self.lib.parse_scene(text, self.name) as scene, scene.compile() as ev:
-                self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
-                                    cell_size=self.cell, open_boundary=self.open_boundary,
-                                    threads=self.threads,
-                                    cancel=self.cancel, edges=compat.takes_libblend_edges())
-                self.clipped = clipped_faces(self.mesh.positions, self.bmin, self.bmax)
-                mats = scene.materials()
-                if len(mats) > 1 and len(self.mesh.triangles):
-                    # each triangle takes the material at its centroid
-                    P = self.mesh.positions[self.mesh.triangles.astype(np.int64)].mean(axis=1)
-                    self.mesh.material_index = scene.material_index(ev, P)
-                    self.mesh.materials = mats
+                    self._mesh(scene, ev)
         except binding.Cancelled:
             self.error = None
         except binding.LibblendError as e:
@@ -113,6 +103,20 @@ class _Job:
             self.error = "internal error: %r" % (e,)
         self.seconds = time.perf_counter() - t0
         self.done.set()
+
+    def _mesh(self, scene, ev):
+        import numpy as np
+        self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
+                            cell_size=self.cell, open_boundary=self.open_boundary,
+                            threads=self.threads, cancel=self.cancel,
+                            edges=compat.takes_libblend_edges())
+        self.clipped = clipped_faces(self.mesh.positions, self.bmin, self.bmax)
+        mats = scene.materials()
+        if len(mats) > 1 and len(self.mesh.triangles):
+            # each triangle takes the material at its centroid
+            P = self.mesh.positions[self.mesh.triangles.astype(np.int64)].mean(axis=1)
+            self.mesh.material_index = scene.material_index(ev, P)
+            self.mesh.materials = mats
 
     def _fit(self, ev, text):
         # only local unions read the bounds when meshing: other scenes keep
