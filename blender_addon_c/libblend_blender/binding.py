@@ -78,7 +78,7 @@ class _Mesh(ctypes.Structure):
 class _PovOptions(ctypes.Structure):
     _fields_ = [("include_only", ctypes.c_int), ("silhouette", ctypes.c_int),
                 ("aspect", ctypes.c_double), ("max_gradient", ctypes.c_double),
-                ("threads", ctypes.c_int)]
+                ("threads", ctypes.c_int), ("mesh_resolution", ctypes.c_int)]
 
 
 class _Material(ctypes.Structure):
@@ -349,11 +349,12 @@ class Scene(_Handle):
         return Evaluator(self.lib, out)
 
     def write_pov(self, evaluator, path, include_only=False, silhouette=False, aspect=0.0,
-                  max_gradient=0.0, threads=0):
+                  max_gradient=0.0, threads=0, mesh_resolution=0):
         """Write a renderable POV-Ray scene (atomically); returns the max_gradient written.
-        The file includes "libblend.inc" (povray_include/)."""
+        The file includes "libblend.inc" (povray_include/). mesh_resolution > 0 writes
+        libblend's mesh at that many cells (a mesh2) instead of the isosurface."""
         o = _PovOptions(int(bool(include_only)), int(bool(silhouette)), float(aspect),
-                        float(max_gradient), int(threads))
+                        float(max_gradient), int(threads), int(mesh_resolution))
         g, err = ctypes.c_double(0.0), _Error()
         st = self.lib._c.lb_scene_write_pov(self.ptr, evaluator.ptr, ctypes.byref(o),
                                             os.fsencode(path), ctypes.byref(g), ctypes.byref(err))

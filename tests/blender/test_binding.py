@@ -162,6 +162,13 @@ with lib.load_scene(fig7) as sc, sc.compile() as ev7:
           and "#declare LB_Surface = LB_Field;" in inc_text
           and "#declare LB_FieldMaxGradient = " in inc_text,
           "include only: the field and what a hand-written scene needs, no object or camera")
+    meshed = os.path.join(WORK, "fig7-mesh.pov")
+    sc.write_pov(ev7, meshed, threads=1, mesh_resolution=32)
+    mtext = open(meshed).read()
+    check("mesh2 {" in mtext and "\nisosurface {" not in mtext,
+          "mesh_resolution reaches the C struct: a mesh2 instead of the isosurface")
+    raises(lambda: sc.write_pov(ev7, meshed, mesh_resolution=5000), binding.LibblendError,
+           "mesh_resolution 5000")
 
 # ---- errors
 raises(lambda: lib.parse_scene('{"format": "libblend-scene",\n "version": 1, }', "a.json"),

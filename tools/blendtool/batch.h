@@ -34,7 +34,8 @@
 typedef struct axis {
     char *path; /* JSON path into the scene */
     size_t n;
-    char **values; /* JSON text per step (sweeps) or per frame (animation) */
+    char **values;  /* JSON text per step (sweeps) or per frame (animation) */
+    char label[33]; /* the contact sheet's name for it ("m2"); empty: the path's last part */
 } axis;
 
 typedef struct job {
@@ -59,7 +60,7 @@ typedef struct job {
     int mesh, mesh_res;
     lb_mesh_format mesh_fmt;
     int pov, pov_w, pov_h;
-    int image, img_w, img_h, img_quality, img_alpha, img_fmt;
+    int image, img_w, img_h, img_quality, img_alpha, img_fmt, img_antialias, img_mesh;
     int sheet, sheet_cols, sheet_w, sheet_h;
     bt_image_plan img_plan; /* how the images are made on this machine */
     int threads;

@@ -109,7 +109,7 @@ static int path_ok(const char *p) {
 }
 
 static int parse_axis(const job *J, const cJSON *a, const char *path, axis *X) {
-    static const char *const keys[] = {"path", "values", "range", NULL};
+    static const char *const keys[] = {"path", "values", "range", "label", NULL};
     if (!cJSON_IsObject(a))
         return batch_bad(J, path,
                          "expected an object {\"path\": ..., \"values\": [...]} or "
@@ -124,6 +124,19 @@ static int parse_axis(const job *J, const cJSON *a, const char *path, axis *X) {
                          "\"root.args[0].radius\"",
                          lb__json_kind(p));
     X->path = batch_dupstr(p->valuestring);
+    const cJSON *lab = cJSON_GetObjectItemCaseSensitive(a, "label");
+    if (lab) {
+        /* printed on the sheet and into image metadata: printable ASCII */
+        const char *l = cJSON_IsString(lab) ? lab->valuestring : NULL;
+        int ok = l && *l && strlen(l) < sizeof X->label;
+        for (const char *c = l; ok && *c; ++c) ok = *c > ' ' && *c < 127 && *c != '=';
+        if (!ok)
+            return batch_bad(J, path,
+                             "\"label\" is %s; allowed: 1 to %zu printable ASCII characters "
+                             "without spaces or '=' (such as \"m2\")",
+                             l ? "not such a name" : lb__json_kind(lab), sizeof X->label - 1);
+        memcpy(X->label, l, strlen(l) + 1);
+    }
     const cJSON *vals = cJSON_GetObjectItemCaseSensitive(a, "values");
     const cJSON *rg = cJSON_GetObjectItemCaseSensitive(a, "range");
     if (!!vals == !!rg) return batch_bad(J, path, "give one of \"values\" (a list) or \"range\"");
@@ -310,8 +323,8 @@ static int parse_outputs(job *J, const cJSON *o) {
     }
     const cJSON *im = cJSON_GetObjectItemCaseSensitive(o, "image");
     if (im) {
-        static const char *const ik[] = {"format", "bits",   "pixel",   "alpha",
-                                         "width",  "height", "quality", NULL};
+        static const char *const ik[] = {"format", "bits",    "pixel", "alpha",     "width",
+                                         "height", "quality", "mesh",  "antialias", NULL};
         if (!cJSON_IsObject(im))
             return batch_bad(J, "$.outputs.image", "expected an object, found %s",
                              lb__json_kind(im));
@@ -338,10 +351,18 @@ static int parse_outputs(job *J, const cJSON *o) {
         if (al && !cJSON_IsBool(al))
             return batch_bad(J, "$.outputs.image.alpha", "is %s; allowed: true or false",
                              lb__json_kind(al));
+        const cJSON *aa = cJSON_GetObjectItemCaseSensitive(im, "antialias");
+        if (aa && !cJSON_IsBool(aa))
+            return batch_bad(J, "$.outputs.image.antialias", "is %s; allowed: true or false",
+                             lb__json_kind(aa));
+        long mres = 0;
         if ((rc = get_int(J, im, "width", "$.outputs.image", 1, 16384, &w)) ||
             (rc = get_int(J, im, "height", "$.outputs.image", 1, 16384, &h)) ||
-            (rc = get_int(J, im, "quality", "$.outputs.image", 0, 11, &q)))
+            (rc = get_int(J, im, "quality", "$.outputs.image", 0, 11, &q)) ||
+            (rc = get_int(J, im, "mesh", "$.outputs.image", 1, 1024, &mres)))
             return rc;
+        J->img_antialias = aa && cJSON_IsTrue(aa);
+        J->img_mesh = (int)mres;
         J->image = 1;
         J->img_w = (int)w;
         J->img_h = (int)h;

@@ -131,7 +131,7 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
     }
     if (!rc && J->pov) {
         snprintf(full, sizeof full, "%s/%s", J->outdir, names[k]);
-        lb_pov_options o = {0, 0, (double)J->pov_w / (double)J->pov_h, 0.0, threads};
+        lb_pov_options o = {0, 0, (double)J->pov_w / (double)J->pov_h, 0.0, threads, 0};
         hashed_out H;
         if (!(rc = hashed_open(full, &H))) {
             if ((s = lb_scene_write_pov_stream(sc, ev, &o, H.f, NULL, &e))) {
@@ -147,7 +147,8 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
         snprintf(full, sizeof full, "%s/%s", J->outdir, names[k]);
         bt_render_dir R;
         if ((rc = bt_render_dir_open(&R)) == 0) {
-            lb_pov_options o = {0, 0, (double)J->img_w / (double)J->img_h, 0.0, threads};
+            lb_pov_options o = {0,   0,       (double)J->img_w / (double)J->img_h,
+                                0.0, threads, J->img_mesh};
             if ((s = lb_scene_write_pov(sc, ev, &o, R.pov, NULL, &e)))
                 rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
             if (!rc) {
@@ -157,14 +158,17 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
                                       .quality = J->img_quality,
                                       .bits16 = J->img_plan.bits16,
                                       .alpha = J->img_plan.alpha,
-                                      .quiet = 1};
+                                      .quiet = 1,
+                                      .antialias = J->img_antialias};
                 rc = bt_povray(J->scenes[T->scene], &R, &P);
             }
             if (!rc) {
                 char hex[33], settings[128], err[1024] = "";
                 bt_hash_hex(scene_hash, hex);
-                snprintf(settings, sizeof settings, "%dx%d quality %d", J->img_w, J->img_h,
-                         J->img_quality);
+                char mesh[32] = "";
+                if (J->img_mesh) snprintf(mesh, sizeof mesh, " mesh %d", J->img_mesh);
+                snprintf(settings, sizeof settings, "%dx%d quality %d%s%s", J->img_w, J->img_h,
+                         J->img_quality, J->img_antialias ? " antialias" : "", mesh);
                 const lbi_meta meta[5] = {{"libblend:scene_hash", hex},
                                           {"libblend:version", BT_VERSION},
                                           {"libblend:render", settings},

@@ -84,7 +84,7 @@ int batch_make_task(const job *J, size_t id, task *T) {
         ++T->nsets;
         /* the label: the path's last part and the value, numbers to 4 digits */
         const char *last = strrchr(X->path, '.');
-        last = last ? last + 1 : X->path;
+        last = X->label[0] ? X->label : last ? last + 1 : X->path;
         char *endp = NULL;
         const double num = strtod(X->values[k], &endp);
         char val[64];
@@ -152,6 +152,7 @@ char *batch_identity(const job *J, const task *T, const uint64_t scene[2]) {
     cJSON *p = cJSON_AddArrayToObject(o, "parameters");
     for (size_t i = 0; i < T->nsets; ++i)
         cJSON_AddItemToArray(p, cJSON_CreateString(T->sets[i].path));
+    cJSON_AddStringToObject(o, "label", T->label); /* it is in the image's metadata */
     cJSON_AddStringToObject(o, "libblend", BT_VERSION);
     bt_hash_hex(J->spec_hash, hex);
     cJSON_AddStringToObject(o, "outputs_spec", hex);

@@ -76,6 +76,15 @@ LB_INTERNAL int lb__pov_written_id(pctx *c, const lb__node *n, const lb__affine 
 LB_INTERNAL lb_status lb__pov_local(pctx *c, const lb__node *n, int id, const char *name, int a,
                                     int d);
 
+/* ---- pov_mesh.c ---- */
+#define LB_POV_MAX_MESH_RESOLUTION 1024
+/* "mesh2 { vertex_vectors ... face_indices ... " of a mesh of ev over
+ * [lo, hi] at resolution cells (the caller writes the texture and the closing
+ * brace); nothing and *empty = 1 when the mesh has no triangle */
+LB_INTERNAL lb_status lb__pov_mesh(sbuf *b, const lb_evaluator *ev, const double lo[3],
+                                   const double hi[3], int resolution, int threads, int *empty,
+                                   lb_error *err);
+
 /* ---- pov_material.c ---- */
 #define LB_POV_MAX_TEXTURES 4096
 /* name (at least 24 bytes) receives the texture of n's surface (Ap: world

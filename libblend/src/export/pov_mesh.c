@@ -1,0 +1,50 @@
+/* The POV-Ray writer's mesh geometry (lb_pov_options.mesh_resolution): the
+ * surface as libblend's own closed mesh, written as a mesh2 of smooth
+ * triangles. POV-Ray stores a mesh's vertices and normals in single
+ * precision, so nine significant digits carry every bit it keeps. */
+#include "pov_internal.h"
+
+lb_status lb__pov_mesh(sbuf *b, const lb_evaluator *ev, const double lo[3], const double hi[3],
+                       int resolution, int threads, int *empty, lb_error *err) {
+    *empty = 0;
+    if (resolution < 1 || resolution > LB_POV_MAX_MESH_RESOLUTION)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: mesh_resolution %d; allowed: 1 to %d cells (0 for the isosurface)", FN,
+                        resolution, LB_POV_MAX_MESH_RESOLUTION);
+    lb_mesh_options mo;
+    lb_mesh_options_init(&mo);
+    for (int d = 0; d < 3; ++d) {
+        mo.bmin[d] = lo[d];
+        mo.bmax[d] = hi[d];
+    }
+    mo.resolution = (unsigned)resolution;
+    mo.threads = threads;
+    lb_mesh *m = NULL;
+    const lb_status s = lb_mesh_create(ev, &mo, &m, err);
+    if (s) return s;
+    const size_t nv = m->nvertices, nt = m->ntriangles;
+    if (!nt) {
+        /* POV-Ray refuses a mesh2 without faces: no object at all */
+        *empty = 1;
+        lb_mesh_free(m);
+        return LB_OK;
+    }
+    sb(b, "mesh2 {\n  vertex_vectors { %zu", nv);
+    for (size_t i = 0; i < nv; ++i) {
+        const double *p = m->positions + 3 * i;
+        sb(b, ",\n    <%.9g, %.9g, %.9g>", p[0], p[1], p[2]);
+    }
+    sb(b, " }\n  normal_vectors { %zu", nv);
+    for (size_t i = 0; i < nv; ++i) {
+        const double *n = m->normals + 3 * i;
+        sb(b, ",\n    <%.9g, %.9g, %.9g>", n[0], n[1], n[2]);
+    }
+    sb(b, " }\n  face_indices { %zu", nt);
+    for (size_t t = 0; t < nt; ++t) {
+        const uint32_t *v = m->triangles + 3 * t;
+        sb(b, ",\n    <%u, %u, %u>", (unsigned)v[0], (unsigned)v[1], (unsigned)v[2]);
+    }
+    sb(b, " }\n  ");
+    lb_mesh_free(m);
+    return LB_OK;
+}
