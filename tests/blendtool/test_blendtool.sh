@@ -24,7 +24,7 @@ out_has() { grep -qF -- "$1" "$T/out"; }
 run --help
 check "--help exits 0 and lists the commands" rc 0
 check "--help lists eval" out_has "eval"
-for c in validate info eval mesh pov render; do
+for c in validate info eval mesh pov render section; do
   run "$c" --help
   check "$c --help exits 0" rc 0
   check "$c --help prints its usage" out_has "usage: blendtool $c"

@@ -194,6 +194,9 @@ typedef struct bt_imageio {
                          char *err, size_t errlen);
     int (*compare)(const char *a, const char *b, double fail, double *max_error, double *mean_error,
                    double *fail_percent, char *err, size_t errlen);
+    int (*write_pixels)(const float *rgb, int w, int h, const lbi_text *texts, size_t ntexts,
+                        lbi_format format, const lbi_meta *meta, size_t nmeta, unsigned char **data,
+                        size_t *size, char *err, size_t errlen);
 } bt_imageio;
 
 /* The image functions, or NULL after printing why they cannot be loaded. */
@@ -229,6 +232,6 @@ int bt_png_direct(const char *in, const lbi_meta *meta, size_t nmeta, unsigned c
 int bt_wants_help(int argc, char **argv);
 
 extern const bt_command bt_cmd_validate, bt_cmd_info, bt_cmd_eval, bt_cmd_mesh, bt_cmd_pov,
-    bt_cmd_render, bt_cmd_batch, bt_cmd_compare;
+    bt_cmd_render, bt_cmd_batch, bt_cmd_compare, bt_cmd_section;
 
 #endif

@@ -55,7 +55,10 @@ const bt_imageio *bt_imageio_try(char *why, size_t whylen) {
                                  char *, size_t))dlsym(h, "lbi_contact_sheet");
     api.compare = (int (*)(const char *, const char *, double, double *, double *, double *, char *,
                            size_t))dlsym(h, "lbi_compare");
-    if (!api.convert || !api.contact_sheet || !api.compare) {
+    api.write_pixels =
+        (int (*)(const float *, int, int, const lbi_text *, size_t, lbi_format, const lbi_meta *,
+                 size_t, unsigned char **, size_t *, char *, size_t))dlsym(h, "lbi_write_pixels");
+    if (!api.convert || !api.contact_sheet || !api.compare || !api.write_pixels) {
         snprintf(why, whylen,
                  "the image module %s lacks its functions (not the one built "
                  "with this blendtool)",

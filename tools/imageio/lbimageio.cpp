@@ -150,6 +150,27 @@ extern "C" int lbi_contact_sheet(const char *const *images, const char *const *l
     return write_buf(sheet, format, meta, nmeta, data, size, err, errlen);
 }
 
+extern "C" int lbi_write_pixels(const float *rgb, int w, int h, const lbi_text *texts,
+                                size_t ntexts, lbi_format format, const lbi_meta *meta,
+                                size_t nmeta, unsigned char **data, size_t *size, char *err,
+                                size_t errlen) {
+    if (!rgb || !data || !size || w < 1 || h < 1 || (double)w * (double)h > (double)LBI_MAX_PIXELS)
+        return fail(err, errlen, "lbi_write_pixels: no pixels or a bad size");
+    ImageBuf buf(ImageSpec(w, h, 3, TypeDesc::FLOAT), (void *)rgb);
+    ImageBuf img(buf.spec());
+    if (!ImageBufAlgo::copy(img, buf)) return fail(err, errlen, "OpenImageIO: " + img.geterror());
+    const char *font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+    for (size_t i = 0; i < ntexts; ++i) {
+        if (!texts || !texts[i].text || !*texts[i].text) continue;
+        if (!ImageBufAlgo::render_text(img, texts[i].x, texts[i].y, texts[i].text, texts[i].size,
+                                       font, texts[i].rgb))
+            return fail(err, errlen,
+                        "OpenImageIO text (font " + std::string(font) +
+                            ", Debian package fonts-dejavu-core): " + img.geterror());
+    }
+    return write_buf(img, format, meta, nmeta, data, size, err, errlen);
+}
+
 extern "C" int lbi_compare(const char *a, const char *b, double failv, double *max_error,
                            double *mean_error, double *fail_percent, char *err, size_t errlen) {
     if (!a || !b) return fail(err, errlen, "lbi_compare: NULL argument");

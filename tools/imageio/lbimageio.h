@@ -41,6 +41,21 @@ int lbi_contact_sheet(const char *const *images, const char *const *labels, size
                       int cell_w, int cell_h, lbi_format format, const lbi_meta *meta, size_t nmeta,
                       unsigned char **data, size_t *size, char *err, size_t errlen);
 
+/* A text drawn onto an image: its baseline starts at (x, y) in pixels,
+ * size in pixels, colour sRGB-encoded in [0, 1]. */
+typedef struct lbi_text {
+    const char *text;
+    int x, y, size;
+    float rgb[3];
+} lbi_text;
+
+/* An image from the caller's pixels: w x h RGB, row by row from the top,
+ * sRGB-encoded values in [0, 1], with the texts drawn on it (DejaVu Sans),
+ * written as format (PNG; EXR stores the same encoded values). */
+int lbi_write_pixels(const float *rgb, int w, int h, const lbi_text *texts, size_t ntexts,
+                     lbi_format format, const lbi_meta *meta, size_t nmeta, unsigned char **data,
+                     size_t *size, char *err, size_t errlen);
+
 /* Compare two images channel by channel (OpenImageIO's compare): *max_error
  * the largest difference, *fail_percent the share of pixels with a channel
  * differing by more than fail. Different sizes or channel counts are an
