@@ -104,6 +104,16 @@ static void shorten_numbers(sbuf *b) {
     while (r < b->n) {
         const char ch = b->s[r];
         if (ch == '/' && r + 1 < b->n && b->s[r + 1] == '/') { /* a comment: copied as is */
+            /* a mesh's data: its numbers are already single-precision
+             * short (and millions), copied as is to the end marker */
+            const size_t lb = sizeof LB_POV_VERBATIM_BEGIN - 1;
+            if (b->n - r >= lb && memcmp(b->s + r, LB_POV_VERBATIM_BEGIN, lb) == 0) {
+                const char *end = strstr(b->s + r, LB_POV_VERBATIM_END);
+                const size_t stop = end ? (size_t)(end - b->s) : b->n;
+                memmove(b->s + w, b->s + r, stop - r);
+                w += stop - r;
+                r = stop;
+            }
             while (r < b->n && b->s[r] != '\n') b->s[w++] = b->s[r++];
             continue;
         }

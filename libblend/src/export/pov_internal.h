@@ -78,6 +78,9 @@ LB_INTERNAL lb_status lb__pov_local(pctx *c, const lb__node *n, int id, const ch
 
 /* ---- pov_mesh.c ---- */
 #define LB_POV_MAX_MESH_RESOLUTION 1024
+/* comment lines around text the number shortener leaves as it is */
+#define LB_POV_VERBATIM_BEGIN "// libblend mesh data:"
+#define LB_POV_VERBATIM_END "// end of libblend mesh data"
 /* "mesh2 { vertex_vectors ... face_indices ... " of a mesh of ev over
  * [lo, hi] at resolution cells (the caller writes the texture and the closing
  * brace); nothing and *empty = 1 when the mesh has no triangle */

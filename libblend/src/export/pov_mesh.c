@@ -29,7 +29,8 @@ lb_status lb__pov_mesh(sbuf *b, const lb_evaluator *ev, const double lo[3], cons
         lb_mesh_free(m);
         return LB_OK;
     }
-    sb(b, "mesh2 {\n  vertex_vectors { %zu", nv);
+    sb(b, "%s %zu vertices, %zu triangles at %d cells\nmesh2 {\n  vertex_vectors { %zu",
+       LB_POV_VERBATIM_BEGIN, nv, nt, resolution, nv);
     for (size_t i = 0; i < nv; ++i) {
         const double *p = m->positions + 3 * i;
         sb(b, ",\n    <%.9g, %.9g, %.9g>", p[0], p[1], p[2]);
@@ -44,7 +45,7 @@ lb_status lb__pov_mesh(sbuf *b, const lb_evaluator *ev, const double lo[3], cons
         const uint32_t *v = m->triangles + 3 * t;
         sb(b, ",\n    <%u, %u, %u>", (unsigned)v[0], (unsigned)v[1], (unsigned)v[2]);
     }
-    sb(b, " }\n  ");
+    sb(b, " }\n" LB_POV_VERBATIM_END "\n  ");
     lb_mesh_free(m);
     return LB_OK;
 }
