@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Builds docs/gallery/ (docs/gallery/README.md): every job in
-# docs/gallery/jobs/ rendered by blendtool batch with POV-Ray (240 x 180 per
-# panel) and assembled by OpenImageIO into one labelled contact sheet per
-# figure; the panels and the sheet are copied to docs/gallery/NAME/.
-# tests/gallery/test_gallery.py regenerates them at half size and compares.
+# docs/gallery/jobs/ rendered by blendtool batch with POV-Ray (480 x 360 per
+# panel, antialiased, libblend's mesh at the job's resolution) and assembled
+# by OpenImageIO into one labelled contact sheet per figure; the panels and
+# the sheet are copied to docs/gallery/NAME/.
+# The field sections of docs/gallery/sections.json go to docs/gallery/sections/.
+# tests/gallery/test_gallery.py regenerates them (panels at half size) and compares.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake -S . -B build-release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -19,3 +21,8 @@ for job in docs/gallery/jobs/*.json; do
   mv "docs/gallery/$name.tmp" "docs/gallery/$name"
   echo "gallery: docs/gallery/$name/${name}_sheet.png"
 done
+# the field sections (2D plots of the contours, docs/gallery/sections.json)
+rm -rf docs/gallery/sections.tmp
+/usr/bin/python3 scripts/gallery_sections.py build-release/tools/blendtool . docs/gallery/sections.tmp
+rm -rf docs/gallery/sections
+mv docs/gallery/sections.tmp docs/gallery/sections
