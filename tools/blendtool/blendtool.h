@@ -51,6 +51,10 @@ const char *bt_last_error(void);
  * (advancing *i past the value), 0 when it is not, -1 (after printing an
  * error) when the value is missing. */
 int bt_option(const char *cmd, int argc, char **argv, int *i, const char *name, const char **value);
+/* An argument that is no known option: an unknown option ("-x", "--y"; "-"
+ * is a name) or the scene, which may be given once. Returns 0 with *scene
+ * set, or -1 after printing which. */
+int bt_scene_arg(const char *cmd, const char *arg, const char **scene);
 
 /* Parse the value of an integer option: the whole text a decimal integer in
  * [lo, hi]. Returns 0 and sets *out, or prints "OPTION TEXT: expected WHAT,

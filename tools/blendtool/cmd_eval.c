@@ -147,15 +147,8 @@ static int run_eval(int argc, char **argv) {
                    (r = bt_option(cmd, argc, argv, &i, "-o", &v))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
             out_path = v;
-        } else if (argv[i][0] == '-' && argv[i][1]) {
-            bt_error(cmd, "unknown option %s; see blendtool eval --help", argv[i]);
+        } else if (bt_scene_arg(cmd, argv[i], &scene_path)) {
             return BT_EXIT_BAD_INPUT;
-        } else if (scene_path) {
-            bt_error(cmd, "more than one scene given (%s, %s); eval takes one", scene_path,
-                     argv[i]);
-            return BT_EXIT_BAD_INPUT;
-        } else {
-            scene_path = argv[i];
         }
     }
     if (!scene_path) {

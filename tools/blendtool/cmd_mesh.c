@@ -123,13 +123,7 @@ static int parse_args(int argc, char **argv, mesh_args *A) {
             A->o.flags |= LB_MESH_TETRAHEDRA;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
             A->quiet = 1;
-        } else if (argv[i][0] == '-' && argv[i][1]) {
-            bt_error(CMD, "unknown option %s; see blendtool mesh --help", argv[i]);
-            return BT_EXIT_BAD_INPUT;
-        } else if (!A->scene_path) {
-            A->scene_path = argv[i];
-        } else {
-            bt_error(CMD, "more than one scene (%s, %s); allowed: one", A->scene_path, argv[i]);
+        } else if (bt_scene_arg(CMD, argv[i], &A->scene_path)) {
             return BT_EXIT_BAD_INPUT;
         }
     }

@@ -72,13 +72,7 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
             if (bt_set_parse(cmd, v, &a->sets[a->nsets++])) return -1;
         } else if (strcmp(argv[i], "--silhouette") == 0) {
             a->silhouette = 1;
-        } else if (argv[i][0] == '-' && argv[i][1]) {
-            bt_error(cmd, "unknown option %s; see blendtool %s --help", argv[i], cmd);
-            return -1;
-        } else if (!a->scene) {
-            a->scene = argv[i];
-        } else {
-            bt_error(cmd, "more than one scene (%s, %s); allowed: one", a->scene, argv[i]);
+        } else if (bt_scene_arg(cmd, argv[i], &a->scene)) {
             return -1;
         }
     }

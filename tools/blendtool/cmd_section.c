@@ -109,13 +109,7 @@ static int parse(int argc, char **argv, secargs *a) {
                 return -1;
             }
             if (bt_set_parse(cmd, v, &a->sets[a->nsets++])) return -1;
-        } else if (argv[i][0] == '-' && argv[i][1]) {
-            bt_error(cmd, "unknown option %s; see blendtool section --help", argv[i]);
-            return -1;
-        } else if (!a->scene) {
-            a->scene = argv[i];
-        } else {
-            bt_error(cmd, "more than one scene (%s, %s); allowed: one", a->scene, argv[i]);
+        } else if (bt_scene_arg(cmd, argv[i], &a->scene)) {
             return -1;
         }
     }

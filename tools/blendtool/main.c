@@ -65,6 +65,19 @@ int bt_option(const char *cmd, int argc, char **argv, int *i, const char *name,
     return 1;
 }
 
+int bt_scene_arg(const char *cmd, const char *arg, const char **scene) {
+    if (arg[0] == '-' && arg[1]) {
+        bt_error(cmd, "unknown option %s; see blendtool %s --help", arg, cmd);
+        return -1;
+    }
+    if (*scene) {
+        bt_error(cmd, "more than one scene (%s, %s); allowed: one", *scene, arg);
+        return -1;
+    }
+    *scene = arg;
+    return 0;
+}
+
 int bt_parse_long(const char *cmd, const char *option, const char *text, long lo, long hi,
                   const char *what, long *out) {
     char *end = NULL;
