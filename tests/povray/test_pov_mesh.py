@@ -28,10 +28,10 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from checks import check, failures, read_ppm  # noqa: E402
+from checks import args, check, failures, read_ppm  # noqa: E402
 
-BT, SRC, WORK = (os.path.abspath(a) for a in sys.argv[1:4])
-shutil.rmtree(WORK, ignore_errors=True)
+BT, SRC, WORK = (os.path.abspath(a) for a in args())
+shutil.rmtree(WORK)
 os.makedirs(WORK)
 W, H = 160, 120
 RES = 128
