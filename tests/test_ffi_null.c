@@ -306,6 +306,17 @@ static lb_status c_mesh_edges(unsigned mask, int size, lb_error *err, int *hs) {
     free(corner);
     return s;
 }
+static lb_status c_velocities(unsigned mask, int size, lb_error *err, int *hs) {
+    *hs = 1;
+    double *v = malloc(3 * C.mesh->nvertices * sizeof *v + 1);
+    assert_non_null(v);
+    /* size picks dt: 0 (refused), 0.1, and a huge step */
+    const double dt = size == 0 ? 0.0 : size == 1 ? 0.1 : 1e300;
+    lb_status s = lb_mesh_velocities(P(0, C.ev), P(1, C.ev), P(2, C.ev), P(3, C.mesh), dt, 1,
+                                     P(4, v), P(5, err));
+    free(v);
+    return s;
+}
 static lb_status c_mesh_write(unsigned mask, int size, lb_error *err, int *hs) {
     *hs = 1;
     char path[128];
@@ -388,6 +399,7 @@ static const fn_case CASES[] = {
     {"lb_mesh_create", 4, 0x07, c_mesh},
     {"lb_mesh_write / _stream", 4, 0x07, c_mesh_write},
     {"lb_mesh_edges", 5, 0x0f, c_mesh_edges},
+    {"lb_mesh_velocities", 6, 0x19, c_velocities},
     {"lb_scene_write_pov", 6, 0x0b, c_pov},
     {"lb_output_*", 5, 0x03, c_output},
 };

@@ -109,6 +109,23 @@ LB_API void lb_mesh_free(lb_mesh *mesh);
 LB_API lb_status lb_mesh_edges(const lb_mesh *mesh, uint32_t *edges, uint32_t *corner_edge,
                                size_t *nedges, lb_error *err);
 
+/* Per-vertex velocities of a moving surface, for motion blur
+ * (meshing/velocity.c). mesh is a mesh of ev's surface at time t; before and
+ * after are the same scene at t - dt and t + dt (either may be NULL, not
+ * both; they must have ev's convention). Each vertex gets the velocity of the
+ * surface along its normal, -(df/dt) grad f / |grad f|^2 with df/dt a
+ * central difference of before and after at the vertex (one-sided with one
+ * of them), in scene units per unit of t; the motion along the surface
+ * cannot be seen in the field and is zero. A vertex without a gradient or a
+ * finite value gets zero. It is first order: a surface that moves further
+ * than its features' size within dt, or appears or vanishes, gets velocities
+ * that say little. velocities (the caller's) has room for 3 * nvertices
+ * values. threads as lb_evaluator_eval. Fails with LB_ERR_INVALID_ARGUMENT
+ * for NULL pointers, dt not finite and > 0, or conventions that differ. */
+LB_API lb_status lb_mesh_velocities(const lb_evaluator *ev, const lb_evaluator *before,
+                                    const lb_evaluator *after, const lb_mesh *mesh, double dt,
+                                    int threads, double *velocities, lb_error *err);
+
 typedef enum lb_mesh_format {
     LB_MESH_FORMAT_AUTO = 0, /* from the file name's extension */
     LB_MESH_FORMAT_PLY = 1,  /* binary little-endian PLY, float positions and normals */
