@@ -133,6 +133,8 @@ _SIGNATURES = {
     "lb_mesh_edges": (ctypes.c_int, [ctypes.POINTER(_Mesh), _U32, _U32,
                                      ctypes.POINTER(ctypes.c_size_t), _ERR]),
     "lb_mesh_write": (ctypes.c_int, [ctypes.POINTER(_Mesh), ctypes.c_char_p, ctypes.c_int, _ERR]),
+    "lb_mesh_velocities": (ctypes.c_int, [_P, _P, _P, ctypes.POINTER(_Mesh), ctypes.c_double,
+                                          ctypes.c_int, _D, _ERR]),
     "lb_render_three_point": (None, [_D, _D, _D, ctypes.POINTER(_Light)]),
     "lb_render_floor_height": (ctypes.c_int, [_P, _D, _D, _D, ctypes.c_int, _D, _ERR]),
     "lb_scene_write_pov": (ctypes.c_int, [_P, _P, ctypes.POINTER(_PovOptions), ctypes.c_char_p,
@@ -438,6 +440,26 @@ class Evaluator(_Handle):
                                              ctypes.byref(flags), ctypes.byref(err))
         self.lib._check(st, err, "extent")
         return tuple(lo), tuple(hi), flags.value
+
+    def velocities(self, positions, before=None, after=None, dt=1.0, threads=0):
+        """(n, 3) velocities of this field's surface at positions (n, 3), points
+        on it (a mesh's vertices), from the same scene's evaluators at t - dt
+        (before) and t + dt (after), either may be None, not both; in scene
+        units per unit of dt (lb_mesh_velocities: the normal motion)."""
+        _need_numpy()
+        P = np.ascontiguousarray(np.asarray(positions, dtype=np.float64))
+        if P.ndim != 2 or P.shape[1] != 3:
+            raise LibblendError("positions: shape %s; allowed: (n, 3)" % (P.shape,), 1)
+        m = _Mesh()
+        m.nvertices, m.ntriangles = len(P), 0
+        m.positions = _dptr(P)
+        v = np.empty((len(P), 3))
+        err = _Error()
+        st = self.lib._c.lb_mesh_velocities(self.ptr, before.ptr if before else None,
+                                            after.ptr if after else None, ctypes.byref(m),
+                                            float(dt), int(threads), _dptr(v), ctypes.byref(err))
+        self.lib._check(st, err, "velocities")
+        return v
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
              max_memory=0, cancel=None, edges=False):

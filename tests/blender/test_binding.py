@@ -170,6 +170,23 @@ with lib.load_scene(fig7) as sc, sc.compile() as ev7:
     raises(lambda: sc.write_pov(ev7, meshed, mesh_resolution=5000), binding.LibblendError,
            "mesh_resolution 5000")
 
+# ---- velocities (lb_mesh_velocities): the sphere moved by +-dt s, at its
+# mesh's vertices: the normal part (s . n) n of the speed s, to 1 %
+s_vel, dt = np.array([0.6, -0.3, 0.2]), 1e-3
+def moved(k):
+    return lib.parse_scene(SPHERE.replace('"center": [0.5, -0.25, 0.125]', '"center": [%r, %r, %r]'
+                                          % tuple(c + k * dt * s_vel)), "moved.json").compile()
+with moved(-1) as evb, moved(1) as eva:
+    m = ev.mesh((-1, -2, -1.5), (2, 1.5, 1.5), resolution=32, threads=1)
+    V = ev.velocities(m.positions, before=evb, after=eva, dt=dt, threads=1)
+    N = (m.positions - c) / np.linalg.norm(m.positions - c, axis=1)[:, None]
+    want = (N @ s_vel)[:, None] * N
+    worst = float(np.abs(V - want).max())
+    check(V.shape == m.positions.shape and worst < 0.01 * np.linalg.norm(s_vel),
+          "velocities: worst error %.2e of the speed %.2f" % (worst, np.linalg.norm(s_vel)))
+    raises(lambda: ev.velocities(m.positions, dt=dt), binding.LibblendError, "lb_mesh_velocities")
+    raises(lambda: ev.velocities(m.positions, after=eva, dt=0.0), binding.LibblendError, "dt")
+
 # ---- errors
 raises(lambda: lib.parse_scene('{"format": "libblend-scene",\n "version": 1, }', "a.json"),
        binding.LibblendError, "a.json:2:", "invalid JSON")

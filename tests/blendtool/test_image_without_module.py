@@ -6,7 +6,7 @@ replaces its time stamp and text chunks with the libblend metadata
 (png_direct.c). Checked here against an independent reading of the PNG
 (Python's zlib for every CRC and for the pixels) and against the render of
 the same scene through the module (the normal build): the same pixels.
-OpenEXR and contact sheets are refused before anything is written.
+OpenEXR, contact sheets and `section` are refused with nothing written.
 
 usage: test_image_without_module.py BLENDTOOL SOURCE_DIR WORK_DIR
 """
@@ -161,6 +161,15 @@ if r.returncode != 2 or "bad.json" not in err or "radius" not in err:
     fail(f"a bad scene with an EXR output without the module: exit {r.returncode}, {err[-300:]!r}")
 if os.path.exists(exr):
     fail("the bad scene's EXR render wrote a file")
+
+# section draws through the module only: exit 1 naming it, nothing written
+sec = os.path.join(WORK, "section.png")
+r = run(BARE, "section", SCENE, "-o", sec, "--plane", "z=0", "--width", "64", "--height", "64")
+err = r.stderr.decode(errors="replace")
+if r.returncode != 1 or "cannot load the image module" not in err:
+    fail(f"section without the module: exit {r.returncode}, {err[-300:]!r}")
+if os.path.exists(sec):
+    fail("the refused section wrote a file")
 
 # batch: PNG images work; a contact sheet is refused before any folder exists
 for sheet in (False, True):
