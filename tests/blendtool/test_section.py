@@ -13,7 +13,8 @@ value, against closed forms.
   label; the metadata names the section and the parameters.
 - Bad input: no --plane, --plane w=1, --region with U0 >= U1, --width 10,
   --sweep with 9 values or no list, a --label with a space, a path the scene
-  does not have: exit 2, the option or path named, no output.
+  does not have, a scene without bounds and no --region: exit 2, the option
+  or path named, no output.
 
 usage: test_section.py BLENDTOOL SOURCE_DIR WORK_DIR
 """
@@ -133,6 +134,18 @@ for extra, word in ((["--region", REGION], "--plane"),
     check(r.returncode == 2 and word in r.stderr, "%s: exit %d, %s" %
           (" ".join(extra), r.returncode, r.stderr.strip()[:200]))
     check(not os.path.exists(bad), "%s: no output" % " ".join(extra))
+
+# a scene without bounds needs a --region
+nob = os.path.join(WORK, "nobounds.json")
+json.dump({"format": "libblend-scene", "version": 1, "convention": "zero",
+           "root": {"type": "sphere", "center": [0, 0, 0], "radius": 1}}, open(nob, "w"))
+bad = os.path.join(WORK, "nobounds.png")
+r = run(nob, "-o", bad, "--plane", "z=0")
+check(r.returncode == 2 and "no bounds" in r.stderr and "--region" in r.stderr,
+      "no bounds: exit %d, %s" % (r.returncode, r.stderr.strip()[:200]))
+check(not os.path.exists(bad), "no bounds: no output")
+r = run(nob, "-o", bad, "--plane", "z=0", "--region", REGION, "--width", W, "--height", H)
+check(r.returncode == 0 and os.path.exists(bad), "no bounds but --region: %s" % r.stderr)
 
 if failures:
     sys.exit(1)

@@ -359,7 +359,7 @@ static int parse_outputs(job *J, const cJSON *o) {
         if ((rc = get_int(J, im, "width", "$.outputs.image", 1, 16384, &w)) ||
             (rc = get_int(J, im, "height", "$.outputs.image", 1, 16384, &h)) ||
             (rc = get_int(J, im, "quality", "$.outputs.image", 0, 11, &q)) ||
-            (rc = get_int(J, im, "mesh", "$.outputs.image", 1, 1024, &mres)))
+            (rc = get_int(J, im, "mesh", "$.outputs.image", 1, LB_POV_MAX_MESH_RESOLUTION, &mres)))
             return rc;
         J->img_antialias = aa && cJSON_IsTrue(aa);
         J->img_mesh = (int)mres;

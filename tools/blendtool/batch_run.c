@@ -151,24 +151,19 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
                                 0.0, threads, J->img_mesh};
             if ((s = lb_scene_write_pov(sc, ev, &o, R.pov, NULL, &e)))
                 rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
-            if (!rc) {
-                const bt_pov_run P = {.width = J->img_w,
-                                      .height = J->img_h,
-                                      .threads = threads ? threads : 1,
-                                      .quality = J->img_quality,
-                                      .bits16 = J->img_plan.bits16,
-                                      .alpha = J->img_plan.alpha,
-                                      .quiet = 1,
-                                      .antialias = J->img_antialias};
-                rc = bt_povray(J->scenes[T->scene], &R, &P);
-            }
+            const bt_pov_run P = {.width = J->img_w,
+                                  .height = J->img_h,
+                                  .threads = threads ? threads : 1,
+                                  .quality = J->img_quality,
+                                  .bits16 = J->img_plan.bits16,
+                                  .alpha = J->img_plan.alpha,
+                                  .quiet = 1,
+                                  .antialias = J->img_antialias};
+            if (!rc) rc = bt_povray(J->scenes[T->scene], &R, &P);
             if (!rc) {
                 char hex[33], settings[128], err[1024] = "";
                 bt_hash_hex(scene_hash, hex);
-                char mesh[32] = "";
-                if (J->img_mesh) snprintf(mesh, sizeof mesh, " mesh %d", J->img_mesh);
-                snprintf(settings, sizeof settings, "%dx%d quality %d%s%s", J->img_w, J->img_h,
-                         J->img_quality, J->img_antialias ? " antialias" : "", mesh);
+                bt_render_settings(settings, sizeof settings, &P, 0, J->img_mesh);
                 const lbi_meta meta[5] = {{"libblend:scene_hash", hex},
                                           {"libblend:version", BT_VERSION},
                                           {"libblend:render", settings},

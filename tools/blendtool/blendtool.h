@@ -178,6 +178,11 @@ typedef struct bt_pov_run {
  * Returns an exit code, after printing a message naming scene_name on
  * failure. */
 int bt_povray(const char *scene_name, const bt_render_dir *R, const bt_pov_run *P);
+/* The image's libblend:render metadata for P's size, quality and
+ * antialiasing, a silhouette and a mesh resolution (0: the isosurface):
+ * "640x480 quality 9[ silhouette][ antialias][ mesh N]", the same words for
+ * `render` and `batch`. */
+void bt_render_settings(char *out, size_t len, const bt_pov_run *P, int silhouette, int mesh);
 
 /* The lbi_format for an image name (.png: --bits 8|16, .exr: --pixel
  * half|float; 0 / NULL: the defaults), or -1 after printing why. */

@@ -60,7 +60,8 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
         } else if (render && strcmp(argv[i], "--antialias") == 0) {
             a->antialias = 1;
         } else if ((r = bt_option(cmd, argc, argv, &i, "--mesh", &v))) {
-            if (r < 0 || parse_int(cmd, "--mesh", v, 1, 1024, &a->mesh)) return -1;
+            if (r < 0 || parse_int(cmd, "--mesh", v, 1, LB_POV_MAX_MESH_RESOLUTION, &a->mesh))
+                return -1;
         } else if (!render && strcmp(argv[i], "--include-only") == 0) {
             a->include_only = 1;
         } else if ((r = bt_option(cmd, argc, argv, &i, "--set", &v))) {
@@ -103,12 +104,9 @@ static int export(const char *cmd, const povargs *a, FILE *f, const char *out_na
         return rc;
     }
     lb_error e = {LB_OK, ""};
-    const lb_pov_options o = {a->include_only,
-                              a->silhouette,
-                              (double)a->width / (double)a->height,
-                              0.0,
-                              a->threads,
-                              a->include_only ? 0 : a->mesh};
+    const lb_pov_options o = {
+        a->include_only, a->silhouette, (double)a->width / (double)a->height, 0.0,
+        a->threads,      a->mesh};
     const lb_status s = lb_scene_write_pov_stream(sc, ev, &o, f, NULL, &e);
     if (s == LB_ERR_IO) {
         bt_error(cmd, "%s: writing the POV-Ray scene failed (%s); nothing was written", out_name,
@@ -162,20 +160,15 @@ static int run_render(int argc, char **argv) {
      * PNG): asked once the scene is known to be good, so a bad scene is
      * exit 2 whatever the output format */
     if (!rc && bt_image_plan_for("render", a.out, fmt, a.alpha, &plan)) rc = BT_EXIT_INTERNAL;
-    if (!rc) {
-        const bt_pov_run P = {a.width,     a.height,   a.threads, a.quality,
-                              plan.bits16, plan.alpha, a.quiet,   a.antialias};
-        rc = bt_povray(a.scene, &R, &P);
-    }
+    const bt_pov_run P = {a.width,     a.height,   a.threads, a.quality,
+                          plan.bits16, plan.alpha, a.quiet,   a.antialias};
+    if (!rc) rc = bt_povray(a.scene, &R, &P);
     unsigned char *img = NULL;
     size_t len = 0;
     if (!rc) {
         char hex[33], settings[128], params[4096], err[1024] = "";
         bt_hash_hex(hash, hex);
-        char mesh[32] = "";
-        if (a.mesh) snprintf(mesh, sizeof mesh, " mesh %d", a.mesh);
-        snprintf(settings, sizeof settings, "%dx%d quality %d%s%s%s", a.width, a.height, a.quality,
-                 a.silhouette ? " silhouette" : "", a.antialias ? " antialias" : "", mesh);
+        bt_render_settings(settings, sizeof settings, &P, a.silhouette, a.mesh);
         size_t o = 0;
         params[0] = '\0';
         for (size_t i = 0; i < a.nsets && o + 1 < sizeof params; ++i) {

@@ -123,8 +123,8 @@ static int parse(int argc, char **argv, secargs *a) {
     return 0;
 }
 
-/* "PATH=[v1, v2, ...]": the path and each value's JSON text (freed by the
- * caller with free_values) */
+/* "PATH=[v1, v2, ...]": the path and each value's JSON text (malloc'd, freed
+ * by the caller) */
 static int parse_sweep(const char *arg, char *path, size_t plen, char **values, size_t *n) {
     const char *eq = strchr(arg, '=');
     *n = 0;
@@ -150,16 +150,16 @@ static int parse_sweep(const char *arg, char *path, size_t plen, char **values, 
     return 0;
 }
 
-/* the field over the plot's pixel centres, with the in-plane gradient */
+/* the plot's pixel centres, and the field and its gradient there */
 typedef struct plotgrid {
-    int w, h;
     double *x, *y, *z, *f, *g[3];
 } plotgrid;
 
 static int run(int argc, char **argv) {
     secargs a = {.width = 640, .height = 480, .axis = -1};
     if (parse(argc, argv, &a)) return BT_EXIT_BAD_INPUT;
-    if (bt_image_format("section", a.out, 8, NULL) < 0) return BT_EXIT_BAD_INPUT;
+    const int fmt = bt_image_format("section", a.out, 8, NULL);
+    if (fmt < 0) return BT_EXIT_BAD_INPUT;
     char path[512] = "", *values[SECTION_MAX_VALUES] = {0};
     size_t nv = 0;
     int rc = 0;
@@ -172,7 +172,7 @@ static int run(int argc, char **argv) {
     const size_t n = (size_t)W * (size_t)H;
     double *mem = rc ? NULL : malloc(7 * n * sizeof *mem);
     if (!rc && (!px || !mem)) rc = BT_EXIT_INTERNAL;
-    plotgrid G = {W, H, NULL, NULL, NULL, NULL, {NULL, NULL, NULL}};
+    plotgrid G = {NULL, NULL, NULL, NULL, {NULL, NULL, NULL}};
     if (!rc) {
         G.x = mem, G.y = G.x + n, G.z = G.y + n, G.f = G.z + n;
         G.g[0] = G.f + n, G.g[1] = G.g[0] + n, G.g[2] = G.g[1] + n;
@@ -212,7 +212,10 @@ static int run(int argc, char **argv) {
                              "%s: the scene has no bounds; allowed: a scene with "
                              "\"bounds\", or --region U0,V0,U1,V1",
                              a.scene);
+                    lb_evaluator_free(ev);
+                    lb_scene_free(sc);
                     rc = BT_EXIT_BAD_INPUT;
+                    break;
                 }
                 r[0] = bmin[U], r[1] = bmin[V], r[2] = bmax[U], r[3] = bmax[V];
             }
@@ -231,9 +234,8 @@ static int run(int argc, char **argv) {
                 }
         }
         lb_error e = {LB_OK, ""};
-        lb_status s = rc ? LB_OK
-                         : lb_evaluator_eval(ev, n, G.x, G.y, G.z, G.f, G.g[0], G.g[1], G.g[2],
-                                             a.threads, &e);
+        const lb_status s =
+            lb_evaluator_eval(ev, n, G.x, G.y, G.z, G.f, G.g[0], G.g[1], G.g[2], a.threads, &e);
         if (s) rc = bt_fail("section", a.scene, s, &e);
         const int soft = lb_scene_convention(sc) == LB_CONVENTION_SOFT;
         const double level = soft ? 0.5 : 0.0;
@@ -294,7 +296,6 @@ static int run(int argc, char **argv) {
                                   {"libblend:version", BT_VERSION},
                                   {"libblend:render", settings},
                                   {"libblend:parameters", params}};
-        const int fmt = bt_image_format("section", a.out, 8, NULL);
         if (io->write_pixels(px, W, HT, texts, nt, (lbi_format)fmt, meta, 4, &img, &len, err,
                              sizeof err)) {
             bt_error("section", "%s: writing the image failed: %s", a.out, err);

@@ -49,6 +49,13 @@ static void remove_stale_renders(void) {
     closedir(d);
 }
 
+void bt_render_settings(char *out, size_t len, const bt_pov_run *P, int silhouette, int mesh) {
+    char m[32] = "";
+    if (mesh) snprintf(m, sizeof m, " mesh %d", mesh);
+    snprintf(out, len, "%dx%d quality %d%s%s%s", P->width, P->height, P->quality,
+             silhouette ? " silhouette" : "", P->antialias ? " antialias" : "", m);
+}
+
 int bt_povray(const char *scene_name, const bt_render_dir *R, const bt_pov_run *P) {
     char outw[64], outh[64], th[64], q[32], dir[4096];
     if (bt_povray_include("render", dir, sizeof dir)) return BT_EXIT_INTERNAL;

@@ -35,6 +35,8 @@ extern "C" {
 #define LB_POV_MAX_ARITY 16
 #define LB_POV_GRADIENT_SAMPLES 48
 #define LB_POV_GRADIENT_SAFETY 1.25
+/* the largest lb_pov_options.mesh_resolution */
+#define LB_POV_MAX_MESH_RESOLUTION 1024
 
 typedef struct lb_pov_options {
     int include_only;    /* 1: only the #declare'd functions: the root is LB_Field, and

@@ -77,7 +77,6 @@ LB_INTERNAL lb_status lb__pov_local(pctx *c, const lb__node *n, int id, const ch
                                     int d);
 
 /* ---- pov_mesh.c ---- */
-#define LB_POV_MAX_MESH_RESOLUTION 1024
 /* comment lines around text the number shortener leaves as it is */
 #define LB_POV_VERBATIM_BEGIN "// libblend mesh data:"
 #define LB_POV_VERBATIM_END "// end of libblend mesh data"
