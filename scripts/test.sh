@@ -24,7 +24,12 @@ for cfg in "build-release:-DCMAKE_BUILD_TYPE=Release -DLIBBLEND_TOOLS_SYSROOT=$O
   # shellcheck disable=SC2086
   cmake -S . -B "$dir" -G Ninja $flags
   cmake --build "$dir" -j "$JOBS"
-  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+  # intercept_tls_get_addr=0: GCC 12's LeakSanitizer records a bogus dynamic-TLS
+  # range for the dlopen'd OpenImageIO module now and then, and its tracer then
+  # crashes at exit ("Tracer caught signal 11", DTLS at 0x2021; 3 of 140 loaded
+  # runs of render --mesh, 0 of 160 with it off). Leaks are still found: the
+  # dynamic TLS blocks are heap chunks reachable from each thread's DTV.
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:intercept_tls_get_addr=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir "$dir" --output-on-failure -j "$JOBS"
 done
 
