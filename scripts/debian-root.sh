@@ -180,7 +180,7 @@ run_in() {
   [ "${1:-}" = "--" ] || die "usage: debian-root.sh $NAME run DIR... -- CMD..."
   shift
   [ $# -gt 0 ] || die "usage: debian-root.sh $NAME run DIR... -- CMD..."
-  unshare --mount --propagation private bash -c '
+  exec unshare --mount --propagation private bash -c '
     set -e
     r=$1; n=$2; shift 2
     mount -t proc proc "$r/proc"

@@ -61,6 +61,15 @@ typedef struct job {
     lb_mesh_format mesh_fmt;
     int pov, pov_w, pov_h;
     int image, img_w, img_h, img_quality, img_alpha, img_fmt, img_antialias, img_mesh;
+    /* the Blender renderer (blender: 1): engine, samples, seed, render threads (0: the
+     * job's), motion blur shutter in frames (0: none) */
+    int blender;
+    char engine[8];
+    int samples, seed, blender_threads;
+    double shutter;
+    int fps;                  /* frames.fps (motion blur's velocities per second) */
+    bt_blender *worker;       /* the process's Blender worker (cmd_batch.c owns it) */
+    char blender_version[64]; /* "Blender 3.4.1": in every manifest's identity */
     int sheet, sheet_cols, sheet_w, sheet_h;
     bt_image_plan img_plan; /* how the images are made on this machine */
     int threads;

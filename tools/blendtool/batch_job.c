@@ -204,7 +204,7 @@ static double key_value(const cJSON *keys, const char *interp, double fr) {
 }
 
 static int parse_frames(job *J, const cJSON *fr) {
-    static const char *const keys[] = {"first", "last", "animate", NULL};
+    static const char *const keys[] = {"first", "last", "fps", "animate", NULL};
     if (!cJSON_IsObject(fr))
         return batch_bad(J, "$.frames",
                          "expected {\"first\": A, \"last\": B, \"animate\": [...]}, found %s",
@@ -221,6 +221,9 @@ static int parse_frames(job *J, const cJSON *fr) {
                          "frames",
                          J->first, J->last, MAX_TASKS);
     J->has_frames = 1;
+    long fps = 24;
+    if ((rc = get_int(J, fr, "fps", "$.frames", 1, 1000, &fps))) return rc;
+    J->fps = (int)fps;
     const cJSON *an = cJSON_GetObjectItemCaseSensitive(fr, "animate");
     if (!an) return 0;
     if (!cJSON_IsArray(an) || cJSON_GetArraySize(an) > MAX_AXES)
@@ -275,6 +278,73 @@ static int parse_frames(job *J, const cJSON *fr) {
     return 0;
 }
 
+/* outputs.image's renderer: "povray" (the default) or "blender" with its
+ * engine, samples, seed, device, threads and motion blur; each key is
+ * refused where its renderer has no use for it. mres: the mesh resolution
+ * (Blender always renders a mesh: 128 cells unless "mesh" says) */
+static int parse_renderer(job *J, const cJSON *im, long *mres) {
+    const cJSON *r = cJSON_GetObjectItemCaseSensitive(im, "renderer");
+    const char *rn = r ? (cJSON_IsString(r) ? r->valuestring : "") : "povray";
+    if (strcmp(rn, "povray") && strcmp(rn, "blender"))
+        return batch_bad(J, "$.outputs.image.renderer", "%s; allowed: \"povray\" or \"blender\"",
+                         r && cJSON_IsString(r) ? r->valuestring : lb__json_kind(r));
+    J->blender = !strcmp(rn, "blender");
+    static const char *const pov_only[] = {"quality", "antialias", NULL};
+    static const char *const blender_only[] = {"engine", "samples",     "seed",
+                                               "device", "motion_blur", NULL};
+    const char *const *other = J->blender ? pov_only : blender_only;
+    for (size_t i = 0; other[i]; ++i)
+        if (cJSON_GetObjectItemCaseSensitive(im, other[i])) {
+            char path[64];
+            snprintf(path, sizeof path, "$.outputs.image.%s", other[i]);
+            return batch_bad(J, path,
+                             "is for the %s renderer; allowed with \"renderer\": \"%s\": %s",
+                             J->blender ? "povray" : "blender", rn,
+                             J->blender ? "engine, samples, seed, device, threads, motion_blur"
+                                        : "quality, antialias, mesh");
+        }
+    if (!J->blender) {
+        if (cJSON_GetObjectItemCaseSensitive(im, "threads"))
+            return batch_bad(J, "$.outputs.image.threads",
+                             "is for the blender renderer; allowed for povray: --threads");
+        return 0;
+    }
+    const cJSON *e = cJSON_GetObjectItemCaseSensitive(im, "engine"),
+                *d = cJSON_GetObjectItemCaseSensitive(im, "device");
+    const char *en = e ? (cJSON_IsString(e) ? e->valuestring : "") : "cycles";
+    if (strcmp(en, "cycles") && strcmp(en, "eevee"))
+        return batch_bad(J, "$.outputs.image.engine", "%s; allowed: \"cycles\" or \"eevee\"",
+                         e && cJSON_IsString(e) ? e->valuestring : lb__json_kind(e));
+    if (d && !(cJSON_IsString(d) && !strcmp(d->valuestring, "CPU")))
+        return batch_bad(J, "$.outputs.image.device",
+                         "%s; allowed: \"CPU\" (farm nodes render on their processors)",
+                         cJSON_IsString(d) ? d->valuestring : lb__json_kind(d));
+    snprintf(J->engine, sizeof J->engine, "%s", en);
+    long samples = 16, seed = 0, threads = 0;
+    int rc;
+    if ((rc = get_int(J, im, "samples", "$.outputs.image", 1, 65536, &samples)) ||
+        (rc = get_int(J, im, "seed", "$.outputs.image", 0, 2147483647L, &seed)) ||
+        (rc = get_int(J, im, "threads", "$.outputs.image", 0, 1024, &threads)))
+        return rc;
+    J->samples = (int)samples;
+    J->seed = (int)seed;
+    J->blender_threads = (int)threads;
+    const cJSON *mb = cJSON_GetObjectItemCaseSensitive(im, "motion_blur");
+    J->shutter = 0;
+    if (mb) {
+        if (!cJSON_IsNumber(mb) || !(mb->valuedouble > 0) || mb->valuedouble > 2)
+            return batch_bad(J, "$.outputs.image.motion_blur",
+                             "is %s; allowed: the shutter in frames, a number in (0, 2]",
+                             cJSON_IsNumber(mb) ? "out of range" : lb__json_kind(mb));
+        if (!J->has_frames)
+            return batch_bad(J, "$.outputs.image.motion_blur",
+                             "needs frames; allowed: a job with \"frames\" (an animation)");
+        J->shutter = mb->valuedouble;
+    }
+    if (!*mres) *mres = 128;
+    return 0;
+}
+
 static int parse_outputs(job *J, const cJSON *o) {
     static const char *const keys[] = {"mesh", "pov", "image", "contact_sheet", NULL};
     if (!cJSON_IsObject(o) || !o->child)
@@ -323,8 +393,10 @@ static int parse_outputs(job *J, const cJSON *o) {
     }
     const cJSON *im = cJSON_GetObjectItemCaseSensitive(o, "image");
     if (im) {
-        static const char *const ik[] = {"format", "bits",    "pixel", "alpha",     "width",
-                                         "height", "quality", "mesh",  "antialias", NULL};
+        static const char *const ik[] = {"format",      "bits",    "pixel", "alpha",     "width",
+                                         "height",      "quality", "mesh",  "antialias", "renderer",
+                                         "engine",      "samples", "seed",  "device",    "threads",
+                                         "motion_blur", NULL};
         if (!cJSON_IsObject(im))
             return batch_bad(J, "$.outputs.image", "expected an object, found %s",
                              lb__json_kind(im));
@@ -361,6 +433,7 @@ static int parse_outputs(job *J, const cJSON *o) {
             (rc = get_int(J, im, "quality", "$.outputs.image", 0, 11, &q)) ||
             (rc = get_int(J, im, "mesh", "$.outputs.image", 1, LB_POV_MAX_MESH_RESOLUTION, &mres)))
             return rc;
+        if ((rc = parse_renderer(J, im, &mres))) return rc;
         J->img_antialias = aa && cJSON_IsTrue(aa);
         J->img_mesh = (int)mres;
         J->image = 1;
@@ -692,6 +765,7 @@ int batch_parse_job(job *J, const char *file) {
     memset(J, 0, sizeof *J);
     J->file = file;
     J->threads = 1;
+    J->fps = 24;
     snprintf(J->dir, sizeof J->dir, "%s", file);
     char *slash = strrchr(J->dir, '/');
     if (slash)

@@ -89,6 +89,78 @@ static int hashed_bytes(const char *path, const void *data, size_t len, char hex
     return hashed_commit(path, &H, hex);
 }
 
+/* the scene text of task T (sets applied) into path; an exit code */
+static int put_scene(const job *J, const task *T, const char *path) {
+    size_t len = 0;
+    char *text = bt_scene_text_set(CMD, J->scenes[T->scene], T->sets, T->nsets, &len);
+    if (!text) return BT_EXIT_INTERNAL;
+    FILE *f = fopen(path, "wb");
+    int rc = f && fwrite(text, 1, len, f) == len ? 0 : BT_EXIT_INTERNAL;
+    if (f && fclose(f) != 0) rc = BT_EXIT_INTERNAL;
+    if (rc) bt_error(CMD, "%s: cannot write (%s)", path, strerror(errno));
+    free(text);
+    return rc;
+}
+
+/* the resolved scene of the task one frame before (d = -1) or after (+1) T, the
+ * same scene and sweep values, into path: 1 written, 0 no such frame, or -exit code */
+static int put_neighbour(const job *J, const task *T, int d, const char *path) {
+    const long f = T->frame + d;
+    if (f < J->first || f > J->last) return 0;
+    task N;
+    int rc = batch_make_task(J, (size_t)((long)T->id + d), &N);
+    if (!rc) rc = put_scene(J, &N, path);
+    batch_task_free(&N);
+    return rc ? -rc : 1;
+}
+
+/* Task T's image rendered by the Blender worker into R->png: the resolved
+ * scene (and for motion blur the frames around it) written into the render
+ * folder, one request to the worker; an exit code. */
+static int blender_render(const job *J, const task *T, const bt_render_dir *R, int threads) {
+    int rc = put_scene(J, T, R->json), hb = 0, ha = 0;
+    if (!rc && J->shutter > 0) {
+        hb = put_neighbour(J, T, -1, R->before);
+        ha = hb < 0 ? 0 : put_neighbour(J, T, +1, R->after);
+        if (hb < 0 || ha < 0) rc = -(hb < 0 ? hb : ha);
+    }
+    if (rc) return rc;
+    cJSON *q = cJSON_CreateObject();
+    cJSON_AddStringToObject(q, "scene", R->json);
+    cJSON_AddStringToObject(q, "name", J->scene_stems[T->scene]);
+    cJSON_AddStringToObject(q, "out", R->png);
+    cJSON_AddNumberToObject(q, "width", J->img_w);
+    cJSON_AddNumberToObject(q, "height", J->img_h);
+    cJSON_AddStringToObject(q, "engine", J->engine);
+    cJSON_AddNumberToObject(q, "samples", J->samples);
+    cJSON_AddNumberToObject(q, "seed", J->seed);
+    cJSON_AddNumberToObject(q, "threads", J->blender_threads ? J->blender_threads : threads);
+    cJSON_AddNumberToObject(q, "resolution", J->img_mesh);
+    cJSON_AddBoolToObject(q, "bits16", J->img_plan.bits16);
+    cJSON_AddBoolToObject(q, "alpha", J->img_plan.alpha);
+    cJSON_AddNumberToObject(q, "fps", J->fps);
+    cJSON_AddNumberToObject(q, "shutter", J->shutter);
+    if (hb > 0)
+        cJSON_AddStringToObject(q, "before", R->before);
+    else
+        cJSON_AddNullToObject(q, "before");
+    if (ha > 0)
+        cJSON_AddStringToObject(q, "after", R->after);
+    else
+        cJSON_AddNullToObject(q, "after");
+    char *line = cJSON_PrintUnformatted(q);
+    cJSON_Delete(q);
+    char err[4096] = "";
+    const int w = line ? bt_blender_task(J->worker, line, err, sizeof err) : 2;
+    free(line);
+    if (w) {
+        bt_error(CMD, "%s: rendering with Blender failed: %s", T->name,
+                 err[0] ? err : "out of memory");
+        return BT_EXIT_INTERNAL;
+    }
+    return 0;
+}
+
 int batch_run_task(const job *J, const task *T, const char *ident, const uint64_t scene_hash[2],
                    lb_scene *sc, logger *L, int threads) {
     lb_error e = {LB_OK, ""};
@@ -149,7 +221,9 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
         if ((rc = bt_render_dir_open(&R)) == 0) {
             lb_pov_options o = {0,   0,       (double)J->img_w / (double)J->img_h,
                                 0.0, threads, J->img_mesh};
-            if ((s = lb_scene_write_pov(sc, ev, &o, R.pov, NULL, &e)))
+            if (J->blender)
+                rc = blender_render(J, T, &R, threads);
+            else if ((s = lb_scene_write_pov(sc, ev, &o, R.pov, NULL, &e)))
                 rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
             const bt_pov_run P = {.width = J->img_w,
                                   .height = J->img_h,
@@ -159,11 +233,18 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
                                   .alpha = J->img_plan.alpha,
                                   .quiet = 1,
                                   .antialias = J->img_antialias};
-            if (!rc) rc = bt_povray(J->scenes[T->scene], &R, &P);
+            if (!rc && !J->blender) rc = bt_povray(J->scenes[T->scene], &R, &P);
             if (!rc) {
-                char hex[33], settings[128], err[1024] = "";
+                char hex[33], settings[256], err[1024] = "";
                 bt_hash_hex(scene_hash, hex);
-                bt_render_settings(settings, sizeof settings, &P, 0, J->img_mesh);
+                char mb[40] = "";
+                if (J->shutter > 0) snprintf(mb, sizeof mb, " motion_blur %.3g", J->shutter);
+                if (J->blender)
+                    snprintf(settings, sizeof settings, "%dx%d %s %s samples %d seed %d mesh %d%s",
+                             J->img_w, J->img_h, J->blender_version, J->engine, J->samples, J->seed,
+                             J->img_mesh, mb);
+                else
+                    bt_render_settings(settings, sizeof settings, &P, 0, J->img_mesh);
                 const lbi_meta meta[5] = {{"libblend:scene_hash", hex},
                                           {"libblend:version", BT_VERSION},
                                           {"libblend:render", settings},

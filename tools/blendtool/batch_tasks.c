@@ -156,6 +156,18 @@ char *batch_identity(const job *J, const task *T, const uint64_t scene[2]) {
     cJSON_AddStringToObject(o, "libblend", BT_VERSION);
     bt_hash_hex(J->spec_hash, hex);
     cJSON_AddStringToObject(o, "outputs_spec", hex);
+    if (J->image && J->blender) { /* who made the image: another Blender re-renders */
+        cJSON *r = cJSON_AddObjectToObject(o, "renderer");
+        cJSON_AddStringToObject(r, "name", "blender");
+        cJSON_AddStringToObject(r, "version", J->blender_version);
+        cJSON_AddStringToObject(r, "engine", J->engine);
+        cJSON_AddNumberToObject(r, "samples", J->samples);
+        cJSON_AddNumberToObject(r, "seed", J->seed);
+        if (J->shutter > 0) {
+            cJSON_AddNumberToObject(r, "motion_blur", J->shutter);
+            cJSON_AddNumberToObject(r, "fps", J->fps);
+        }
+    }
     char *t = cJSON_PrintUnformatted(o);
     cJSON_Delete(o);
     return t;

@@ -148,6 +148,7 @@ int bt_signals_temp(const char *path); /* returns a slot for bt_signals_untemp, 
 void bt_signals_untemp(int slot);
 void bt_signals_temp_dir(const char *dir); /* NULL: none */
 void bt_signals_child(pid_t pid);          /* 0: none */
+void bt_signals_worker(pid_t pid);         /* a second child (the Blender worker); 0: none */
 void bt_signals_commit(void);              /* hold the signals from here to exit */
 
 /* ---- rendering (cmd_pov.c) ---- */
@@ -156,11 +157,13 @@ void bt_signals_commit(void);              /* hold the signals from here to exit
  * and its state file, all registered with the signal handler (removed on
  * SIGINT / SIGTERM / SIGHUP; a folder of a killed run is removed by the
  * next render). */
-enum { BT_RENDER_FILES = 5 };
+enum { BT_RENDER_FILES = 8 };
 typedef struct bt_render_dir {
     char dir[4096];
     /* the folder's files (cmd_pov.c's RENDER_FILES, in that order) */
     char pov[4200], png[4200], state[4200], log[4200], ini[4200];
+    /* a Blender task's resolved scene, and the scenes a frame before and after it */
+    char json[4200], before[4200], after[4200];
     int slot[BT_RENDER_FILES];
 } bt_render_dir;
 int bt_render_dir_open(bt_render_dir *r); /* exit code */
@@ -183,6 +186,36 @@ int bt_povray(const char *scene_name, const bt_render_dir *R, const bt_pov_run *
  * "640x480 quality 9[ silhouette][ antialias][ mesh N]", the same words for
  * `render` and `batch`. */
 void bt_render_settings(char *out, size_t len, const bt_pov_run *P, int silhouette, int mesh);
+
+/* The scene file's text with sets applied (malloc'd, its length in len),
+ * the same document bt_load_scene_set parses; NULL after printing why. */
+char *bt_scene_text_set(const char *cmd, const char *path, const bt_set *sets, size_t nsets,
+                        size_t *len);
+
+/* ---- the Blender worker (blender_worker.c) ---- */
+
+/* One background Blender that renders batch tasks one after another (pid 0:
+ * not running; it starts on the first task and again after a crash). */
+typedef struct bt_blender {
+    const char *exe; /* bt_blender_exe() */
+    pid_t pid;
+    FILE *req, *rep;  /* its fd 3 (requests) and fd 4 (replies) */
+    int logfd;        /* its stdout and stderr: an unnamed temporary file, or -1 */
+    char running[64]; /* the version the running worker reported */
+} bt_blender;
+/* the Blender to run: option (--blender), else $LIBBLEND_BLENDER, else "blender" on PATH */
+const char *bt_blender_exe(const char *option);
+/* "Blender 3.4.1" from exe --version into out; 0, or -1 when it cannot run */
+int bt_blender_version(const char *exe, char *out, size_t n);
+/* start the worker; 0, or -1 with the reason in err */
+int bt_blender_start(bt_blender *B, char *err, size_t errlen);
+/* send one request (a JSON object on one line) and wait for its reply: 0 done,
+ * 1 the task failed inside Blender (err says why; the worker goes on), 2 the
+ * worker died or could not start (err: how, and its last output; the next
+ * task starts a new one) */
+int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen);
+/* end the worker (if running) and close its log */
+void bt_blender_stop(bt_blender *B);
 
 /* The lbi_format for an image name (.png: --bits 8|16, .exr: --pixel
  * half|float; 0 / NULL: the defaults), or -1 after printing why. */

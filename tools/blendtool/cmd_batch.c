@@ -23,7 +23,7 @@ static int parse_range(const char *v, long *a, long *b) {
 
 /* the command line of blendtool batch */
 typedef struct batch_opts {
-    const char *file, *logpath, *partition;
+    const char *file, *logpath, *partition, *blender;
     int list, log_json, fail_fast, slurm, submit, array, threads, sheet_only;
     long time_min, mem_mb; /* --time, --mem of --slurm: 0 = measured or default */
     long task_id, shard_i, shard_n, fa, fb;
@@ -68,6 +68,9 @@ static int parse_options(int argc, char **argv, batch_opts *o) {
                     bt_error(CMD, "--frames %s: expected A-B (or one frame A) with 0 <= A <= B", v);
                 return BT_EXIT_BAD_INPUT;
             }
+        } else if ((r = bt_option(CMD, argc, argv, &i, "--blender", &v))) {
+            if (r < 0) return BT_EXIT_BAD_INPUT;
+            o->blender = v;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--log", &v))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
             o->logpath = v;
@@ -377,6 +380,20 @@ static int run(int argc, char **argv) {
         goto done;
     }
     if (!o.sheet_only && (rc = check_selection(&J, &o, lo, hi))) goto done;
+    bt_blender worker = {.exe = bt_blender_exe(o.blender), .logfd = -1};
+    if (!o.sheet_only && J.image && J.blender) {
+        /* its version is in every manifest: another Blender re-renders */
+        if (bt_blender_version(worker.exe, J.blender_version, sizeof J.blender_version)) {
+            bt_error(CMD,
+                     "%s: the job renders with Blender, but `%s --version` did not run; "
+                     "allowed: install Blender (Debian package blender), or name it with "
+                     "--blender PATH or LIBBLEND_BLENDER",
+                     o.file, worker.exe);
+            rc = BT_EXIT_INTERNAL;
+            goto done;
+        }
+        J.worker = &worker;
+    }
     char mdir[8192];
     logger L;
     if ((rc = open_outputs(&J, &o, mdir, sizeof mdir, &L))) goto done;
@@ -393,6 +410,7 @@ static int run(int argc, char **argv) {
     batch_log_event(&L, je);
     tally t = {0, 0, 0, 0};
     rc = run_tasks(&J, &o, lo, hi, mdir, &L, &t);
+    bt_blender_stop(&worker);
     if (!rc && !t.failed && J.sheet && lo == 0 && hi == nt && o.fa < 0)
         rc = batch_contact_sheet(&J, nt, &L);
     cJSON *e = batch_event("job_end", NULL);
@@ -432,6 +450,8 @@ const bt_command bt_cmd_batch = {
     "  --task ID       run one task; --shard I/N the I-th of N contiguous chunks\n"
     "  --frames A-B    only the frames A to B\n"
     "  --threads N     threads per task (the job's \"threads\", default 1)\n"
+    "  --blender PATH  the Blender that renders outputs.image.renderer \"blender\"\n"
+    "                  (default: $LIBBLEND_BLENDER, else blender on PATH)\n"
     "  --log FILE      append one JSON line per event to FILE; --log-json to stdout\n"
     "  --fail-fast     stop at the first failed task (default: run the others)\n"
     "  --sheet         only (re)make the contact sheet from the finished images\n"

@@ -265,3 +265,27 @@ int bt_load_scene_set(const char *cmd, const char *path, const bt_set *sets, siz
     free(text);
     return rc;
 }
+
+char *bt_scene_text_set(const char *cmd, const char *path, const bt_set *sets, size_t nsets,
+                        size_t *len) {
+    char why[1024];
+    char *text = bt_read_file(path, LB_SCENE_MAX_BYTES, len, why, sizeof why);
+    if (!text) {
+        bt_error(cmd, "%s: cannot read the scene (%s)", path, why);
+        return NULL;
+    }
+    if (!nsets) return text;
+    cJSON *doc = cJSON_ParseWithLength(text, *len);
+    free(text);
+    for (size_t i = 0; doc && i < nsets; ++i)
+        if (apply_one(doc, &sets[i], why, sizeof why)) {
+            bt_error(cmd, "%s: --set %s: %s", path, sets[i].path, why);
+            cJSON_Delete(doc);
+            return NULL;
+        }
+    char *resolved = doc ? cJSON_PrintUnformatted(doc) : NULL;
+    cJSON_Delete(doc);
+    if (!resolved) bt_error(cmd, "%s: the scene is not JSON, or out of memory", path);
+    *len = resolved ? strlen(resolved) : 0;
+    return resolved;
+}

@@ -25,7 +25,8 @@ static const char *tmp_root(void) {
 /* what a render folder holds: the scene, the image, and the state file
  * povray writes when it is stopped mid-render */
 static const char *const RENDER_FILES[BT_RENDER_FILES] = {
-    "scene.pov", "image.png", "image.pov-state", "povray.log", "render.ini"};
+    "scene.pov",  "image.png",  "image.pov-state", "povray.log",
+    "render.ini", "scene.json", "before.json",     "after.json"};
 
 static void remove_stale_renders(void) {
     DIR *d = opendir(tmp_root());
@@ -151,7 +152,8 @@ int bt_render_dir_open(bt_render_dir *r) {
         return BT_EXIT_INTERNAL;
     }
     /* registered before they exist: the handler removes what is there */
-    char *const files[BT_RENDER_FILES] = {r->pov, r->png, r->state, r->log, r->ini};
+    char *const files[BT_RENDER_FILES] = {r->pov, r->png,  r->state,  r->log,
+                                          r->ini, r->json, r->before, r->after};
     for (size_t i = 0; i < BT_RENDER_FILES; ++i) {
         snprintf(files[i], sizeof r->pov, "%s/%s", r->dir, RENDER_FILES[i]);
         r->slot[i] = bt_signals_temp(files[i]);
@@ -161,7 +163,8 @@ int bt_render_dir_open(bt_render_dir *r) {
 }
 
 void bt_render_dir_close(bt_render_dir *r) {
-    const char *const files[BT_RENDER_FILES] = {r->pov, r->png, r->state, r->log, r->ini};
+    const char *const files[BT_RENDER_FILES] = {r->pov, r->png,  r->state,  r->log,
+                                                r->ini, r->json, r->before, r->after};
     for (size_t i = 0; i < BT_RENDER_FILES; ++i) remove(files[i]);
     rmdir(r->dir);
     for (size_t i = 0; i < BT_RENDER_FILES; ++i) bt_signals_untemp(r->slot[i]);

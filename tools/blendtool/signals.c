@@ -16,7 +16,7 @@
 
 #define MAX_TEMPS 12
 
-static volatile sig_atomic_t child_pid = 0;
+static volatile sig_atomic_t child_pid = 0, worker_pid = 0;
 static char temps[MAX_TEMPS][4096 + 640];
 static volatile sig_atomic_t temp_used[MAX_TEMPS];
 static char temp_dir[4096];
@@ -28,11 +28,11 @@ static void say(const char *s) {
 }
 
 static void on_signal(int sig) {
-    const pid_t pid = (pid_t)child_pid;
-    if (pid > 0) {
-        kill(pid, SIGTERM);
-        waitpid(pid, NULL, 0);
-    }
+    const pid_t pids[2] = {(pid_t)child_pid, (pid_t)worker_pid};
+    for (int i = 0; i < 2; ++i)
+        if (pids[i] > 0) kill(pids[i], SIGTERM);
+    for (int i = 0; i < 2; ++i)
+        if (pids[i] > 0) waitpid(pids[i], NULL, 0);
     for (int i = 0; i < MAX_TEMPS; ++i)
         if (temp_used[i]) unlink(temps[i]);
     if (temp_dir_used) rmdir(temp_dir);
@@ -112,6 +112,10 @@ void bt_signals_temp_dir(const char *dir) {
 
 void bt_signals_child(pid_t pid) {
     child_pid = pid;
+}
+
+void bt_signals_worker(pid_t pid) {
+    worker_pid = pid;
 }
 
 void bt_signals_commit(void) {
