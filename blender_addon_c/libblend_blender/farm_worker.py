@@ -10,9 +10,10 @@ Each request is one task:
     out         where to write the image (PNG, 8 or 16 bits, RGB or RGBA)
     width, height, engine ("cycles" | "eevee"), samples, seed, threads
     resolution  cells along the region's longest side for the mesh
-    bits16, alpha
-    fps, shutter, before, after (motion blur: the resolved scenes one frame
-                before and after, either may be null; shutter in frames, 0: off)
+    bits16, alpha (the PNG's channels), transparent (a background of alpha 0:
+                outputs.image.alpha)
+    fps, shutter, before, after, dt_frames (motion blur: the resolved scenes
+                dt_frames before and after the frame; shutter in frames, 0: off)
 The scene is imported as the add-on's Import does (the blend tree, the
 render section's camera, lights, floor and materials), meshed at the
 task's resolution, rendered, and saved; then everything it made is
@@ -22,9 +23,9 @@ replies {"error": ...} and the worker goes on; end of input ends it.
 Motion blur: the mesh gets a point attribute `velocity` (scene units per
 second), which Cycles uses to blur a mesh whose topology is its own
 (Blender 3.4 and 4.3 measured: tests/blender/test_farm.py). The velocity of
-a surface point is its normal motion, from the field one frame before and
-one frame after (libblend's lb_mesh_velocities: -df/dt / |grad f| along the
-normal), times the frame rate.
+a surface point is its normal motion, from the field a sub-frame before and
+after (libblend's lb_mesh_velocities: -df/dt / |grad f| along the normal),
+times the frame rate.
 """
 import importlib
 import json
@@ -77,9 +78,10 @@ def _velocities(pkg, lib, out, req):
             else:
                 evs.append(None)
         here, before, after = evs
-        # both neighbours: a central difference over 2 frames; one: over 1 frame
-        v = here.velocities(P, before, after, dt=1.0, threads=req.get("threads", 0))
-        v *= float(req["fps"])  # scene units per frame -> per second
+        # the scenes dt_frames before and after: units per frame, then per second
+        dt = float(req.get("dt_frames", 1.0))
+        v = here.velocities(P, before, after, dt=dt, threads=req.get("threads", 0))
+        v *= float(req["fps"])
     finally:
         for e in evs:
             if e is not None:
@@ -133,7 +135,7 @@ def render(bpy, pkg, req):
         raise ValueError(msg)
     sc.render.resolution_x, sc.render.resolution_y = int(req["width"]), int(req["height"])
     sc.render.resolution_percentage = 100
-    sc.render.film_transparent = bool(req["alpha"])
+    sc.render.film_transparent = bool(req.get("transparent"))
     _engine(bpy, pkg, sc, req)
     sc.render.fps, sc.render.fps_base = int(req.get("fps", 24)), 1.0
     vmax = 0.0

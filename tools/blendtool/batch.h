@@ -36,6 +36,8 @@ typedef struct axis {
     size_t n;
     char **values;  /* JSON text per step (sweeps) or per frame (animation) */
     char label[33]; /* the contact sheet's name for it ("m2"); empty: the path's last part */
+    cJSON *keys;    /* an animated path's [frame, value] keys (sub-frames: motion blur) */
+    char interp[8]; /* and their interpolation */
 } axis;
 
 typedef struct job {
@@ -101,6 +103,8 @@ int batch_parse_job(job *J, const char *file);
 /* a bad job file: prints the file, the JSON path and what is allowed; returns exit 2 */
 int batch_bad(const job *J, const char *path, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+/* an animated axis's value at a (fractional) frame, as JSON number text (malloc'd) */
+char *batch_anim_value(const axis *X, double frame);
 /* free what batch_parse_job allocated */
 void batch_job_free(job *J);
 

@@ -272,6 +272,8 @@ static int parse_frames(job *J, const cJSON *fr) {
         X->path = batch_dupstr(p->valuestring);
         X->n = (size_t)(J->last - J->first + 1);
         X->values = calloc(X->n, sizeof *X->values);
+        X->keys = cJSON_Duplicate(k, 1);
+        snprintf(X->interp, sizeof X->interp, "%s", interp);
         for (size_t f = 0; f < X->n && X->values; ++f)
             X->values[f] = num_text(key_value(k, interp, (double)(J->first + (long)f)));
     }
@@ -797,6 +799,10 @@ out:
     return rc;
 }
 
+char *batch_anim_value(const axis *X, double frame) {
+    return X->keys ? num_text(key_value(X->keys, X->interp, frame)) : NULL;
+}
+
 void batch_job_free(job *J) {
     for (size_t i = 0; i < J->nscenes; ++i) {
         if (J->scenes) free(J->scenes[i]);
@@ -811,5 +817,6 @@ void batch_job_free(job *J) {
         for (size_t i = 0; X->values && i < X->n; ++i) free(X->values[i]);
         free(X->values);
         free(X->path);
+        cJSON_Delete(X->keys);
     }
 }

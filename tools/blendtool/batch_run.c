@@ -102,28 +102,45 @@ static int put_scene(const job *J, const task *T, const char *path) {
     return rc;
 }
 
-/* the resolved scene of the task one frame before (d = -1) or after (+1) T, the
- * same scene and sweep values, into path: 1 written, 0 no such frame, or -exit code */
-static int put_neighbour(const job *J, const task *T, int d, const char *path) {
-    const long f = T->frame + d;
-    if (f < J->first || f > J->last) return 0;
-    task N;
-    int rc = batch_make_task(J, (size_t)((long)T->id + d), &N);
+/* Motion blur's velocities come from the field a small step before and
+ * after the task's frame (a sub-frame, the animated paths at their keys'
+ * interpolation there), so the difference quotient is the derivative, not
+ * a whole frame's chord: 0.01 frame. */
+#define SUBFRAME 0.01
+
+/* the resolved scene of task T at its frame + d frames into path; an exit code */
+static int put_subframe(const job *J, const task *T, double d, const char *path) {
+    task N = *T; /* its sets, the animated ones (the last nanim) at frame + d */
+    char *vals[MAX_AXES] = {0};
+    int rc = 0;
+    for (size_t a = 0; a < J->nanim && !rc; ++a) {
+        const size_t i = T->nsets - J->nanim + a;
+        const axis *X = &J->anim[a];
+        char *v = batch_anim_value(X, (double)T->frame + d);
+        const size_t l = v ? strlen(X->path) + strlen(v) + 2 : 0;
+        vals[a] = v ? malloc(l) : NULL;
+        if (!vals[a]) {
+            rc = BT_EXIT_INTERNAL;
+        } else {
+            snprintf(vals[a], l, "%s=%s", X->path, v);
+            N.sets[i].path = vals[a];
+            N.sets[i].value = vals[a] + strlen(X->path) + 1;
+        }
+        free(v);
+    }
     if (!rc) rc = put_scene(J, &N, path);
-    batch_task_free(&N);
-    return rc ? -rc : 1;
+    for (size_t a = 0; a < J->nanim; ++a) free(vals[a]);
+    return rc;
 }
 
 /* Task T's image rendered by the Blender worker into R->png: the resolved
  * scene (and for motion blur the frames around it) written into the render
  * folder, one request to the worker; an exit code. */
 static int blender_render(const job *J, const task *T, const bt_render_dir *R, int threads) {
-    int rc = put_scene(J, T, R->json), hb = 0, ha = 0;
-    if (!rc && J->shutter > 0) {
-        hb = put_neighbour(J, T, -1, R->before);
-        ha = hb < 0 ? 0 : put_neighbour(J, T, +1, R->after);
-        if (hb < 0 || ha < 0) rc = -(hb < 0 ? hb : ha);
-    }
+    int rc = put_scene(J, T, R->json);
+    const int mb = J->shutter > 0;
+    if (!rc && mb) rc = put_subframe(J, T, -SUBFRAME, R->before);
+    if (!rc && mb) rc = put_subframe(J, T, +SUBFRAME, R->after);
     if (rc) return rc;
     cJSON *q = cJSON_CreateObject();
     cJSON_AddStringToObject(q, "scene", R->json);
@@ -137,17 +154,15 @@ static int blender_render(const job *J, const task *T, const bt_render_dir *R, i
     cJSON_AddNumberToObject(q, "threads", J->blender_threads ? J->blender_threads : threads);
     cJSON_AddNumberToObject(q, "resolution", J->img_mesh);
     cJSON_AddBoolToObject(q, "bits16", J->img_plan.bits16);
-    cJSON_AddBoolToObject(q, "alpha", J->img_plan.alpha);
+    cJSON_AddBoolToObject(q, "alpha", J->img_plan.alpha);           /* the PNG's channels */
+    cJSON_AddBoolToObject(q, "transparent", J->img_plan.out_alpha); /* the background's alpha */
     cJSON_AddNumberToObject(q, "fps", J->fps);
     cJSON_AddNumberToObject(q, "shutter", J->shutter);
-    if (hb > 0)
+    if (mb) {
         cJSON_AddStringToObject(q, "before", R->before);
-    else
-        cJSON_AddNullToObject(q, "before");
-    if (ha > 0)
         cJSON_AddStringToObject(q, "after", R->after);
-    else
-        cJSON_AddNullToObject(q, "after");
+        cJSON_AddNumberToObject(q, "dt_frames", SUBFRAME);
+    }
     char *line = cJSON_PrintUnformatted(q);
     cJSON_Delete(q);
     char err[4096] = "";
