@@ -102,6 +102,10 @@ def _engine(bpy, pkg, sc, req):
         sc.cycles.use_denoising = False  # OpenImageDenoise is not on every node
         if hasattr(sc.cycles, "use_adaptive_sampling"):
             sc.cycles.use_adaptive_sampling = False  # the same samples in every pixel
+        # tiles of 128 pixels: Blender reports "Rendered T/N Tiles" as it goes,
+        # which blendtool turns into progress events (in one tile Cycles
+        # reports its samples only at the start and the end)
+        sc.cycles.use_auto_tile, sc.cycles.tile_size = True, 128
     else:
         sc.render.engine = pkg.compat.eevee_engine()
         eevee = sc.eevee

@@ -163,6 +163,10 @@ for line in p.stdout:
 err = p.stderr.read()
 p.wait()
 ends = {e["task"]: e for e in map(json.loads, lines) if e["event"] == "task_end"}
+prog = [e["fraction"] for e in map(json.loads, lines) if e["event"] == "progress" and e["task"] == 0]
+print("progress events of task 0: %s" % prog)
+check(len(prog) >= 3 and prog == sorted(prog) and 0 < prog[0] and prog[-1] <= 1,
+      "task 0's progress events (a 320x240 render at 64 samples): %s" % prog)
 check(killed is not None, "no Blender worker to kill (children of blendtool)")
 check(p.returncode == 1, "a killed worker: exit %s (expected 1): %s" % (p.returncode, err[-1500:]))
 check(ends.get(1, {}).get("status") == "failed" and "died" in ends[1].get("error", ""),

@@ -133,10 +133,25 @@ static int put_subframe(const job *J, const task *T, double d, const char *path)
     return rc;
 }
 
+/* the render's progress: a log event, and the terminal's line */
+typedef struct progress_ctx {
+    const task *T;
+    logger *L;
+} progress_ctx;
+
+static void on_progress(void *c, double f) {
+    const progress_ctx *P = c;
+    cJSON *e = batch_event("progress", P->T);
+    cJSON_AddNumberToObject(e, "fraction", floor(f * 100 + 0.5) / 100);
+    batch_log_event(P->L, e);
+    if (P->L->bar) fprintf(stderr, "\r%s %3.0f%% ", P->T->name, 100 * f), fflush(stderr);
+}
+
 /* Task T's image rendered by the Blender worker into R->png: the resolved
  * scene (and for motion blur the frames around it) written into the render
  * folder, one request to the worker; an exit code. */
-static int blender_render(const job *J, const task *T, const bt_render_dir *R, int threads) {
+static int blender_render(const job *J, const task *T, const bt_render_dir *R, int threads,
+                          logger *L) {
     int rc = put_scene(J, T, R->json);
     const int mb = J->shutter > 0;
     if (!rc && mb) rc = put_subframe(J, T, -SUBFRAME, R->before);
@@ -166,7 +181,8 @@ static int blender_render(const job *J, const task *T, const bt_render_dir *R, i
     char *line = cJSON_PrintUnformatted(q);
     cJSON_Delete(q);
     char err[4096] = "";
-    const int w = line ? bt_blender_task(J->worker, line, err, sizeof err) : 2;
+    progress_ctx P = {T, L};
+    const int w = line ? bt_blender_task(J->worker, line, err, sizeof err, on_progress, &P) : 2;
     free(line);
     if (w) {
         bt_error(CMD, "%s: rendering with Blender failed: %s", T->name,
@@ -237,7 +253,7 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
             lb_pov_options o = {0,   0,       (double)J->img_w / (double)J->img_h,
                                 0.0, threads, J->img_mesh};
             if (J->blender)
-                rc = blender_render(J, T, &R, threads);
+                rc = blender_render(J, T, &R, threads, L);
             else if ((s = lb_scene_write_pov(sc, ev, &o, R.pov, NULL, &e)))
                 rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
             const bt_pov_run P = {.width = J->img_w,

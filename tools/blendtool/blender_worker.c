@@ -22,6 +22,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -215,7 +216,29 @@ int bt_blender_start(bt_blender *B, char *err, size_t errlen) {
     return 0;
 }
 
-int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen) {
+/* The render's progress from the worker's output, the last such line
+ * Blender printed: "Rendered T/N Tiles, Sample A/B" (Cycles with tiles, as
+ * the worker renders: (T + A/B) / N), "Sample A/B" (Cycles in one tile) or
+ * "Rendering A / B samples" (EEVEE); -1 when there is none yet. */
+static double progress_of(const bt_blender *B) {
+    char tail[2048];
+    log_tail(B, tail, sizeof tail);
+    double best = -1;
+    for (const char *p = tail; (p = strpbrk(p, "SR")) != NULL; ++p) {
+        int t = 0, n = 0, a = 0, b = 0;
+        if (sscanf(p, "Rendered %d/%d Tiles, Sample %d/%d", &t, &n, &a, &b) == 4 && n > 0 &&
+            b > 0 && t >= 0 && t < n && a >= 0 && a <= b)
+            best = (t + (double)a / b) / n;
+        else if ((sscanf(p, "Sample %d/%d", &a, &b) == 2 ||
+                  sscanf(p, "Rendering %d / %d samples", &a, &b) == 2) &&
+                 b > 0 && a >= 0 && a <= b && (p - tail < 2 || (p[-1] != ',' && p[-2] != ',')))
+            best = (double)a / b;
+    }
+    return best;
+}
+
+int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen,
+                    void (*progress)(void *ctx, double fraction), void *ctx) {
     if (B->pid <= 0 && bt_blender_start(B, err, errlen)) return 2;
     if (lseek(B->logfd, 0, SEEK_SET) == 0 && ftruncate(B->logfd, 0) != 0) {
         /* the log keeps the older output; only its tail is shown */
@@ -223,6 +246,19 @@ int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen
     if (fprintf(B->req, "%s\n", request) < 0 || fflush(B->req) != 0) {
         died(B, "before the task", err, errlen);
         return 2;
+    }
+    /* while it renders: its progress every half second, reported in steps
+     * of a tenth */
+    int step = 0;
+    struct pollfd pf = {fileno(B->rep), POLLIN, 0};
+    for (;;) {
+        const int r = poll(&pf, 1, 500);
+        if (r > 0 || (r < 0 && errno != EINTR)) break;
+        const double f = progress ? progress_of(B) : -1;
+        if (f >= 0 && (int)(f * 10) > step) {
+            step = (int)(f * 10);
+            progress(ctx, f);
+        }
     }
     cJSON *reply = NULL;
     if (read_reply(B, &reply)) {

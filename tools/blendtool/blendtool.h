@@ -212,8 +212,10 @@ int bt_blender_start(bt_blender *B, char *err, size_t errlen);
 /* send one request (a JSON object on one line) and wait for its reply: 0 done,
  * 1 the task failed inside Blender (err says why; the worker goes on), 2 the
  * worker died or could not start (err: how, and its last output; the next
- * task starts a new one) */
-int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen);
+ * task starts a new one). While Blender renders, progress (may be NULL) is
+ * called with the fraction of samples done, each time it passes a tenth. */
+int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen,
+                    void (*progress)(void *ctx, double fraction), void *ctx);
 /* end the worker (if running) and close its log */
 void bt_blender_stop(bt_blender *B);
 
