@@ -31,6 +31,7 @@ import importlib
 import json
 import os
 import sys
+import time
 import traceback
 
 
@@ -118,6 +119,10 @@ def _engine(bpy, pkg, sc, req):
 
 
 def render(bpy, pkg, req):
+    """One task (the request's fields: the module's docstring); returns the
+    reply: the mesh's status line, the largest velocity, the seconds in
+    Blender's render and in the whole task."""
+    t_start = time.perf_counter()
     _clear(bpy)
     lib = pkg.libhandle.library()
     path = req["scene"]
@@ -154,11 +159,14 @@ def render(bpy, pkg, req):
     im.color_depth = "16" if req["bits16"] else "8"
     im.compression = 15
     sc.render.use_stamp = False
+    t0 = time.perf_counter()
     bpy.ops.render.render(write_still=False)
+    t_render = time.perf_counter() - t0
     tmp = req["out"] + ".part.png"
     bpy.data.images["Render Result"].save_render(filepath=tmp, scene=sc)
     os.replace(tmp, req["out"])
-    return {"ok": True, "mesh": msg, "max_velocity": vmax}
+    return {"ok": True, "mesh": msg, "max_velocity": vmax, "render_seconds": t_render,
+            "seconds": time.perf_counter() - t_start}
 
 
 def main():

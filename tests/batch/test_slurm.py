@@ -2,7 +2,9 @@
 """blendtool batch on a real Slurm cluster (single node, this machine):
 an 8-task job in 4 array tasks gives the same bytes as a local run; an
 array task killed mid-render leaves nothing corrupt, and resubmitting the
-same script redoes only its unfinished task.
+same script redoes only its unfinished task; the same for a job rendered by
+Blender workers (8 tasks in 2 array tasks, one killed while its Blender
+renders: the Blender goes with it).
 
 usage: test_slurm.py BLENDTOOL SOURCE_DIR WORK_DIR
 """
@@ -144,6 +146,66 @@ try:
     check(redone == [5], "the resubmission redid only the killed task: %s" % redone)
     check({k: v for k, v in digest(kout).items() if k != "farm_sheet.png"} == kref,
           "and every output now equals the reference")
+
+    # A Blender job (outputs.image.renderer "blender"): 8 tasks in 2 array
+    # tasks, each running one worker Blender; array task 1 is killed while
+    # its last task renders (its Blender goes with it), the resubmission
+    # redoes exactly that task, and every output equals a local run's
+    bjob = dict(JOB, outputs={"image": {"width": 240, "height": 180, "renderer": "blender",
+                                        "samples": 32, "mesh": 40}})
+    dbl, jbl = job_in("blender-local", bjob)
+    r = subprocess.run([BT, "batch", jbl], capture_output=True, text=True)
+    check(r.returncode == 0, "Blender job, local run: " + r.stderr[-800:])
+    bref = digest(os.path.join(dbl, "out"))
+    dbk, jbk = job_in("blender-slurm", bjob)
+    r = subprocess.run([BT, "batch", jbk, "--slurm", "--array-size", "2"], capture_output=True,
+                       text=True)
+    script = r.stdout.strip()
+    check(r.returncode == 0, "Blender job: batch --slurm: " + r.stderr[-500:])
+    p = subprocess.Popen(["sbatch", "--wait", script], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    shard_log = os.path.join(dbk, "out", "logs", "farm_shard_1.jsonl")
+    killed, workers = None, []
+    deadline = time.time() + 300
+    while time.time() < deadline and killed is None:
+        if os.path.exists(shard_log):
+            ev = [json.loads(l) for l in open(shard_log) if l.strip()]
+            if any(e["event"] == "task_start" and e["task"] == 7 for e in ev):
+                time.sleep(0.3)
+                shard = subprocess.run(["pgrep", "-f", "--", "--shard 1/2"], capture_output=True,
+                                       text=True).stdout.split()
+                for pid in shard:
+                    try:
+                        with open("/proc/%s/task/%s/children" % (pid, pid)) as f:
+                            workers += f.read().split()
+                    except OSError:
+                        pass
+                k = subprocess.run(["pkill", "-KILL", "-f", "--", "--shard 1/2"])
+                killed = k.returncode == 0
+        time.sleep(0.05)
+    out, err = p.communicate(timeout=600)
+    check(killed and workers, "Blender job: array task 1 killed mid-render (its workers %s)" % workers)
+    check(p.returncode != 0, "Blender job: sbatch --wait reports the kill: exit %d" % p.returncode)
+    time.sleep(1)
+    alive = [w for w in workers if os.path.exists("/proc/%s" % w)]
+    check(not alive, "the killed array task's Blender ended with it: %s alive" % alive)
+    bout = os.path.join(dbk, "out")
+    check(not os.path.exists(os.path.join(bout, "farm_0007.png")) and
+          not os.path.exists(os.path.join(bout, ".libblend-manifest", "farm_0007.json")),
+          "Blender job: the killed task left no image and no manifest")
+    before = {i: len(open(os.path.join(bout, "logs", "farm_shard_%d.jsonl" % i)).readlines())
+              for i in range(2)}
+    r = subprocess.run(["sbatch", "--wait", script], capture_output=True, text=True, timeout=600)
+    check(r.returncode == 0, "Blender job: the resubmission succeeds: " + r.stderr)
+    redone = []
+    for i in range(2):
+        lines = open(os.path.join(bout, "logs", "farm_shard_%d.jsonl" % i)).readlines()[before[i]:]
+        redone += [json.loads(l)["task"] for l in lines
+                   if '"task_end"' in l and json.loads(l)["status"] == "done"]
+    check(redone == [7], "Blender job: the resubmission redid only the killed task: %s" % redone)
+    got = digest(bout)
+    check(got == bref, "Blender job: Slurm's outputs equal the local run's: %s" %
+          sorted(set(got.items()) ^ set(bref.items()))[:6])
 finally:
     subprocess.run(["bash", os.path.join(SRC, "scripts", "slurm-cluster.sh"), "stop", cluster])
 finish()

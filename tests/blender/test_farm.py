@@ -28,12 +28,15 @@ import subprocess
 import sys
 import time
 
+import jsonschema
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from checks import args, check, failures, finish, read_ppm  # noqa: E402
 
 BT, SRC, WORK = (os.path.abspath(a) for a in args())
 shutil.rmtree(WORK)
 os.makedirs(WORK)
+SCHEMA = json.load(open(os.path.join(SRC, "docs", "libblend-job.schema.json")))
 ADDON = os.path.join(os.path.dirname(os.path.dirname(BT)), "blender_addon")
 ENV = dict(os.environ, TMPDIR=WORK, LIBBLEND_BLENDER_ADDON=ADDON)
 
@@ -46,6 +49,7 @@ def job(name, out, outputs, **extra):
     j = {"format": "libblend-job", "version": 1, "name": name, "outputs": outputs,
          "output_dir": out}
     j.update(extra)
+    jsonschema.validate(j, SCHEMA)  # the documented schema takes every job here
     path = os.path.join(WORK, name + "-" + os.path.basename(out) + ".json")
     with open(path, "w") as f:
         json.dump(j, f)
@@ -298,6 +302,10 @@ if files(out4):
                           capture_output=True, text=True).stdout
     check(re.search(r'libblend:render: "160x120 Blender 4\.3\.\d+ cycles', info),
           "Blender 4.3's image metadata: %s" % info)
+    r1 = run(BT, "batch", sweep("b43-2"), "--blender", b4, "--threads", "2")
+    diff = same_bytes(out4, os.path.join(WORK, "b43-2"), names) if r1.returncode == 0 else names
+    check(not diff, "Blender 4.3, Cycles CPU at 1 and 2 threads: bytes differ in %s %s" %
+          (diff, r1.stderr[-500:]))
     r2 = run(BT, "batch", sweep("b43"), "--blender", b4)
     check("4 skipped" in r2.stderr, "Blender 4.3 rerun skips: %s" % r2.stderr[-300:])
     r3 = run(BT, "batch", sweep("b43"))

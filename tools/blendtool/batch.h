@@ -150,8 +150,10 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
 /* whether p can be a Slurm partition name */
 int batch_partition_ok(const char *p);
 /* write the job's sbatch script (OUT/NAME.sbatch, its path into out) running ntasks as
- * an array of `array` shards, every value in it quoted; an exit code */
+ * an array of `array` shards (with --blender BLENDER when not NULL), every value in it
+ * quoted; an exit code */
 int batch_slurm_script(const job *J, size_t ntasks, int array, const char *partition, long time_min,
-                       long mem_mb, const char *self, char *out, size_t outlen);
+                       long mem_mb, const char *self, const char *blender, char *out,
+                       size_t outlen);
 
 #endif

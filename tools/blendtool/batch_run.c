@@ -182,8 +182,16 @@ static int blender_render(const job *J, const task *T, const bt_render_dir *R, i
     cJSON_Delete(q);
     char err[4096] = "";
     progress_ctx P = {T, L};
-    const int w = line ? bt_blender_task(J->worker, line, err, sizeof err, on_progress, &P) : 2;
+    double sec[2] = {-1, -1};
+    const int w =
+        line ? bt_blender_task(J->worker, line, err, sizeof err, on_progress, &P, sec) : 2;
     free(line);
+    if (!w) { /* where the time went: Blender's render, and its whole task */
+        cJSON *e = batch_event("blender", T);
+        cJSON_AddNumberToObject(e, "render_seconds", sec[0]);
+        cJSON_AddNumberToObject(e, "seconds", sec[1]);
+        batch_log_event(L, e);
+    }
     if (w) {
         bt_error(CMD, "%s: rendering with Blender failed: %s", T->name,
                  err[0] ? err : "out of memory");

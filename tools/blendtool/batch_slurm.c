@@ -79,7 +79,8 @@ static void measured_costs(const job *J, double *sec, double *rss_kb) {
 }
 
 int batch_slurm_script(const job *J, size_t ntasks, int array, const char *partition, long time_min,
-                       long mem_mb, const char *self, char *out, size_t outlen) {
+                       long mem_mb, const char *self, const char *blender, char *out,
+                       size_t outlen) {
     if (batch_mkdirs(J->outdir)) {
         bt_error(CMD, "%s: cannot create the output folder (%s)", J->outdir, strerror(errno));
         return BT_EXIT_BAD_INPUT;
@@ -109,8 +110,8 @@ int batch_slurm_script(const job *J, size_t ntasks, int array, const char *parti
     if (!mem_mb) mem_mb = rss > 0.0 ? (long)ceil(2.0 * rss / 1024.0) + 256 : 4096;
     /* every path is a shell word in single quotes; the log folder goes into
      * a #SBATCH line only where sbatch keeps it as it is */
-    char logs[8300], qself[20000], qjob[20000], qlog[20000];
-    size_t o1 = 0, o2 = 0, o3 = 0;
+    char logs[8300], qself[20000], qjob[20000], qlog[20000], qbl[20000] = "";
+    size_t o1 = 0, o2 = 0, o3 = 0, o4 = 0;
     if (snprintf(logs, sizeof logs, "%s/logs", dirabs) >= (int)sizeof logs) {
         bt_error(CMD, "%s: paths too long for the script", dirabs);
         return BT_EXIT_BAD_INPUT;
@@ -123,6 +124,18 @@ int batch_slurm_script(const job *J, size_t ntasks, int array, const char *parti
     sh_quote(qself, sizeof qself, &o1, self);
     sh_quote(qjob, sizeof qjob, &o2, jobabs);
     sh_quote(qlog, sizeof qlog, &o3, logfile);
+    if (blender && J->blender && J->image) { /* --blender PATH, as given */
+        char abs[8192];
+        const char *b = strchr(blender, '/') && realpath(blender, abs) ? abs : blender;
+        sh_quote(qbl, sizeof qbl, &o4, "--blender");
+        qbl[o4++] = ' ';
+        qbl[o4] = '\0';
+        sh_quote(qbl, sizeof qbl, &o4, b);
+        qbl[o4++] = ' ';
+        qbl[o4] = '\0';
+    }
+    /* a Blender job's render threads are the array task's CPUs */
+    const int cpus = J->blender && J->image && J->blender_threads > 0 ? J->blender_threads : 1;
     const int direct = directive_ok(logs);
     char text[80000];
     const int tl = snprintf(
@@ -134,15 +147,15 @@ int batch_slurm_script(const job *J, size_t ntasks, int array, const char *parti
         "#SBATCH --array=0-%d\n"
         "%s%s%s"
         "#SBATCH --ntasks=1\n"
-        "#SBATCH --cpus-per-task=1\n"
+        "#SBATCH --cpus-per-task=%d\n"
         "#SBATCH --time=%ld\n"
         "#SBATCH --mem=%ldM\n"
         "%s%s%s"
         "%s%s%s"
-        "exec %s batch %s --shard \"$SLURM_ARRAY_TASK_ID/%d\" --threads 1 "
+        "exec %s batch %s --shard \"$SLURM_ARRAY_TASK_ID/%d\" --threads 1 %s"
         "--log %s\"$SLURM_ARRAY_TASK_ID\"'.jsonl'\n",
         BT_VERSION, ntasks, array, J->name, array - 1, direct ? "#SBATCH --output=\"" : "",
-        direct ? logs : "", direct ? "/%x_%A_%a.log\"\n" : "", time_min, mem_mb,
+        direct ? logs : "", direct ? "/%x_%A_%a.log\"\n" : "", cpus, time_min, mem_mb,
         partition ? "#SBATCH --partition=" : "", partition ? partition : "", partition ? "\n" : "",
         direct ? ""
                : "# the output folder's path has characters a #SBATCH line cannot carry:\n"
@@ -150,9 +163,9 @@ int batch_slurm_script(const job *J, size_t ntasks, int array, const char *parti
                  "# slurm-JOB_TASK.out in the folder it was submitted from)\n"
                  "exec >>",
         direct ? "" : qlog, direct ? "" : "\"$SLURM_ARRAY_TASK_ID\"'.log' 2>&1\n", qself, qjob,
-        array, qlog);
+        array, qbl, qlog);
     if (tl >= (int)sizeof text || o1 + 1 >= sizeof qself || o2 + 1 >= sizeof qjob ||
-        o3 + 1 >= sizeof qlog) {
+        o3 + 1 >= sizeof qlog || o4 + 2 >= sizeof qbl) {
         bt_error(CMD, "%s: paths too long for the script", dirabs);
         return BT_EXIT_BAD_INPUT;
     }

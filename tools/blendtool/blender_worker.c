@@ -238,7 +238,7 @@ static double progress_of(const bt_blender *B) {
 }
 
 int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen,
-                    void (*progress)(void *ctx, double fraction), void *ctx) {
+                    void (*progress)(void *ctx, double fraction), void *ctx, double *seconds) {
     if (B->pid <= 0 && bt_blender_start(B, err, errlen)) return 2;
     if (lseek(B->logfd, 0, SEEK_SET) == 0 && ftruncate(B->logfd, 0) != 0) {
         /* the log keeps the older output; only its tail is shown */
@@ -266,6 +266,10 @@ int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen
         return 2;
     }
     const cJSON *e = cJSON_GetObjectItemCaseSensitive(reply, "error");
+    for (int i = 0; i < 2 && seconds; ++i) {
+        const cJSON *t = cJSON_GetObjectItemCaseSensitive(reply, i ? "seconds" : "render_seconds");
+        seconds[i] = cJSON_IsNumber(t) ? t->valuedouble : -1;
+    }
     int rc = 0;
     if (cJSON_IsString(e)) {
         snprintf(err, errlen, "%s", e->valuestring);

@@ -213,9 +213,11 @@ int bt_blender_start(bt_blender *B, char *err, size_t errlen);
  * 1 the task failed inside Blender (err says why; the worker goes on), 2 the
  * worker died or could not start (err: how, and its last output; the next
  * task starts a new one). While Blender renders, progress (may be NULL) is
- * called with the fraction of samples done, each time it passes a tenth. */
+ * called with the fraction of samples done, each time it passes a tenth.
+ * seconds (may be NULL): [0] Blender's render, [1] the whole task in Blender
+ * (import, mesh, render, save), -1 when not reported. */
 int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen,
-                    void (*progress)(void *ctx, double fraction), void *ctx);
+                    void (*progress)(void *ctx, double fraction), void *ctx, double *seconds);
 /* end the worker (if running) and close its log */
 void bt_blender_stop(bt_blender *B);
 

@@ -131,8 +131,8 @@ static int run_slurm(const job *J, const batch_opts *o, size_t nt) {
     char self[4096];
     const ssize_t sl = readlink("/proc/self/exe", self, sizeof self - 1);
     self[sl > 0 ? sl : 0] = '\0';
-    int rc = batch_slurm_script(J, nt, o->array, o->partition, o->time_min, o->mem_mb, self, script,
-                                sizeof script);
+    int rc = batch_slurm_script(J, nt, o->array, o->partition, o->time_min, o->mem_mb, self,
+                                o->blender, script, sizeof script);
     if (!rc) printf("%s\n", script);
     if (rc || !o->submit) return rc;
     fflush(stdout);
