@@ -90,6 +90,7 @@ def _velocities(pkg, lib, out, req):
     v = v @ np.linalg.inv(M[:3, :3]).T  # back into the object's frame
     a = me.attributes.get("velocity") or me.attributes.new("velocity", "FLOAT_VECTOR", "POINT")
     a.data.foreach_set("vector", v.astype(np.float32).ravel())
+    me["libblend_velocities"] = "given"  # the add-on's render path leaves them as they are
     return float(np.abs(v).max()) if len(v) else 0.0
 
 

@@ -660,13 +660,63 @@ def on_load(*_):
     _structure.clear()
 
 
-_render = {"active": False, "meshed": []}
+_render = {"active": False, "meshed": [], "sub": {}}
 
 
 def _render_frame(obj, frame, depsgraph=None):
     ok, _msg = frame_update(obj, frame, depsgraph, final=True)
     if ok and obj.name not in _render["meshed"]:
         _render["meshed"].append(obj.name)
+    return ok
+
+
+def note_subframe(obj, time, depsgraph):
+    """A motion-blur step of a render: keep the field's scene at that time
+    (the depsgraph's values) for the frame's velocities."""
+    try:
+        text = tree.to_json(obj, depsgraph, render=False, compact=True)[0]
+    except tree.TreeError:
+        return
+    _render["sub"].setdefault(obj.name, {})[time] = text
+
+
+def set_velocities(obj, frame, fps, depsgraph=None):
+    """The point attribute `velocity` (scene units per second) on the field's
+    mesh, which Cycles blurs by: the surface's normal motion between the
+    render's motion-blur steps around frame (libblend's lb_mesh_velocities).
+    Without steps on both sides the attribute is removed. Returns the
+    largest speed, or None."""
+    import numpy as np
+    me = obj.data
+    steps = _render["sub"].pop(obj.name, {})
+    if me.get("libblend_velocities") == "given":
+        return None  # blendtool's farm worker wrote them, from the job's own frames
+    before = [t for t in steps if t < frame]
+    after = [t for t in steps if t > frame]
+    old = me.attributes.get("velocity")
+    if old is not None:
+        me.attributes.remove(old)
+    n = len(me.vertices)
+    if not before or not after or n == 0:
+        return None
+    tb, ta = max(before), min(after)
+    lib = libhandle.library()
+    try:
+        text = tree.to_json(obj, depsgraph, render=False, compact=True)[0]
+    except tree.TreeError:
+        return None
+    P = np.empty(3 * n, dtype=np.float32)
+    me.vertices.foreach_get("co", P)
+    P = P.reshape(-1, 3).astype(np.float64)
+    with lib.parse_scene(text) as s0, lib.parse_scene(steps[tb]) as s1, \
+            lib.parse_scene(steps[ta]) as s2, s0.compile() as e0, s1.compile() as e1, \
+            s2.compile() as e2:
+        # the steps are symmetric about the frame (the shutter is centred):
+        # a central difference over half their distance, in frames
+        v = e0.velocities(P, e1, e2, dt=(ta - tb) / 2, threads=libhandle.threads()) * fps
+    a = me.attributes.new("velocity", "FLOAT_VECTOR", "POINT")
+    a.data.foreach_set("vector", v.astype(np.float32).ravel())
+    return float(np.abs(v).max())
 
 
 @bpy.app.handlers.persistent
@@ -697,13 +747,23 @@ def on_frame_change(scene, depsgraph=None):
         return  # a bake steps through frames itself
     outputs = [o.original for o in scene.objects if o.libblend.kind == "OUTPUT"]
     if _render["active"]:
+        blur = scene.render.use_motion_blur
         if depsgraph is not None and depsgraph.scene_eval.frame_subframe != 0.0:
             # a motion-blur step: Cycles blurs a shape only between steps with the same
-            # vertices, which a remeshed field never has, so the frame's own mesh stays
+            # vertices, which a remeshed field never has, so the frame's own mesh stays;
+            # the step's scene is kept for the frame's velocities
+            if blur:
+                se = depsgraph.scene_eval
+                for obj in outputs:
+                    if not obj.hide_render:
+                        note_subframe(obj, se.frame_current + se.frame_subframe, depsgraph)
             return
+        frame = _frame(scene, depsgraph)
         for obj in outputs:
             if not obj.hide_render:  # a field left out of the render is left as it is
-                _render_frame(obj, _frame(scene, depsgraph), depsgraph)
+                if _render_frame(obj, frame, depsgraph) and blur:
+                    set_velocities(obj, frame, scene.render.fps / scene.render.fps_base,
+                                   depsgraph)
         return
     for obj in outputs:
         if obj.libblend.use_bake and from_cache(obj, _frame(scene, depsgraph), depsgraph)[0]:
@@ -716,6 +776,7 @@ def on_frame_change(scene, depsgraph=None):
 def on_render_done(scene, *_):
     """After a render: back to the viewport's mesh of the current frame."""
     _render["active"] = False
+    _render["sub"].clear()
     while _render["meshed"]:
         obj = bpy.data.objects.get(_render["meshed"].pop())
         if obj is not None:

@@ -262,6 +262,28 @@ blur_m, blur_i, _ = render("blur", ["--python-expr", "import bpy; bpy.context.sc
                                     "use_motion_blur = True", "-f", "3"])
 check(blur_m[3]["vertices"] == full_m[3]["vertices"] and blur_m[3]["volume"] == full_m[3]["volume"],
       "motion blur: frame 3 renders frame 3's mesh, not a sub-frame's")
+# ... with velocities from libblend (the point attribute `velocity`, units per
+# second): zero on the static sphere s3 (a sharp union, far from the rest);
+# on s2's far cap (x = 2.0 at frame 3, outside every blend's range) the
+# sphere's own motion, 0.6 / 3 units a frame x 24 fps = 4.8 units/s along x
+z = np.load(os.path.join(WORK, "blur", "meshes", "anim_0003.npz"))
+if check("U" in z.files, "motion blur: the rendered mesh has a velocity attribute"):
+    V, U = z["V"].astype(np.float64), z["U"].astype(np.float64)
+    static = V[:, 0] < -2.0
+    check(static.any() and np.abs(U[static]).max() < 1e-6,
+          "motion blur: the static sphere's vertices do not move: %g" % np.abs(U[static]).max())
+    # the cap's vertices (x > 1.75; s2's centre is at x = 1.4 at frame 3):
+    # the normal motion of a sphere moving at s along x, (s . n) n
+    cap = V[:, 0] > 1.75
+    speed = 0.6 / 3 * bpy.context.scene.render.fps
+    n = V[cap] - (1.4, 0, 0)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    expect = speed * n[:, :1] * n
+    err = np.linalg.norm(U[cap] - expect, axis=1).max() / speed if cap.any() else 1.0
+    print("motion blur: %d vertices on s2's far cap; velocity error at most %.2g of the speed "
+          "%.2f units/s" % (cap.sum(), err, speed))
+    check(cap.sum() >= 10 and err < 0.01, "motion blur: s2's far cap's velocities %.3g of the "
+          "speed from (s . n) n (bar 1 %%)" % err)
 for f, (mm, ii) in {2: (part_m, part_i), 4: (part_m, part_i), 3: (one_m, one_i)}.items():
     check(mm[f]["vertices"] == full_m[f]["vertices"] and mm[f]["volume"] == full_m[f]["volume"],
           "frame %d: the same mesh in a range render" % f)
