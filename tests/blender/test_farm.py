@@ -5,9 +5,9 @@ Debian 13 root's Blender 4.3:
   sheet, the image metadata and the manifest naming the Blender version;
 - Cycles on the CPU gives the same bytes run to run and at 1 or 2 threads;
 - resume: a rerun skips every task; another sample count re-renders;
-- a worker killed mid-render fails only its task (exit 1, the message says
-  it died), the other tasks finish, a rerun redoes exactly that task and
-  its image equals the uninterrupted run's;
+- a worker killed mid-render, or while idle between tasks, fails only one
+  task (exit 1, the message says it died), the other tasks finish, a rerun
+  redoes exactly that task and its image equals the uninterrupted run's;
 - two shards in two processes at once, and --task through GNU parallel,
   give the same bytes;
 - motion blur: a sphere moving 0.5 units a frame, shutter 1 frame, is
@@ -16,6 +16,7 @@ Debian 13 root's Blender 4.3:
   is not;
 - a scene without a camera and a Blender that cannot run are refused with
   messages naming the fix;
+- an installed blendtool (cmake --install) finds the installed add-on;
 - Blender 4.3 (the Debian 13 root) renders a job the same way.
 usage: test_farm.py BLENDTOOL SOURCE_DIR WORK_DIR
 """
@@ -31,7 +32,7 @@ import time
 import jsonschema
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from checks import args, check, failures, finish, read_ppm  # noqa: E402
+from checks import args, check, finish, read_ppm  # noqa: E402
 
 BT, SRC, WORK = (os.path.abspath(a) for a in args())
 shutil.rmtree(WORK)
@@ -191,6 +192,35 @@ check(not same_bytes(crash, whole, names) if files(crash) == files(whole) else F
 left = [f for f in os.listdir(WORK) if f.startswith("blendtool-")]
 check(not left, "temporary folders left in TMPDIR: %s" % left)
 
+# a worker that dies while idle (blendtool held still right after task 0's
+# image, the worker killed, blendtool let go): the next request meets a
+# closed pipe; that task fails, blendtool goes on with a new worker
+idle = os.path.join(WORK, "idle")
+p = subprocess.Popen([BT, "batch", sweep("idle"), "--log-json"], stdout=subprocess.PIPE,
+                     stderr=subprocess.PIPE, text=True, env=ENV)
+lines, idle_killed = [], None
+for line in p.stdout:
+    lines.append(line)
+    e = json.loads(line)
+    if e["event"] == "output" and e["task"] == 0 and idle_killed is None:
+        os.kill(p.pid, signal.SIGSTOP)
+        kids = children(p.pid)
+        if kids:
+            idle_killed = kids[0]
+            os.kill(idle_killed, signal.SIGKILL)
+            time.sleep(0.5)
+        os.kill(p.pid, signal.SIGCONT)
+err = p.stderr.read()
+p.wait()
+ends = {e["task"]: e for e in map(json.loads, lines) if e["event"] == "task_end"}
+check(idle_killed is not None and p.returncode == 1,
+      "an idle worker killed: blendtool exit %s (expected 1, not killed by SIGPIPE): %s" %
+      (p.returncode, err[-800:]))
+check(ends.get(1, {}).get("status") == "failed" and "died" in ends[1].get("error", "") and
+      all(ends.get(i, {}).get("status") == "done" for i in (0, 2, 3)),
+      "an idle worker killed: task 1 fails, the others are done: %s" %
+      {i: ends.get(i, {}).get("status") for i in range(4)})
+
 # ---- two shards at once, and --task through GNU parallel
 sh = sweep("shards")
 ps = [subprocess.Popen([BT, "batch", sh, "--shard", "%d/2" % i], stdout=subprocess.DEVNULL,
@@ -274,6 +304,23 @@ if len(results) == 2:
     check(s_ramp < 3.0, "without motion_blur the edges ramp over %.1f px (the pixel filter "
           "alone: about 1-2)" % s_ramp)
 
+# ---- sweeps and frames together: 2 radii x 2 frames, names, sheet, metadata
+both = os.path.join(WORK, "both")
+r = run(BT, "batch", job("both", both, {"image": dict(MB, samples=4, mesh=48, width=120,
+                                                        height=90, motion_blur=0.5),
+                                        "contact_sheet": SHEET},
+                         scene=sphere, sweep=[{"path": "root.radius", "values": [0.3, 0.45]}],
+                         frames=dict(FRAMES, first=2, last=3)))
+want = ["both_t%d_%04d.png" % (t, f) for t in (0, 1) for f in (2, 3)]
+check(r.returncode == 0 and files(both) == sorted(want + ["both_sheet.png"]),
+      "a sweep with frames: %s %s" % (files(both), r.stderr[-800:]))
+if files(both):
+    info = subprocess.run(["oiiotool", "--info", "-v", os.path.join(both, want[3])],
+                          capture_output=True, text=True).stdout
+    check("motion_blur 0.5" in info and "radius=0.45" in info and
+          re.search(r"center\[0\]=0\"", info),
+          "a sweep with frames: the image's metadata: %s" % info)
+
 # ---- refused: no camera, no Blender, a POV-Ray key
 nocam = dict(SPHERE)
 nocam.pop("render")
@@ -290,6 +337,19 @@ check(r.returncode == 1 and "--version" in r.stderr and "--blender PATH" in r.st
 r = run(BT, "batch", sweep("bad", dict(IMG, quality=9)))
 check(r.returncode == 2 and "$.outputs.image.quality" in r.stderr and "povray" in r.stderr,
       "quality with renderer blender: exit %d: %s" % (r.returncode, r.stderr[-500:]))
+
+# ---- an installed blendtool finds its add-on (share/libblend/blender_addon)
+inst = os.path.join(WORK, "inst")
+r = subprocess.run(["cmake", "--install", os.path.dirname(os.path.dirname(BT)), "--prefix", inst],
+                   capture_output=True, text=True)
+check(r.returncode == 0, "cmake --install: %s" % r.stderr[-500:])
+env_inst = {k: v for k, v in ENV.items() if k != "LIBBLEND_BLENDER_ADDON"}
+r = subprocess.run([os.path.join(inst, "bin", "blendtool"), "batch", sweep("installed"), "--task",
+                    "1"], capture_output=True, text=True, env=env_inst)
+check(r.returncode == 0 and files(os.path.join(WORK, "installed")) == [names[1]] and
+      not same_bytes(ref, os.path.join(WORK, "installed"), [names[1]]),
+      "the installed blendtool renders with its installed add-on, the same bytes: %s" %
+      r.stderr[-800:])
 
 # ---- Blender 4.3 (the Debian 13 root) renders the same job
 b4 = os.path.join(SRC, "tests", "blender", "blender4_worker.sh")

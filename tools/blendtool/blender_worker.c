@@ -30,6 +30,7 @@
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #ifndef LIBBLEND_ADDON_REL
@@ -178,10 +179,9 @@ int bt_blender_start(bt_blender *B, char *err, size_t errlen) {
         if (in < 0 || out < 0 || dup2(in, 3) < 0 || dup2(out, 4) < 0) _exit(127);
         const int nul = open("/dev/null", O_RDONLY);
         if (nul >= 0) dup2(nul, STDIN_FILENO);
-        if (B->logfd >= 0) {
-            dup2(B->logfd, STDOUT_FILENO);
-            dup2(B->logfd, STDERR_FILENO);
-        }
+        /* Blender's messages never reach blendtool's own output (--log-json) */
+        const int lf = B->logfd >= 0 ? B->logfd : open("/dev/null", O_WRONLY);
+        if (lf < 0 || dup2(lf, STDOUT_FILENO) < 0 || dup2(lf, STDERR_FILENO) < 0) _exit(127);
         setenv("PYTHONDONTWRITEBYTECODE", "1", 1);
         execlp(B->exe, B->exe, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
                script, (char *)NULL);
@@ -243,7 +243,20 @@ int bt_blender_task(bt_blender *B, const char *request, char *err, size_t errlen
     if (lseek(B->logfd, 0, SEEK_SET) == 0 && ftruncate(B->logfd, 0) != 0) {
         /* the log keeps the older output; only its tail is shown */
     }
-    if (fprintf(B->req, "%s\n", request) < 0 || fflush(B->req) != 0) {
+    /* a worker that died while idle: the write fails with EPIPE, and the
+     * SIGPIPE it raises is held and taken back, so that blendtool goes on */
+    sigset_t pipe_set, old;
+    sigemptyset(&pipe_set);
+    sigaddset(&pipe_set, SIGPIPE);
+    sigprocmask(SIG_BLOCK, &pipe_set, &old);
+    const int bad = fprintf(B->req, "%s\n", request) < 0 || fflush(B->req) != 0;
+    sigset_t pending;
+    if (sigpending(&pending) == 0 && sigismember(&pending, SIGPIPE)) {
+        const struct timespec zero = {0, 0};
+        sigtimedwait(&pipe_set, NULL, &zero);
+    }
+    sigprocmask(SIG_SETMASK, &old, NULL);
+    if (bad) {
         died(B, "before the task", err, errlen);
         return 2;
     }
