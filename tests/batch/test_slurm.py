@@ -47,6 +47,45 @@ for c in (cluster, cluster2):
     check(q.returncode == 0 and q.stdout.strip() in ("idle", "mixed", "allocated"),
           "%s answers: %r %r" % (c, q.stdout, q.stderr))
 subprocess.run(["bash", os.path.join(SRC, "scripts", "slurm-cluster.sh"), "stop", cluster2])
+
+
+def kill_mid_task(shard_log, task, shard):
+    """Wait (up to 300 s) until the shard's log says the task started, then
+    SIGKILL the array task's blendtool (its command line has `--shard
+    SHARD`). Returns (killed, the pids of its children at that moment)."""
+    deadline = time.time() + 300
+    while time.time() < deadline:
+        if os.path.exists(shard_log):
+            ev = [json.loads(l) for l in open(shard_log) if l.strip()]
+            if any(e["event"] == "task_start" and e["task"] == task for e in ev):
+                time.sleep(0.3)
+                kids = []
+                for pid in subprocess.run(["pgrep", "-f", "--", "--shard " + shard],
+                                          capture_output=True, text=True).stdout.split():
+                    try:
+                        with open("/proc/%s/task/%s/children" % (pid, pid)) as f:
+                            kids += f.read().split()
+                    except OSError:
+                        pass
+                k = subprocess.run(["pkill", "-KILL", "-f", "--", "--shard " + shard])
+                return k.returncode == 0, kids
+        time.sleep(0.05)
+    return False, []
+
+
+def resubmit(script, out, shards):
+    """sbatch --wait the script again; (its result, the tasks the shards'
+    logs say were done by it)"""
+    logs = [os.path.join(out, "logs", "farm_shard_%d.jsonl" % i) for i in range(shards)]
+    before = [len(open(l).readlines()) for l in logs]
+    r = subprocess.run(["sbatch", "--wait", script], capture_output=True, text=True, timeout=600)
+    redone = []
+    for log, n in zip(logs, before):
+        redone += [json.loads(l)["task"] for l in open(log).readlines()[n:]
+                   if '"task_end"' in l and json.loads(l)["status"] == "done"]
+    return r, redone
+
+
 try:
     JOB = {"format": "libblend-job", "version": 1, "name": "farm",
            "scene": os.path.join(SRC, "scenes", "bernhardt-compare-local.json"),
@@ -114,18 +153,8 @@ try:
     check(r.returncode == 0 and script.endswith("farm.sbatch"), "batch --slurm writes the script: " + r.stdout)
     p = subprocess.Popen(["sbatch", "--wait", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                          text=True)
-    shard_log = os.path.join(dk, "out", "logs", "farm_shard_2.jsonl")
-    killed = None
-    deadline = time.time() + 300
-    while time.time() < deadline and killed is None:
-        # shard 2 holds tasks 4 and 5: kill it while task 5 renders
-        if os.path.exists(shard_log):
-            ev = [json.loads(l) for l in open(shard_log) if l.strip()]
-            if any(e["event"] == "task_start" and e["task"] == 5 for e in ev):
-                time.sleep(0.3)
-                k = subprocess.run(["pkill", "-KILL", "-f", "--", "--shard 2/4"])
-                killed = k.returncode == 0
-        time.sleep(0.05)
+    # shard 2 holds tasks 4 and 5: kill it while task 5 renders
+    killed, _ = kill_mid_task(os.path.join(dk, "out", "logs", "farm_shard_2.jsonl"), 5, "2/4")
     out, err = p.communicate(timeout=600)
     check(killed, "array task 2 was killed mid-task")
     check(p.returncode != 0, "sbatch --wait reports the killed array task: exit %d" % p.returncode)
@@ -134,15 +163,8 @@ try:
         check(kref.get(n) == h, "after the kill, %s is complete (the reference's bytes)" % n)
     check(not os.path.exists(os.path.join(kout, ".libblend-manifest", "farm_0005.json")),
           "the killed task has no manifest")
-    before = {i: len(open(os.path.join(kout, "logs", "farm_shard_%d.jsonl" % i)).readlines())
-              for i in range(4)}
-    r = subprocess.run(["sbatch", "--wait", script], capture_output=True, text=True, timeout=600)
+    r, redone = resubmit(script, kout, 4)
     check(r.returncode == 0, "resubmitting the script succeeds: " + r.stderr)
-    redone = []
-    for i in range(4):
-        lines = open(os.path.join(kout, "logs", "farm_shard_%d.jsonl" % i)).readlines()[before[i]:]
-        redone += [json.loads(l)["task"] for l in lines
-                   if '"task_end"' in l and json.loads(l)["status"] == "done"]
     check(redone == [5], "the resubmission redid only the killed task: %s" % redone)
     check({k: v for k, v in digest(kout).items() if k != "farm_sheet.png"} == kref,
           "and every output now equals the reference")
@@ -164,25 +186,8 @@ try:
     check(r.returncode == 0, "Blender job: batch --slurm: " + r.stderr[-500:])
     p = subprocess.Popen(["sbatch", "--wait", script], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
-    shard_log = os.path.join(dbk, "out", "logs", "farm_shard_1.jsonl")
-    killed, workers = None, []
-    deadline = time.time() + 300
-    while time.time() < deadline and killed is None:
-        if os.path.exists(shard_log):
-            ev = [json.loads(l) for l in open(shard_log) if l.strip()]
-            if any(e["event"] == "task_start" and e["task"] == 7 for e in ev):
-                time.sleep(0.3)
-                shard = subprocess.run(["pgrep", "-f", "--", "--shard 1/2"], capture_output=True,
-                                       text=True).stdout.split()
-                for pid in shard:
-                    try:
-                        with open("/proc/%s/task/%s/children" % (pid, pid)) as f:
-                            workers += f.read().split()
-                    except OSError:
-                        pass
-                k = subprocess.run(["pkill", "-KILL", "-f", "--", "--shard 1/2"])
-                killed = k.returncode == 0
-        time.sleep(0.05)
+    killed, workers = kill_mid_task(os.path.join(dbk, "out", "logs", "farm_shard_1.jsonl"), 7,
+                                    "1/2")
     out, err = p.communicate(timeout=600)
     check(killed and workers, "Blender job: array task 1 killed mid-render (its workers %s)" % workers)
     check(p.returncode != 0, "Blender job: sbatch --wait reports the kill: exit %d" % p.returncode)
@@ -193,15 +198,8 @@ try:
     check(not os.path.exists(os.path.join(bout, "farm_0007.png")) and
           not os.path.exists(os.path.join(bout, ".libblend-manifest", "farm_0007.json")),
           "Blender job: the killed task left no image and no manifest")
-    before = {i: len(open(os.path.join(bout, "logs", "farm_shard_%d.jsonl" % i)).readlines())
-              for i in range(2)}
-    r = subprocess.run(["sbatch", "--wait", script], capture_output=True, text=True, timeout=600)
+    r, redone = resubmit(script, bout, 2)
     check(r.returncode == 0, "Blender job: the resubmission succeeds: " + r.stderr)
-    redone = []
-    for i in range(2):
-        lines = open(os.path.join(bout, "logs", "farm_shard_%d.jsonl" % i)).readlines()[before[i]:]
-        redone += [json.loads(l)["task"] for l in lines
-                   if '"task_end"' in l and json.loads(l)["status"] == "done"]
     check(redone == [7], "Blender job: the resubmission redid only the killed task: %s" % redone)
     got = digest(bout)
     check(got == bref, "Blender job: Slurm's outputs equal the local run's: %s" %
