@@ -16,6 +16,8 @@ Debian 13 root's Blender 4.3:
   is not;
 - a scene without a camera and a Blender that cannot run are refused with
   messages naming the fix;
+- EEVEE renders on Blender 3.4; on 4.3 without OpenGL the task fails
+  saying what EEVEE needs;
 - an installed blendtool (cmake --install) finds the installed add-on;
 - Blender 4.3 (the Debian 13 root) renders a job the same way.
 usage: test_farm.py BLENDTOOL SOURCE_DIR WORK_DIR
@@ -337,6 +339,22 @@ check(r.returncode == 1 and "--version" in r.stderr and "--blender PATH" in r.st
 r = run(BT, "batch", sweep("bad", dict(IMG, quality=9)))
 check(r.returncode == 2 and "$.outputs.image.quality" in r.stderr and "povray" in r.stderr,
       "quality with renderer blender: exit %d: %s" % (r.returncode, r.stderr[-500:]))
+
+# ---- EEVEE: Blender 3.4 renders it headless here; Blender 4.3 in the root
+# has no OpenGL (no libEGL): the task fails saying what EEVEE needs
+eimg = dict(IMG, engine="eevee")
+r = run(BT, "batch", sweep("eevee", eimg), "--task", "2")
+eout = os.path.join(WORK, "eevee")
+check(r.returncode == 0 and files(eout) == [names[2]], "EEVEE on 3.4: %s" % r.stderr[-800:])
+if files(eout):
+    info = subprocess.run(["oiiotool", "--info", "-v", os.path.join(eout, names[2])],
+                          capture_output=True, text=True).stdout
+    check("Blender 3.4.1 eevee samples 8" in info, "EEVEE's metadata: %s" % info)
+    check(same_bytes(ref, eout, [names[2]]), "EEVEE's image is not Cycles' image")
+r = run(BT, "batch", sweep("eevee4", eimg), "--task", "2", "--blender",
+        os.path.join(SRC, "tests", "blender", "blender4_worker.sh"))
+check(r.returncode == 1 and "EEVEE needs OpenGL" in r.stderr and "libEGL" in r.stderr,
+      "EEVEE on 4.3 without OpenGL: exit %d: %s" % (r.returncode, r.stderr[-800:]))
 
 # ---- an installed blendtool finds its add-on (share/libblend/blender_addon)
 inst = os.path.join(WORK, "inst")

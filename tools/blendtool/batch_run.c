@@ -193,8 +193,12 @@ static int blender_render(const job *J, const task *T, const bt_render_dir *R, i
         batch_log_event(L, e);
     }
     if (w) {
-        bt_error(CMD, "%s: rendering with Blender failed: %s", T->name,
-                 err[0] ? err : "out of memory");
+        const int eevee = w == 2 && !strcmp(J->engine, "eevee");
+        bt_error(CMD, "%s: rendering with Blender failed: %s%s", T->name,
+                 err[0] ? err : "out of memory",
+                 eevee ? "\nEEVEE needs OpenGL on the node (Blender 4.x: libEGL and a GPU or "
+                         "Mesa); allowed: \"engine\": \"cycles\", or a node with OpenGL"
+                       : "");
         return BT_EXIT_INTERNAL;
     }
     return 0;
