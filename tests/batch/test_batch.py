@@ -258,7 +258,8 @@ CASES = [
     ("range key", dict(good, sweep=[{"path": "a", "range": {"from": 0, "to": 1, "n": 3}}]), "unknown key \"n\""),
     ("range from", dict(good, sweep=[{"path": "a", "range": {"from": "x", "to": 1, "count": 2}}]), "\"from\""),
     ("frames order", dict(good, frames={"first": 5, "last": 2}), "$.frames"),
-    ("frames key", dict(good, frames={"first": 1, "last": 2, "fps": 24}), "unknown key \"fps\""),
+    ("frames key", dict(good, frames={"first": 1, "last": 2, "rate": 24}), "unknown key \"rate\""),
+    ("frames fps", dict(good, frames={"first": 1, "last": 2, "fps": 0}), "$.frames"),
     ("keys order", dict(good, frames={"first": 1, "last": 2, "animate": [
         {"path": "a", "keys": [[2, 0], [1, 1]]}]}), "increasing frames"),
     ("keys pair", dict(good, frames={"first": 1, "last": 2, "animate": [
