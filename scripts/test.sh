@@ -37,11 +37,16 @@ echo "== build-windows (mingw-w64 cross build; the C test programs under Wine)"
 cmake -S . -B build-windows -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_TOOLCHAIN_FILE=cmake/mingw-w64-x86_64.cmake -DLIBBLEND_BENCH=OFF
 cmake --build build-windows -j "$JOBS"
+# one wineserver for the Wine programs of this stage and the next (why: scripts/wine-run.sh)
+bash scripts/wine-run.sh --hold
+trap 'bash scripts/wine-run.sh --release' EXIT
 ctest --test-dir build-windows --output-on-failure -j "$JOBS"
 
 echo "== packages (scripts/package.sh from the two builds, each opened as a user would)"
 LIBBLEND_DIST="$PWD/build-dist" bash scripts/package.sh --builds build-release build-windows
 bash tests/packaging/test_packages.sh build-dist .
+bash scripts/wine-run.sh --release
+trap - EXIT
 
 echo "== build-tsan (ThreadSanitizer: the tests that run threads)"
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_TSAN=ON \

@@ -5,6 +5,13 @@
 # as the cross-compiling emulator of the Windows build
 # (cmake/mingw-w64-x86_64.cmake).
 #   wine-run.sh PROGRAM.exe ARGS...
+#   wine-run.sh --hold      start the prefix's wineserver for good (until --release)
+#   wine-run.sh --release   stop it
+# Why hold: a wineserver started by a program exits 3 s after its last
+# client, and a program that connects while it is exiting dies with "wine
+# client error:0: recvmsg: Connection reset by peer" (it failed a CI run,
+# ctest starting tests 2 at a time). A server held for the whole test stage
+# never exits under a program, and --hold starts Wine's services itself.
 set -euo pipefail
 WINE=${LIBBLEND_WINE:-/usr/lib/wine/wine64}
 [ -x "$WINE" ] || {
@@ -31,4 +38,20 @@ if [ ! -f "$WINEPREFIX/.libblend-ok" ]; then
   flock -u 9
   exec 9>&-
 fi
+WINESERVER="$(dirname "$WINE")/wineserver"
+case "${1-}" in
+--hold)
+  # exit status 2: a server already runs for this prefix (held or not)
+  "$WINESERVER" -p </dev/null >/dev/null 2>&1 || [ $? -eq 2 ]
+  # Wine's own services (services.exe, winedevice.exe, ...) live as long as a
+  # held server; started here, they hold no test's output pipe open (ctest
+  # waits for a test's pipe to close)
+  "$WINE" cmd /c exit </dev/null >/dev/null 2>&1 || true
+  exit 0
+  ;;
+--release)
+  "$WINESERVER" -k 2>/dev/null || true
+  exit 0
+  ;;
+esac
 exec "$WINE" "$@"
