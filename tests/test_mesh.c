@@ -646,6 +646,43 @@ static void test_no_self_intersections(void **state) {
     assert_true(checked > 1000000);
 }
 
+/* With LB_MESH_FEATURES (a vertex on each crease, up to half a cell outside
+ * its cell, and the flips that join them): the papers' scenes and the sharp
+ * shapes of tests/data/features, still free of self-intersections, closed
+ * and manifold. */
+static void test_no_self_intersections_features(void **state) {
+    (void)state;
+    static const char *const sharp[] = {"cube", "rotated-cube", "two-boxes", "cylinder-slab",
+                                        "clean-union-spheres"};
+    const unsigned res[2] = {64, 128};
+    size_t checked = 0;
+    for (size_t s = 0; s < nscenes + 5; ++s) {
+        char path[1100];
+        if (s < nscenes) {
+            if (!strstr(scene_paths[s], "/scenes/hsu")) continue;
+            snprintf(path, sizeof path, "%s", scene_paths[s]);
+        } else {
+            snprintf(path, sizeof path, "%s/tests/data/features/%s.json", SOURCE_DIR,
+                     sharp[s - nscenes]);
+        }
+        for (int r = 0; r < 2; ++r) {
+            built B;
+            build_file(path, res[r], LB_MESH_FEATURES, 0, &B);
+            const topo t = topology(B.m);
+            if (!t.closed || !t.oriented || !t.manifold)
+                fail_msg("%s at %u with features: closed %d oriented %d manifold %d", path, res[r],
+                         t.closed, t.oriented, t.manifold);
+            size_t pairs = 0;
+            const size_t hits = self_intersections(B.m, &pairs);
+            if (hits) fail_msg("%s at %u: %zu intersecting triangle pairs", path, res[r], hits);
+            checked += pairs;
+            unbuild(&B);
+        }
+    }
+    fprintf(stderr, "  %zu nearby triangle pairs tested\n", checked);
+    assert_true(checked > 1000000);
+}
+
 /* ---- progress, cancel, bad options ---- */
 
 typedef struct prog {
@@ -1136,6 +1173,7 @@ int main(void) {
         cmocka_unit_test(test_ambiguous_fields),
         cmocka_unit_test(test_region_cap_and_open),
         cmocka_unit_test(test_no_self_intersections),
+        cmocka_unit_test(test_no_self_intersections_features),
         cmocka_unit_test(test_progress_and_cancel),
         cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_memory_cap_and_empty),

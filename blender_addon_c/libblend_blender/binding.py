@@ -35,6 +35,7 @@ STATUS_NAMES = {0: "ok", 1: "invalid argument", 2: "not finite", 3: "no memory",
 STATUS_CANCELLED = 5
 FORMATS = {"auto": 0, "ply": 1, "obj": 2, "stl": 3, "glb": 4}
 MESH_OPEN_BOUNDARY = 1
+MESH_FEATURES = 4  # LB_MESH_FEATURES: keep sharp creases and corners
 
 
 class LibblendError(Exception):
@@ -462,10 +463,11 @@ class Evaluator(_Handle):
         return v
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
-             max_memory=0, cancel=None, edges=False):
+             max_memory=0, cancel=None, edges=False, features=False):
         """Mesh the field over the box [bmin, bmax] (docs/meshing.md). Returns a
         Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called.
-        edges=True also fills Mesh.edges and Mesh.corner_edges (lb_mesh_edges)."""
+        edges=True also fills Mesh.edges and Mesh.corner_edges (lb_mesh_edges);
+        features=True keeps sharp creases and corners (LB_MESH_FEATURES)."""
         _need_numpy()
         o = _MeshOptions()
         self.lib._c.lb_mesh_options_init(ctypes.byref(o))
@@ -473,7 +475,7 @@ class Evaluator(_Handle):
             o.bmin[i], o.bmax[i] = float(bmin[i]), float(bmax[i])
         o.resolution = int(resolution)
         o.cell_size = float(cell_size)
-        o.flags = MESH_OPEN_BOUNDARY if open_boundary else 0
+        o.flags = (MESH_OPEN_BOUNDARY if open_boundary else 0) | (MESH_FEATURES if features else 0)
         o.threads = int(threads)
         o.max_memory = int(max_memory)
         if cancel is not None:

@@ -6,11 +6,13 @@ shared defs, bulge elimination, nesting up to depth 4), from fixed seeds
 0..N-1 so that every run checks the same ones, then from a seed of this run
 (printed, so a failure can be replayed) for the rest of the time budget.
 Each is parsed and compiled through the library (the ctypes binding, no
-process per scene) and meshed at 12 cells on two threads and 20 on one; every
-non-empty mesh must be closed, oriented and 2-manifold (tests/mesh's numpy
-checks), and the scenes found wrong before (by an issue, or by this test's
-fresh seeds: barthe-underflow.json, seed 578775895819, failed to compile)
-must mesh closed at 20, 64 and 97 cells (tests/data/regressions/).
+process per scene) and meshed at 12 cells on two threads and 20 on one, and
+at 20 on two with sharp features (LB_MESH_FEATURES); every non-empty mesh
+must be closed, oriented and 2-manifold (tests/mesh's numpy checks), and the
+scenes found wrong before (by an issue, or by this test's fresh seeds:
+barthe-underflow.json, seed 578775895819, failed to compile) must mesh
+closed at 20, 64 and 97 cells, and at 64 and 97 with sharp features
+(tests/data/regressions/).
 
 usage: random_meshes.py ADDON_DIR SOURCE_DIR FIXED_COUNT EXTRA_SECONDS
 """
@@ -52,21 +54,28 @@ def closed(text, name, runs):
         with ev:
             lo, hi = sc.bounds
             n = 0
-            for res, th in runs:
-                m = ev.mesh(lo, hi, resolution=res, threads=th)
+            for res, th, feat in runs:
+                try:
+                    m = ev.mesh(lo, hi, resolution=res, threads=th, features=feat)
+                except binding.LibblendError as e:  # a valid scene must mesh
+                    fail("%s: mesh at %d cells, %d threads%s: %s" %
+                         (name, res, th, " with sharp features" if feat else "", e))
+                    return n
                 if not len(m.triangles):
                     continue
                 c = meshcheck.check(m.positions, m.triangles)
                 n += 1
                 if not (c["closed"] and c["oriented"] and c["manifold"]):
-                    fail("%s: mesh at %d cells, %d threads: %s" % (name, res, th, c))
+                    fail("%s: mesh at %d cells, %d threads%s: %s" %
+                         (name, res, th, " with sharp features" if feat else "", c))
                     return n
             return n
 
 
 # the scenes an issue found open
 for p in sorted(glob.glob(os.path.join(SRC, "tests", "data", "regressions", "*.json"))):
-    n = closed(open(p).read(), os.path.basename(p), ((20, 1), (64, 2), (97, 1)))
+    n = closed(open(p).read(), os.path.basename(p), ((20, 1, False), (64, 2, False), (97, 1, False),
+                                                        (64, 2, True), (97, 1, True)))
     if not n:
         fail("%s: nothing meshed" % p)
 
@@ -76,7 +85,7 @@ stats = {"scenes": 0, "meshes": 0, "refused": 0, "empty": 0}
 
 def run(seed):
     sc, _ = random_scenes.scene(seed)
-    n = closed(json.dumps(sc), "seed %d" % seed, ((12, 2), (20, 1)))
+    n = closed(json.dumps(sc), "seed %d" % seed, ((12, 2, False), (20, 1, False), (20, 2, True)))
     stats["scenes"] += 1
     if n is None:
         stats["refused"] += 1

@@ -121,6 +121,8 @@ static int parse_args(int argc, char **argv, mesh_args *A) {
             A->o.flags |= LB_MESH_OPEN_BOUNDARY;
         } else if (strcmp(argv[i], "--tetrahedra") == 0) {
             A->o.flags |= LB_MESH_TETRAHEDRA;
+        } else if (strcmp(argv[i], "--features") == 0) {
+            A->o.flags |= LB_MESH_FEATURES;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
             A->quiet = 1;
         } else if (bt_scene_arg(CMD, argv[i], &A->scene_path)) {
@@ -213,7 +215,8 @@ const bt_command bt_cmd_mesh = {
     "mesh", "a closed triangle mesh of the scene (PLY, OBJ, STL, glTF binary)",
     "usage: blendtool mesh SCENE -o OUT.{ply,obj,stl,glb} [--resolution N | --cell-size H]\n"
     "                      [--bounds x0,y0,z0,x1,y1,z1] [--open] [--threads N] [--quiet]\n"
-    "                      [--format ply|obj|stl|glb] [--set PATH=VALUE]... [--tetrahedra]\n\n"
+    "                      [--format ply|obj|stl|glb] [--set PATH=VALUE]... [--tetrahedra]\n"
+    "                      [--features]\n\n"
     "Meshes the scene's surface inside the region (the scene's bounds, or --bounds):\n"
     "closed and manifold, vertices on the surface with normals from the analytic\n"
     "gradient. Where the region cuts the solid the mesh is closed on the region's\n"
@@ -226,6 +229,9 @@ const bt_command bt_cmd_mesh = {
     "  --quiet         no progress bar (shown only on a terminal) and no summary line\n"
     "  --tetrahedra    split cells into six tetrahedra instead of cube polygons (about\n"
     "                  3x the triangles; the zero set of one piecewise-linear field)\n"
+    "  --features      keep sharp creases and corners (of min, max, clean and local\n"
+    "                  unions, slabs, the region's cap) exactly: a vertex on the crease\n"
+    "                  or corner of each cell it passes through\n"
     "  --set PATH=VALUE  override a scene value first (VALUE is JSON), e.g.\n"
     "                  --set root.args[0].radius=0.5; repeatable, applied in order\n"
     "OUT may be a symbolic link (its target is replaced), a device or a FIFO (written\n"

@@ -54,6 +54,13 @@ extern "C" {
  * the default cube polygons: about 3x the triangles, the zero set of one
  * piecewise-linear function (docs/meshing.md, Method) */
 #define LB_MESH_TETRAHEDRA 2u
+/* keep sharp creases and corners: where the normals of a cell's surface
+ * disagree (a crease of min, max, a clean or local union, a slab, the
+ * region's cap), the cell gets a vertex on the crease or corner, found from
+ * the normals by a least-squares fit within the cell and put on the surface;
+ * still closed, manifold and independent of the thread count (docs/meshing.md,
+ * Sharp features). Not with LB_MESH_TETRAHEDRA (ignored there). */
+#define LB_MESH_FEATURES 4u
 
 /* Called on the calling thread with the fraction of work done, in [0, 1];
  * return non-zero to cancel the run (lb_mesh_create then fails with

@@ -61,6 +61,7 @@ typedef struct lb__grid {
     double bmin[3], bmax[3];
     int soft;
     int tetrahedra; /* LB_MESH_TETRAHEDRA: the Kuhn split instead of cube polygons */
+    int features;   /* LB_MESH_FEATURES: a vertex on the crease or corner of a cell (features.c) */
     lb__mctable mc;
 } lb__grid;
 
@@ -70,6 +71,7 @@ typedef struct lb__grid {
 typedef struct lb__fent {
     uint32_t idx, pad;
     double pos[3];
+    double nrm[3]; /* its unit normal (for the sharp features' test) */
 } lb__fent;
 
 /* Entries of a block's near-face table: per near face (axis d), per node of
@@ -104,6 +106,7 @@ typedef struct lb__block {
      * ones in vpos; nt triangles over local vertex indices (own ones, then
      * the references) */
     size_t nv, np, nref, nt;
+    size_t nfeat; /* of the np, the last nfeat are feature points (features.c) */
     uint64_t *okey;
     uint32_t *rref;
     double *vpos, *vnrm;
@@ -248,6 +251,19 @@ static inline int64_t lb__cell_edge(lb__bctx *C, uint32_t i, uint32_t j, uint32_
  * triangles may join (LB__PAIR bits; LB__ALL_PAIRS: any diagonal). 0 when
  * out of memory. */
 LB_INTERNAL int lb__cell_polygon(lb__bctx *C, const uint32_t *e, uint64_t ok, uint32_t n);
+
+/* Sharp features (features.c). A polygon whose vertex normals include two
+ * with a cosine below LB__FEATURE_COS gets a feature point. */
+#define LB__FEATURE_COS 0.9
+/* The point of the box [lo, hi] that minimises sum_i (n_i . (x - p_i))^2
+ * over the m points p and unit normals n (3 per point), small eigen-
+ * directions left to the mass point; 0 when m < 2. */
+LB_INTERNAL int lb__feature_qef(const double *p, const double *n, int m, const double lo[3],
+                                const double hi[3], double x[3]);
+/* Flip every cell-face segment between two fans around feature points
+ * (feat[v] = 1) into the edge joining the two points, where that keeps
+ * both triangles' orientation and makes no edge twice. */
+LB_INTERNAL lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err);
 
 /* One cell (i, j, k) with corner values c (some inside, some outside; bit o
  * of cfg set: corner o inside): its polygons, by the cube cases or by the

@@ -91,6 +91,7 @@ static lb_status make_grid(const lb_evaluator *ev, const lb_mesh_options *o, lb_
     }
     g->closed = !(o->flags & LB_MESH_OPEN_BOUNDARY);
     g->tetrahedra = (o->flags & LB_MESH_TETRAHEDRA) != 0;
+    g->features = (o->flags & LB_MESH_FEATURES) != 0;
     g->soft = lb_evaluator_convention(ev) == LB_CONVENTION_SOFT;
     for (int d = 0; d < 3; ++d) {
         const double nf = ceil(ext[d] / h - 1e-9);
@@ -276,6 +277,9 @@ typedef struct mstate {
     size_t cap, used;
     uint32_t *local;
     uint32_t *base;
+    /* the feature points' vertex ranges (first, count), for the flips */
+    size_t *fr;
+    size_t nfr, frcap;
     lb_status s;
     lb_error err;
 } mstate;
@@ -677,6 +681,21 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     /* the block's own vertices are the mesh's next ones */
     const size_t base = M->nvertices;
     S->base[bi] = (uint32_t)base;
+    if (B->nfeat) {
+        if (S->nfr == S->frcap) {
+            const size_t c = S->frcap ? 2 * S->frcap : 64;
+            size_t *p = realloc(S->fr, 2 * c * sizeof *p);
+            if (!p) {
+                S->s = lb__fail(&S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+                return 0;
+            }
+            S->fr = p;
+            S->frcap = c;
+        }
+        S->fr[2 * S->nfr] = base + B->np - B->nfeat;
+        S->fr[2 * S->nfr + 1] = B->nfeat;
+        ++S->nfr;
+    }
     if (B->np) { /* a block may have no vertex (and no arrays) */
         memcpy(M->positions + 3 * base, B->vpos, 3 * B->np * sizeof(double));
         memcpy(M->normals + 3 * base, B->vnrm, 3 * B->np * sizeof(double));
@@ -1016,10 +1035,10 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: threads = %d; allowed: 0 (one per CPU) or a positive count", FN,
                         opt->threads);
-    if (opt->flags & ~(unsigned)(LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA))
+    if (opt->flags & ~(unsigned)(LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA | LB_MESH_FEATURES))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: flags = %#x; allowed: 0 or LB_MESH_OPEN_BOUNDARY | "
-                        "LB_MESH_TETRAHEDRA",
+                        "LB_MESH_TETRAHEDRA | LB_MESH_FEATURES",
                         FN, opt->flags);
     lb__grid g;
     lb_status s = make_grid(ev, opt, &g, err);
@@ -1089,6 +1108,17 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
             s = lb__fail(err, LB_ERR_INTERNAL, "%s: %zu blocks not merged", FN,
                          R.nblocks - R.mnext);
     }
+    if (!s && !P.cancelled && R.ms.nfr) { /* sharp features: join them (features.c) */
+        uint8_t *feat = calloc(M->nvertices, 1);
+        if (!feat) {
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        } else {
+            for (size_t i = 0; i < R.ms.nfr; ++i)
+                memset(feat + R.ms.fr[2 * i], 1, R.ms.fr[2 * i + 1]);
+            s = lb__feature_flips(M, feat, err);
+            free(feat);
+        }
+    }
     if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
         M->positions = malloc(3 * sizeof *M->positions);
         M->normals = malloc(3 * sizeof *M->normals);
@@ -1131,6 +1161,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     free(R.refs);
     free(R.fin);
     free(R.ms.tab);
+    free(R.ms.fr);
     free(R.ms.base);
     free(R.ms.local);
     pthread_mutex_destroy(&R.lock);

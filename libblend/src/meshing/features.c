@@ -1,0 +1,262 @@
+/* Sharp features (LB_MESH_FEATURES): a vertex on the crease or corner that
+ * a cell's surface bends around, and the flips that join those vertices
+ * along the crease. extract.c places the points; this file holds the
+ * least-squares fit and the flips.
+ *
+ * A cell polygon's vertices lie on the cell's edges, each with the unit
+ * normal of the field there. Where two of them differ by more than
+ * LB__FEATURE_COS, the surface bends sharply inside the cell and the
+ * polygon's own triangles would cut the bend off (a bevel of up to half a
+ * cell). Each vertex and normal says the surface passes through p_i with
+ * tangent plane n_i . (x - p_i) = 0; the point that best satisfies all of
+ * them in the least-squares sense (the quadric error function, QEF, of
+ * dual contouring) lies on the crease of two planes, or at the corner of
+ * three. It is found with the small directions of the 3x3 normal matrix cut
+ * off (what those directions cannot decide, the polygon's mass point does),
+ * within a box (the cell, grown by half a cell: extract.c says why), by the
+ * box's faces, edges and corners when the free minimum lies outside. The
+ * polygon becomes a fan around that point: the same boundary segments on
+ * the cell faces, so the mesh stays closed and manifold.
+ *
+ * A fan's triangle runs from the feature point to a segment on a cell
+ * face; the neighbouring cell's fan has the same segment. When both cells
+ * have a feature point, the segment crosses the crease between them: it is
+ * flipped into the edge between the two points (lb__feature_flips), so the
+ * crease is an edge of the mesh. */
+#include "mesh_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Eigenvalues w and eigenvectors (columns of V) of the symmetric k x k
+ * matrix A (k <= 3, row-major in a 3x3 array), by cyclic Jacobi rotations:
+ * a fixed sequence of operations, so the same input gives the same bits. */
+static void sym_eigen(double A[3][3], int k, double w[3], double V[3][3]) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) V[i][j] = i == j;
+    for (int sweep = 0; sweep < 32; ++sweep) {
+        double off = 0.0;
+        for (int p = 0; p < k; ++p)
+            for (int q = p + 1; q < k; ++q) off += A[p][q] * A[p][q];
+        if (off <= 1e-30 * (A[0][0] * A[0][0] + 1e-300)) break;
+        for (int p = 0; p < k; ++p)
+            for (int q = p + 1; q < k; ++q) {
+                if (A[p][q] == 0.0) continue;
+                const double theta = (A[q][q] - A[p][p]) / (2.0 * A[p][q]);
+                const double t =
+                    (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                const double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int r = 0; r < k; ++r) { /* A = A J */
+                    const double arp = A[r][p], arq = A[r][q];
+                    A[r][p] = c * arp - s * arq;
+                    A[r][q] = s * arp + c * arq;
+                }
+                for (int r = 0; r < k; ++r) { /* A = J^T A */
+                    const double apr = A[p][r], aqr = A[q][r];
+                    A[p][r] = c * apr - s * aqr;
+                    A[q][r] = s * apr + c * aqr;
+                }
+                for (int r = 0; r < k; ++r) {
+                    const double vrp = V[r][p], vrq = V[r][q];
+                    V[r][p] = c * vrp - s * vrq;
+                    V[r][q] = s * vrp + c * vrq;
+                }
+            }
+    }
+    for (int i = 0; i < k; ++i) w[i] = A[i][i];
+}
+
+/* Directions whose eigenvalue is below this fraction of the largest are
+ * left to the mass point: for the normals of two planes at angle t the
+ * small eigenvalue is about sin^2 t of the large one, so creases sharper
+ * than about 8 degrees are resolved, and nearly parallel normals (a gently
+ * curved surface) do not throw the point far along its tangent plane. */
+#define EIG_CUT 0.02
+
+/* The QEF's least-squares point over the free coordinates (free bit d set:
+ * x[d] free; the others stay as given in x), starting from the mass point
+ * c: x_F = c_F + pinv(A_F^T A_F) A_F^T r with r_i = n_i . (p_i - x0), x0 =
+ * x with c in the free coordinates. */
+static void qef_free(const double *p, const double *n, int m, const double c[3], int freem,
+                     double x[3]) {
+    int idx[3], k = 0;
+    for (int d = 0; d < 3; ++d)
+        if ((freem >> d) & 1) idx[k++] = d;
+    double x0[3];
+    for (int d = 0; d < 3; ++d) x0[d] = (freem >> d) & 1 ? c[d] : x[d];
+    if (!k) {
+        memcpy(x, x0, sizeof x0);
+        return;
+    }
+    double A[3][3] = {{0}}, b[3] = {0};
+    for (int i = 0; i < m; ++i) {
+        const double *ni = n + 3 * i, *pi = p + 3 * i;
+        const double r =
+            ni[0] * (pi[0] - x0[0]) + ni[1] * (pi[1] - x0[1]) + ni[2] * (pi[2] - x0[2]);
+        for (int a = 0; a < k; ++a) {
+            b[a] += ni[idx[a]] * r;
+            for (int q = 0; q < k; ++q) A[a][q] += ni[idx[a]] * ni[idx[q]];
+        }
+    }
+    double w[3], V[3][3];
+    sym_eigen(A, k, w, V);
+    double wmax = 0.0;
+    for (int a = 0; a < k; ++a) wmax = fmax(wmax, w[a]);
+    double y[3] = {0, 0, 0};
+    for (int a = 0; a < k; ++a) {
+        if (!(w[a] > EIG_CUT * wmax) || !(wmax > 0.0)) continue;
+        double vb = 0.0;
+        for (int q = 0; q < k; ++q) vb += V[q][a] * b[q];
+        for (int q = 0; q < k; ++q) y[q] += V[q][a] * vb / w[a];
+    }
+    memcpy(x, x0, sizeof x0);
+    for (int a = 0; a < k; ++a) x[idx[a]] += y[a];
+}
+
+static double qef_err(const double *p, const double *n, int m, const double x[3]) {
+    double e = 0.0;
+    for (int i = 0; i < m; ++i) {
+        const double *ni = n + 3 * i, *pi = p + 3 * i;
+        const double r = ni[0] * (x[0] - pi[0]) + ni[1] * (x[1] - pi[1]) + ni[2] * (x[2] - pi[2]);
+        e += r * r;
+    }
+    return e;
+}
+
+int lb__feature_qef(const double *p, const double *n, int m, const double lo[3], const double hi[3],
+                    double x[3]) {
+    if (m < 2) return 0;
+    double c[3] = {0, 0, 0};
+    for (int i = 0; i < m; ++i)
+        for (int d = 0; d < 3; ++d) c[d] += p[3 * i + d];
+    for (int d = 0; d < 3; ++d) c[d] /= m;
+    /* slack: a point on the box within rounding counts as inside */
+    double tol[3];
+    for (int d = 0; d < 3; ++d) tol[d] = 1e-9 * (hi[d] - lo[d]);
+    double best[3] = {c[0], c[1], c[2]}, beste = INFINITY;
+    /* the free minimum, then every face (one coordinate fixed), edge (two)
+     * and corner (three) of the box; the first feasible one with the least
+     * error wins (a fixed order: deterministic) */
+    for (int nfix = 0; nfix <= 3; ++nfix) {
+        for (int fixm = 0; fixm < 8; ++fixm) {
+            const int cnt = (fixm & 1) + ((fixm >> 1) & 1) + ((fixm >> 2) & 1);
+            if (cnt != nfix) continue;
+            for (int side = 0; side < 8; ++side) {
+                if (side & ~fixm) continue; /* side bits only on fixed axes */
+                double x2[3];
+                for (int d = 0; d < 3; ++d)
+                    x2[d] = (fixm >> d) & 1 ? ((side >> d) & 1 ? hi[d] : lo[d]) : c[d];
+                qef_free(p, n, m, c, 7 & ~fixm, x2);
+                int inside = 1;
+                for (int d = 0; d < 3; ++d)
+                    inside &= x2[d] >= lo[d] - tol[d] && x2[d] <= hi[d] + tol[d];
+                if (!inside) continue;
+                const double e = qef_err(p, n, m, x2);
+                if (e < beste * (1.0 - 1e-12)) {
+                    beste = e;
+                    memcpy(best, x2, sizeof best);
+                }
+            }
+        }
+        /* the free minimum inside the box is the global one: done */
+        if (nfix == 0 && beste < INFINITY) break;
+    }
+    for (int d = 0; d < 3; ++d) x[d] = fmin(fmax(best[d], lo[d]), hi[d]);
+    return 1;
+}
+
+/* edge key -> the triangle whose feature corner faces it */
+typedef struct fkv {
+    uint64_t key; /* (min vertex << 32 | max vertex) + 1; 0: empty */
+    size_t t;
+} fkv;
+
+static inline size_t fslot(uint64_t key, size_t cap) {
+    key ^= key >> 33;
+    key *= 0xff51afd7ed558ccdULL;
+    key ^= key >> 33;
+    return (size_t)key & (cap - 1);
+}
+
+/* Find or insert key; returns the slot. */
+static size_t ftab_find(fkv *tab, size_t cap, uint64_t key) {
+    size_t h = fslot(key, cap);
+    while (tab[h].key && tab[h].key != key) h = (h + 1) & (cap - 1);
+    return h;
+}
+
+static void tri_normal(const double *P, const uint32_t *t, double nrm[3]) {
+    const double *a = P + 3 * (size_t)t[0], *b = P + 3 * (size_t)t[1], *c = P + 3 * (size_t)t[2];
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                 v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    nrm[0] = u[1] * v[2] - u[2] * v[1];
+    nrm[1] = u[2] * v[0] - u[0] * v[2];
+    nrm[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err) {
+    /* the fan triangles: exactly one feature corner */
+    size_t nfan = 0;
+    for (size_t t = 0; t < M->ntriangles; ++t) {
+        const uint32_t *T = M->triangles + 3 * t;
+        nfan += (feat[T[0]] + feat[T[1]] + feat[T[2]]) == 1;
+    }
+    if (!nfan) return LB_OK;
+    size_t cap = 16;
+    while (cap < 2 * nfan) cap *= 2;
+    fkv *tab = calloc(cap, sizeof *tab);
+    /* the feature-to-feature edges made so far (no edge twice) */
+    size_t ecap = 16;
+    while (ecap < nfan) ecap *= 2;
+    fkv *made = calloc(ecap, sizeof *made);
+    if (!tab || !made) {
+        free(tab);
+        free(made);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+    }
+    size_t nmade = 0;
+    for (size_t t = 0; t < M->ntriangles; ++t) {
+        uint32_t *T = M->triangles + 3 * t;
+        if ((feat[T[0]] + feat[T[1]] + feat[T[2]]) != 1) continue;
+        const int k = feat[T[0]] ? 0 : feat[T[1]] ? 1 : 2;
+        const uint32_t a = T[(k + 1) % 3], b = T[(k + 2) % 3];
+        const uint64_t key = ((uint64_t)(a < b ? a : b) << 32 | (a < b ? b : a)) + 1;
+        const size_t h = ftab_find(tab, cap, key);
+        if (!tab[h].key) {
+            tab[h].key = key;
+            tab[h].t = t;
+            continue;
+        }
+        /* the other fan on this segment: triangle (d, b, a) */
+        uint32_t *U = M->triangles + 3 * tab[h].t;
+        tab[h].key = UINT64_MAX; /* used: no third triangle pairs with it */
+        const int kk = feat[U[0]] ? 0 : feat[U[1]] ? 1 : 2;
+        const uint32_t c = T[k], d = U[kk];
+        if (U[(kk + 1) % 3] != b || U[(kk + 2) % 3] != a || c == d) continue;
+        const uint64_t ck = ((uint64_t)(c < d ? c : d) << 32 | (c < d ? d : c)) + 1;
+        if (2 * (nmade + 1) > ecap) continue; /* cannot happen: at most nfan / 2 flips */
+        const size_t hm = ftab_find(made, ecap, ck);
+        if (made[hm].key) continue; /* c and d already joined */
+        /* flipped: (c, a, d) and (d, b, c); only where both keep their
+         * orientation (no fold) */
+        const uint32_t T1[3] = {c, a, d}, T2[3] = {d, b, c};
+        double m1[3], m2[3];
+        tri_normal(M->positions, T1, m1);
+        tri_normal(M->positions, T2, m2);
+        /* each new triangle faces the way the surface does at its
+         * vertex off the crease (a, b: on the grid edges, with the field's
+         * normals) */
+        const double *na = M->normals + 3 * (size_t)a, *nb = M->normals + 3 * (size_t)b;
+        if (!(m1[0] * na[0] + m1[1] * na[1] + m1[2] * na[2] > 0.0) ||
+            !(m2[0] * nb[0] + m2[1] * nb[1] + m2[2] * nb[2] > 0.0))
+            continue;
+        made[hm].key = ck;
+        ++nmade;
+        memcpy(T, T1, sizeof T1);
+        memcpy(U, T2, sizeof T2);
+    }
+    free(tab);
+    free(made);
+    return LB_OK;
+}
