@@ -4,7 +4,8 @@
  * (best of ROUNDS), triangles, vertices, peak RSS and RSS before meshing.
  * bench/mesh/run_mesh_bench.py runs it next to the anchors.
  *
- * Usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1] */
+ * Usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1] [--features]
+ * (--features: LB_MESH_FEATURES, sharp creases and corners) */
 #define _POSIX_C_SOURCE 200809L
 #include <libblend/libblend.h>
 
@@ -31,8 +32,14 @@ static long rss_kb(void) { /* current resident set, from /proc */
 }
 
 int main(int argc, char **argv) {
+    unsigned flags = 0;
+    if (argc > 1 && strcmp(argv[argc - 1], "--features") == 0) {
+        flags = LB_MESH_FEATURES;
+        --argc;
+    }
     if (argc != 4 && argc != 10) {
-        fprintf(stderr, "usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1]\n");
+        fprintf(stderr,
+                "usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1] [--features]\n");
         return 2;
     }
     lb_error e = {LB_OK, ""};
@@ -46,6 +53,7 @@ int main(int argc, char **argv) {
     lb_mesh_options_init(&o);
     o.resolution = (unsigned)atoi(argv[2]);
     o.threads = atoi(argv[3]);
+    o.flags = flags;
     if (argc == 10)
         for (int d = 0; d < 3; ++d) {
             o.bmin[d] = atof(argv[4 + d]);

@@ -186,12 +186,6 @@ static int blender_render(const job *J, const task *T, const bt_render_dir *R, i
     const int w =
         line ? bt_blender_task(J->worker, line, err, sizeof err, on_progress, &P, sec) : 2;
     free(line);
-    if (!w) { /* where the time went: Blender's render, and its whole task */
-        cJSON *e = batch_event("blender", T);
-        cJSON_AddNumberToObject(e, "render_seconds", sec[0]);
-        cJSON_AddNumberToObject(e, "seconds", sec[1]);
-        batch_log_event(L, e);
-    }
     if (w) {
         const int eevee = w == 2 && !strcmp(J->engine, "eevee");
         bt_error(CMD, "%s: rendering with Blender failed: %s%s", T->name,
@@ -201,6 +195,11 @@ static int blender_render(const job *J, const task *T, const bt_render_dir *R, i
                        : "");
         return BT_EXIT_INTERNAL;
     }
+    /* where the time went: Blender's render, and its whole task */
+    cJSON *e = batch_event("blender", T);
+    cJSON_AddNumberToObject(e, "render_seconds", sec[0]);
+    cJSON_AddNumberToObject(e, "seconds", sec[1]);
+    batch_log_event(L, e);
     return 0;
 }
 
