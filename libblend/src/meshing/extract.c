@@ -605,6 +605,11 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
     size_t nfeat = 0;
     for (size_t c = 0; c < nc; ++c) nfeat += state[c] == 1;
     if (!nfeat) return LB_OK;
+    double *vp = realloc(B->vpos, 3 * (ne + nfeat + nref) * sizeof *vp);
+    if (vp) B->vpos = vp;
+    double *vn = realloc(B->vnrm, 3 * (ne + nfeat) * sizeof *vn);
+    if (vn) B->vnrm = vn;
+    if (!vp || !vn) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
     /* make room after the vertices of the block alone: orphans and
      * references move up by nfeat */
     memmove(B->vpos + 3 * (np0 + nfeat), B->vpos + 3 * np0, 3 * (ne - np0 + nref) * sizeof(double));
@@ -686,16 +691,13 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
     B->nref = nref;
     B->nfeat = 0;
     if (ne + nref) {
-        /* room for a feature point per polygon and a fan of n triangles */
-        size_t nt = 0;
-        for (size_t f = 0; f < C->nf; ++f) nt += C->faces[f].n - (feats ? 0 : 2);
-        const size_t nfx = feats ? C->nf : 0;
-        B->vpos = malloc(3 * (ne + nfx + nref) * sizeof *B->vpos);
-        B->vnrm = malloc(3 * (ne + nfx ? ne + nfx : 1) * sizeof *B->vnrm);
-        B->tri = malloc(3 * (nt ? nt : 1) * sizeof *B->tri);
+        /* sharp features grow vpos and vnrm (place_features) and make
+         * fans, so the triangles are counted after them */
+        B->vpos = malloc(3 * (ne + nref) * sizeof *B->vpos);
+        B->vnrm = malloc(3 * (ne ? ne : 1) * sizeof *B->vnrm);
         B->rref = malloc(2 * (nref ? nref : 1) * sizeof *B->rref);
         B->okey = C->norph ? malloc(C->norph * sizeof *B->okey) : NULL;
-        if (!B->vpos || !B->vnrm || !B->tri || !B->rref || (C->norph && !B->okey)) {
+        if (!B->vpos || !B->vnrm || !B->rref || (C->norph && !B->okey)) {
             s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
             goto done;
         }
@@ -720,6 +722,14 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
         if (feats) {
             s = place_features(ev, g, B, C, err);
             if (s) goto done;
+        }
+        size_t nt = 0;
+        for (size_t f = 0; f < C->nf; ++f)
+            nt += C->faces[f].n - (C->faces[f].feat == NOFEAT ? 2 : 0);
+        B->tri = malloc(3 * (nt ? nt : 1) * sizeof *B->tri);
+        if (!B->tri) {
+            s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+            goto done;
         }
         uint32_t *T = B->tri;
         for (size_t f = 0; f < C->nf; ++f) {
