@@ -4,7 +4,8 @@
  * never take that path, so this program is built twice: against the library
  * (test_mesh_orphans_ref) and against a build of it in which every third
  * edge on a block's near face is an orphan of all the blocks that hold it
- * (test_mesh_orphans, LB__FORCE_ORPHANS). For every scene it meshes on 1
+ * (test_mesh_orphans, LB__FORCE_ORPHANS). For every scene, plain and with
+ * sharp features (LB_MESH_FEATURES), it meshes on 1
  * and 3 threads, checks that both meshes are the same bytes and closed (each
  * directed edge once, with its reverse), and prints the vertex and triangle
  * counts and a hash of the triangles as position triples (each rotated to
@@ -94,32 +95,38 @@ int main(int argc, char **argv) {
             fprintf(stderr, "test_mesh_orphans: %s\n", e.message);
             return 1;
         }
-        lb_mesh_options o;
-        lb_mesh_options_init(&o);
-        o.resolution = 40; /* five blocks along the longest side */
-        lb_scene_bounds(sc, o.bmin, o.bmax);
-        lb_mesh *m[2] = {NULL, NULL};
-        for (int k = 0; k < 2; ++k) {
-            o.threads = k ? 3 : 1;
-            if (lb_mesh_create(ev, &o, &m[k], &e)) {
-                fprintf(stderr, "test_mesh_orphans: %s: %s\n", argv[a], e.message);
-                return 1;
+        /* plain, and with sharp features (their points and fans moved
+         * past the orphans) */
+        for (int fl = 0; fl < 2; ++fl) {
+            lb_mesh_options o;
+            lb_mesh_options_init(&o);
+            o.resolution = 40; /* five blocks along the longest side */
+            o.flags = fl ? LB_MESH_FEATURES : 0;
+            lb_scene_bounds(sc, o.bmin, o.bmax);
+            lb_mesh *m[2] = {NULL, NULL};
+            for (int k = 0; k < 2; ++k) {
+                o.threads = k ? 3 : 1;
+                if (lb_mesh_create(ev, &o, &m[k], &e)) {
+                    fprintf(stderr, "test_mesh_orphans: %s: %s\n", argv[a], e.message);
+                    return 1;
+                }
             }
+            const char *name = strrchr(argv[a], '/') ? strrchr(argv[a], '/') + 1 : argv[a];
+            if (!same(m[0], m[1])) {
+                fprintf(stderr, "FAIL %s: 1 and 3 threads give different meshes\n", name);
+                failed = 1;
+            }
+            if (!closed(m[0])) {
+                fprintf(stderr,
+                        "FAIL %s: not closed (a directed edge twice or without its reverse)\n",
+                        name);
+                failed = 1;
+            }
+            printf("%s%s %zu %zu %016llx\n", name, fl ? "+features" : "", m[0]->nvertices,
+                   m[0]->ntriangles, (unsigned long long)fingerprint(m[0]));
+            lb_mesh_free(m[0]);
+            lb_mesh_free(m[1]);
         }
-        const char *name = strrchr(argv[a], '/') ? strrchr(argv[a], '/') + 1 : argv[a];
-        if (!same(m[0], m[1])) {
-            fprintf(stderr, "FAIL %s: 1 and 3 threads give different meshes\n", name);
-            failed = 1;
-        }
-        if (!closed(m[0])) {
-            fprintf(stderr, "FAIL %s: not closed (a directed edge twice or without its reverse)\n",
-                    name);
-            failed = 1;
-        }
-        printf("%s %zu %zu %016llx\n", name, m[0]->nvertices, m[0]->ntriangles,
-               (unsigned long long)fingerprint(m[0]));
-        lb_mesh_free(m[0]);
-        lb_mesh_free(m[1]);
         lb_evaluator_free(ev);
         lb_scene_free(sc);
     }
