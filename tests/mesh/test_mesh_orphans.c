@@ -5,12 +5,11 @@
  * (test_mesh_orphans_ref) and against a build of it in which every third
  * edge on a block's near face is an orphan of all the blocks that hold it
  * (test_mesh_orphans, LB__FORCE_ORPHANS). For every scene, plain and with
- * sharp features (LB_MESH_FEATURES), it meshes on 1 and 3 threads, checks that both meshes are the same bytes and closed (each
- * directed edge once, with its reverse), and prints the vertex and triangle
- * counts and a hash of the triangles as position triples (each rotated to
- * start at its smallest vertex, then sorted): tests/CMakeLists.txt compares
- * the two builds' lines, which must be equal, since an orphan's vertex is
- * refined exactly as its owner's would be.
+ * sharp features (LB_MESH_FEATURES), it meshes on 1 and 3 threads, checks that both meshes are the
+ * same bytes and closed (each directed edge once, with its reverse), and prints the vertex and
+ * triangle counts and a hash of the triangles as position triples (each rotated to start at its
+ * smallest vertex, then sorted): tests/CMakeLists.txt compares the two builds' lines, which must be
+ * equal, since an orphan's vertex is refined exactly as its owner's would be.
  *
  * Usage: test_mesh_orphans SCENE... (exit 1 on a failed check) */
 #include <libblend/libblend.h>
