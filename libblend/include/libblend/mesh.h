@@ -10,7 +10,9 @@
  *    shared vertices, counter-clockwise seen from outside, every vertex on
  *    the surface (refined along its grid edge by a safeguarded root solve to
  *    |f| / |grad f| <= 1e-7 cell sizes) with its normal from the analytic
- *    gradient. Closed (every edge in exactly two triangles) and 2-manifold;
+ *    gradient (with LB_MESH_FEATURES, a crease or corner point to the same
+ *    tolerance, its normal the mean of its cell polygon's). Closed (every
+ *    edge in exactly two triangles) and 2-manifold;
  *    where the region cuts the solid the mesh is closed by a cap on the
  *    region's faces, or left open with LB_MESH_OPEN_BOUNDARY.
  *  - The output does not depend on the thread count: the same vertices and
