@@ -455,6 +455,12 @@ static void publish(lb__bctx *C) {
  * reach, at 32, 64 and 128 cells; a whole cell changed nothing more. */
 #define FEAT_REACH 0.5
 
+/* The unit normal of a polygon's local vertex v: an own vertex's, or a
+ * reference's (from the owner's near-face table). */
+static inline const double *vertex_normal(const lb__block *B, const bctx *C, uint32_t v) {
+    return v < C->ne ? B->vnrm + 3 * v : C->rnrm + 3 * (v - C->ne);
+}
+
 static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__block *B, bctx *C,
                                 lb_error *err) {
     const size_t ne = C->ne, nref = C->nref, np0 = ne - C->norph;
@@ -469,8 +475,7 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
         for (uint32_t q = 0; q < F->n; ++q) {
             const uint32_t v = F->e[q];
             memcpy(P + 3 * q, B->vpos + 3 * v, 3 * sizeof(double));
-            memcpy(N + 3 * q, v < ne ? B->vnrm + 3 * v : C->rnrm + 3 * (v - ne),
-                   3 * sizeof(double));
+            memcpy(N + 3 * q, vertex_normal(B, C, v), 3 * sizeof(double));
             for (int d = 0; d < 3; ++d) ns[d] += N[3 * q + d];
             for (uint32_t r = 0; r < q; ++r) {
                 const double cs =
@@ -503,8 +508,8 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
     const double tol = 1e-7 * hmin, boxmax = lb__block_boxmax(g, B);
     lb__boxeval *E = &C->S.E;
     lb__boxeval_load(ev, &B->plan, E);
-    /* candidates still moving: cface's order kept, the done ones marked in
-     * cv (NAN: rejected) */
+    /* each candidate's state; cv, cgx..cgz hold the tangent plane of its
+     * last point (cv NAN: none yet) for the crease step */
     uint8_t *state = (uint8_t *)C->S.eact; /* 0 moving, 1 on the surface, 2 rejected */
     memset(state, 0, nc);
     for (int it = 0; it < FEAT_ITER; ++it) {
@@ -589,8 +594,7 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
         for (uint32_t q = 0; q < F->n && state[c] == 1; ++q) {
             const uint32_t v = F->e[q], w = F->e[(q + 1) % F->n];
             const double *Pv = B->vpos + 3 * v, *Pw = B->vpos + 3 * w;
-            const double *Nv = v < ne ? B->vnrm + 3 * v : C->rnrm + 3 * (v - ne),
-                         *Nw = w < ne ? B->vnrm + 3 * w : C->rnrm + 3 * (w - ne);
+            const double *Nv = vertex_normal(B, C, v), *Nw = vertex_normal(B, C, w);
             const double a[3] = {Pv[0] - X[0], Pv[1] - X[1], Pv[2] - X[2]},
                          b[3] = {Pw[0] - X[0], Pw[1] - X[1], Pw[2] - X[2]};
             const double m[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
