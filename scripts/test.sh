@@ -53,7 +53,7 @@ cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_T
   -DLIBBLEND_BENCH=OFF
 cmake --build build-tsan -j "$JOBS" --target test_threads test_scene_eval test_mesh
 TSAN_OPTIONS=halt_on_error=1 \
-  ctest --test-dir build-tsan --output-on-failure -R '^(test_threads|test_scene_eval|test_mesh)$'
+  ctest --test-dir build-tsan --output-on-failure -R '^(test_threads|test_scene_eval|test_mesh_threaded)$'
 
 echo "== build-fuzz (clang, libFuzzer, ASan + UBSan)"
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_FUZZ=ON \

@@ -230,14 +230,25 @@ static void test_scenes_closed_and_accurate(void **state) {
     tally_end(&nrm, 100000);
 }
 
-/* The same mesh, bit for bit, for 1, 2 and 3 threads. */
+/* The same mesh, bit for bit, for 1, 2 and 3 threads: every scene, and
+ * with LB_MESH_FEATURES also the sharp shapes of tests/data/features (the
+ * feature points are placed per block and flipped over the merged mesh). */
 static void test_threads_identical(void **state) {
     (void)state;
-    for (size_t s = 0; s < nscenes; ++s) {
+    static const char *const sharp[] = {"cube", "rotated-cube", "two-boxes", "cylinder-slab",
+                                        "clean-union-spheres"};
+    for (size_t s = 0; s < 2 * nscenes + 5; ++s) {
+        char path[1100];
+        const unsigned flags = s < nscenes ? 0u : LB_MESH_FEATURES;
+        if (s < 2 * nscenes)
+            snprintf(path, sizeof path, "%s", scene_paths[s % nscenes]);
+        else
+            snprintf(path, sizeof path, "%s/tests/data/features/%s.json", SOURCE_DIR,
+                     sharp[s - 2 * nscenes]);
         built A, B, C;
-        build_file(scene_paths[s], 40, 0, 1, &A);
-        build_file(scene_paths[s], 40, 0, 2, &B);
-        build_file(scene_paths[s], 40, 0, 3, &C);
+        build_file(path, 40, flags, 1, &A);
+        build_file(path, 40, flags, 2, &B);
+        build_file(path, 40, flags, 3, &C);
         const lb_mesh *ms[2] = {B.m, C.m};
         for (int k = 0; k < 2; ++k) {
             const lb_mesh *m = ms[k];
@@ -245,7 +256,7 @@ static void test_threads_identical(void **state) {
                 memcmp(m->positions, A.m->positions, 3 * m->nvertices * sizeof(double)) ||
                 memcmp(m->normals, A.m->normals, 3 * m->nvertices * sizeof(double)) ||
                 memcmp(m->triangles, A.m->triangles, 3 * m->ntriangles * sizeof(uint32_t)))
-                fail_msg("%s: %d threads differ from 1", scene_paths[s], k + 2);
+                fail_msg("%s (flags %u): %d threads differ from 1", path, flags, k + 2);
         }
         unbuild(&A);
         unbuild(&B);
@@ -1163,8 +1174,11 @@ static void test_bad_options(void **state) {
     lb_scene_free(sc);
 }
 
-int main(void) {
-    const struct CMUnitTest tests[] = {
+/* With no argument every case runs; with names (e.g. "test_threads_identical"),
+ * only those: the ThreadSanitizer build runs the cases that start threads
+ * (tests/CMakeLists.txt, test_mesh_threaded). An unknown name fails. */
+int main(int argc, char **argv) {
+    const struct CMUnitTest all[] = {
         cmocka_unit_test(test_scenes_closed_and_accurate),
         cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_volumes_and_euler),
@@ -1181,5 +1195,18 @@ int main(void) {
         cmocka_unit_test(test_edges),
         cmocka_unit_test(test_wide_union),
     };
-    return cmocka_run_group_tests(tests, setup, NULL);
+    enum { NALL = sizeof all / sizeof all[0] };
+    if (argc < 2) return cmocka_run_group_tests(all, setup, NULL);
+    struct CMUnitTest some[NALL];
+    size_t n = 0;
+    for (int a = 1; a < argc; ++a) {
+        size_t i = 0;
+        while (i < NALL && strcmp(all[i].name, argv[a])) ++i;
+        if (i == NALL || n == NALL) {
+            fprintf(stderr, "test_mesh: no case named '%s'\n", argv[a]);
+            return 2;
+        }
+        some[n++] = all[i];
+    }
+    return _cmocka_run_group_tests("test_mesh", some, n, setup, NULL);
 }
