@@ -4,8 +4,10 @@
  * (best of ROUNDS), triangles, vertices, peak RSS and RSS before meshing.
  * bench/mesh/run_mesh_bench.py runs it next to the anchors.
  *
- * Usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1] [--features]
- * (--features: LB_MESH_FEATURES, sharp creases and corners) */
+ * Usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1]
+ *                   [--features | --corner-normals]
+ * (--features: LB_MESH_FEATURES, sharp creases and corners; --corner-normals:
+ * also LB_MESH_CORNER_NORMALS) */
 #define _POSIX_C_SOURCE 200809L
 #include <libblend/libblend.h>
 
@@ -36,10 +38,13 @@ int main(int argc, char **argv) {
     if (argc > 1 && strcmp(argv[argc - 1], "--features") == 0) {
         flags = LB_MESH_FEATURES;
         --argc;
+    } else if (argc > 1 && strcmp(argv[argc - 1], "--corner-normals") == 0) {
+        flags = LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS;
+        --argc;
     }
     if (argc != 4 && argc != 10) {
-        fprintf(stderr,
-                "usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1] [--features]\n");
+        fprintf(stderr, "usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1] "
+                        "[--features | --corner-normals]\n");
         return 2;
     }
     lb_error e = {LB_OK, ""};

@@ -5,4 +5,4 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake -S . -B build-release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build-release -j "$(nproc)" --target bench_mesh >/dev/null
-/usr/bin/python3 bench/mesh/run_features_bench.py build-release/bench/bench_mesh . "${1:-3}"
+/usr/bin/python3 bench/mesh/run_features_bench.py build-release/bench/bench_mesh . "${1:-5}"

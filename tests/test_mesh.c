@@ -14,6 +14,7 @@
 #endif
 
 #include "scenelist.h"
+#include "testfs.h"
 #include "../libblend/src/meshing/mesh_internal.h"
 
 /* ---- helpers ---- */
@@ -1011,6 +1012,108 @@ static int cmp_pair(const void *a, const void *b) {
     return x < y ? -1 : x > y;
 }
 
+/* Corner normals (lb_mesh.corner_normals): NULL unless asked for
+ * (LB_MESH_CORNER_NORMALS) and on a smooth scene (S1: no crease); on the cube
+ * added normals, each of unit length, used, and owned by one vertex. A mesh
+ * whose corner normals or triangles name entries out of range is refused by
+ * both writers before a byte is written. (Their directions against the
+ * closed forms: tests/mesh/test_mesh_features.py.) */
+static void test_corner_normals(void **state) {
+    (void)state;
+    char path[1100];
+    built A, B, C;
+    snprintf(path, sizeof path, "%s/scenes/bench-s1-three-spheres.json", SOURCE_DIR);
+    build_file(path, 64, 0, 0, &A);
+    assert_null(A.m->corner_normals);
+    assert_int_equal(A.m->nnormals, A.m->nvertices);
+    build_file(path, 64, LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS, 0, &B);
+    assert_null(B.m->corner_normals);
+    assert_int_equal(B.m->nnormals, B.m->nvertices);
+    unbuild(&A);
+    unbuild(&B);
+    snprintf(path, sizeof path, "%s/tests/data/features/cube.json", SOURCE_DIR);
+    build_file(path, 32, LB_MESH_FEATURES, 0, &C); /* not asked for */
+    assert_null(C.m->corner_normals);
+    assert_int_equal(C.m->nnormals, C.m->nvertices);
+    unbuild(&C);
+    build_file(path, 32, LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS, 0, &C);
+    const lb_mesh *m = C.m;
+    const size_t nv = m->nvertices, nx = m->nnormals - nv;
+    assert_true(m->nnormals > nv);
+    uint32_t *owner = malloc(nx * sizeof *owner);
+    assert_non_null(owner);
+    for (size_t i = 0; i < nx; ++i) owner[i] = UINT32_MAX;
+    for (size_t c = 0; c < 3 * m->ntriangles; ++c) {
+        const uint32_t n = m->corner_normals[c], v = m->triangles[c];
+        if (n < nv) {
+            assert_int_equal(n, v);
+            continue;
+        }
+        assert_true(n < m->nnormals);
+        if (owner[n - nv] != UINT32_MAX) assert_int_equal(owner[n - nv], v);
+        owner[n - nv] = v;
+    }
+    for (size_t i = 0; i < nx; ++i) {
+        assert_true(owner[i] != UINT32_MAX);
+        const double *q = m->normals + 3 * (nv + i);
+        assert_true(fabs(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] - 1.0) < 1e-12);
+    }
+    free(owner);
+    /* refused before writing: a corner naming a normal past the end, another
+     * vertex's normal, a triangle naming a vertex past the end */
+    char dir[512], out[600];
+    assert_int_equal(test_mkdtemp(dir, sizeof dir, "lb-corners"), 0);
+    char sout[600];
+    snprintf(out, sizeof out, "%s/bad.glb", dir);
+    snprintf(sout, sizeof sout, "%s/stream.bin", dir);
+    lb_mesh bad = *m;
+    uint32_t *cn = malloc(3 * m->ntriangles * sizeof *cn),
+             *tri = malloc(3 * m->ntriangles * sizeof *tri);
+    assert_true(cn && tri);
+    memcpy(cn, m->corner_normals, 3 * m->ntriangles * sizeof *cn);
+    memcpy(tri, m->triangles, 3 * m->ntriangles * sizeof *tri);
+    bad.corner_normals = cn;
+    bad.triangles = tri;
+    const size_t t = m->ntriangles / 2;
+    struct {
+        uint32_t *arr;
+        uint32_t value;
+        const char *says;
+    } rows[3] = {{cn, (uint32_t)m->nnormals, "has normal"},
+                 {cn, tri[3 * t] ? 0u : 1u, "has normal"},
+                 {tri, (uint32_t)nv, "names vertex"}};
+    for (int r = 0; r < 3; ++r) {
+        const uint32_t keep = rows[r].arr[3 * t];
+        rows[r].arr[3 * t] = rows[r].value;
+        for (int f = LB_MESH_FORMAT_PLY; f <= LB_MESH_FORMAT_GLB; ++f) {
+            lb_error e = {LB_OK, ""};
+            assert_int_equal(lb_mesh_write(&bad, out, (lb_mesh_format)f, &e),
+                             LB_ERR_INVALID_ARGUMENT);
+            char want[64];
+            snprintf(want, sizeof want, "triangle %zu", t);
+            if (!strstr(e.message, want) || !strstr(e.message, rows[r].says))
+                fail_msg("row %d format %d: \"%s\"", r, f, e.message);
+            FILE *probe = fopen(out, "rb");
+            if (probe) fail_msg("row %d: %s was written", r, out);
+            FILE *st = fopen(sout, "w+b");
+            assert_non_null(st);
+            assert_int_equal(lb_mesh_write_stream(&bad, st, (lb_mesh_format)f, &e),
+                             LB_ERR_INVALID_ARGUMENT);
+            assert_int_equal(ftell(st), 0);
+            fclose(st);
+            remove(sout);
+        }
+        rows[r].arr[3 * t] = keep;
+    }
+    lb_error e = {LB_OK, ""};
+    assert_int_equal(lb_mesh_write(&bad, out, LB_MESH_FORMAT_GLB, &e), LB_OK);
+    remove(out);
+    test_rmdir(dir);
+    free(cn);
+    free(tri);
+    unbuild(&C);
+}
+
 static void test_edges(void **state) {
     (void)state;
     size_t checked = 0;
@@ -1118,7 +1221,7 @@ static void test_bad_options(void **state) {
         {2, -1, LB_ERR_INVALID_ARGUMENT, "cell_size = -1; allowed: a positive number"},
         {2, 1e-6, LB_ERR_INVALID_ARGUMENT, "allowed: at most 8192 cells per axis"},
         {3, -2, LB_ERR_INVALID_ARGUMENT, "threads = -2"},
-        {4, 8, LB_ERR_INVALID_ARGUMENT, "flags = 0x8"},
+        {4, 16, LB_ERR_INVALID_ARGUMENT, "flags = 0x10"},
         {5, 1e9, LB_ERR_INVALID_ARGUMENT, "|value| <= 1e+09"},
         {6, 1 << 20, LB_ERR_INVALID_ARGUMENT, "over the memory cap of 1 MiB"},
         {7, NAN, LB_ERR_INVALID_ARGUMENT, "allowed: finite"},
@@ -1193,6 +1296,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_memory_cap_and_empty),
         cmocka_unit_test(test_min_feature),
         cmocka_unit_test(test_edges),
+        cmocka_unit_test(test_corner_normals),
         cmocka_unit_test(test_wide_union),
     };
     enum { NALL = sizeof all / sizeof all[0] };

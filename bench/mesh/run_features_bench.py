@@ -3,7 +3,8 @@
     /usr/bin/python3 bench/mesh/run_features_bench.py BENCH_MESH SOURCE_DIR [ROUNDS]
 
 For S1 and S2 at 128 and 256 cells on one thread, lb_mesh_create's time with
-LB_MESH_FEATURES against without, the two runs alternating ROUNDS times (3)
+LB_MESH_FEATURES (and with LB_MESH_CORNER_NORMALS too) against without, the
+runs alternating ROUNDS times (3)
 in this process's run so that the machine's load hits both alike; the ratio
 of the medians of the best-of-3 times (bench_mesh). Then the sharp shapes of
 tests/data/features at 64 cells: triangles with and without (the errors are
@@ -19,26 +20,29 @@ ROUNDS = int(sys.argv[3]) if len(sys.argv) > 3 else 3
 
 
 def run(scene, res, features):
-    args = [BENCH, scene, str(res), "1"] + (["--features"] if features else [])
+    """features: False, True or "corners" (with corner normals)"""
+    args = [BENCH, scene, str(res), "1"] + (["--corner-normals"] if features == "corners" else
+                                            ["--features"] if features else [])
     return json.loads(subprocess.run(args, check=True, capture_output=True,
                                      text=True).stdout.strip().splitlines()[-1])
 
 
-print("| scene | cells | without (s) | with (s) | with / without | triangles without / with |")
-print("|---|---|---|---|---|---|")
+print("| scene | cells | without (s) | with (s) | with / without | with corner normals (s) "
+      "| corners / without | triangles without / with |")
+print("|---|---|---|---|---|---|---|---|")
 for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spheres.json")):
     scene = os.path.join(SRC, "scenes", f)
     for res in (128, 256):
-        t = {False: [], True: []}
+        t = {False: [], True: [], "corners": []}
         tri = {}
         for _ in range(ROUNDS):
-            for feat in (False, True):
+            for feat in (False, True, "corners"):
                 r = run(scene, res, feat)
                 t[feat].append(r["seconds"])
                 tri[feat] = r["triangles"]
-        a, b = statistics.median(t[False]), statistics.median(t[True])
-        print("| %s | %d | %.4f | %.4f | %.3f | %d / %d |" % (name, res, a, b, b / a, tri[False],
-                                                            tri[True]))
+        a, b, c = (statistics.median(t[k]) for k in (False, True, "corners"))
+        print("| %s | %d | %.4f | %.4f | %.3f | %.4f | %.3f | %d / %d |" %
+              (name, res, a, b, b / a, c, c / a, tri[False], tri[True]))
 print()
 print("| shape | cells | triangles without | triangles with |")
 print("|---|---|---|---|")

@@ -55,6 +55,17 @@ class CachedMesh:
         self.resolution = resolution
         # the nodes' materials, when the scene names any (live.set_materials)
         self.material_index, self.materials = material_index, materials
+        # Sharp Features: each corner's normal index and the added normals
+        # (binding.Mesh.corner_normals, split_normals)
+        self.corner_normals, self.split_normals = None, None
+
+    def loop_normals(self):
+        """As binding.Mesh.loop_normals: each triangle corner's normal."""
+        import numpy as np
+        if self.corner_normals is None:
+            return self.normals[self.triangles.ravel().astype(np.int64)]
+        return np.concatenate([self.normals, self.split_normals])[
+            self.corner_normals.ravel().astype(np.int64)]
 
 
 def write(path, mesh, key, frame, resolution, name):
@@ -69,6 +80,9 @@ def write(path, mesh, key, frame, resolution, name):
     if getattr(mesh, "materials", None):
         info["materials"] = mesh.materials
         arrays["material_index"] = np.asarray(mesh.material_index, dtype=np.uint32)
+    if getattr(mesh, "corner_normals", None) is not None:
+        arrays["corner_normals"] = np.asarray(mesh.corner_normals, dtype=np.uint32)
+        arrays["split_normals"] = np.asarray(mesh.split_normals, dtype=np.float32)
     meta = json.dumps(info)
     try:
         with os.fdopen(fd, "wb") as f:
@@ -105,6 +119,8 @@ def read(path, key=None):
             pos, nrm, tri = z["positions"], z["normals"], z["triangles"]
             mats = meta.get("materials")
             midx = z["material_index"] if mats else None
+            cn = z["corner_normals"] if "corner_normals" in z.files else None
+            sn = z["split_normals"] if cn is not None else None
     except (OSError, ValueError, KeyError) as e:
         raise CacheError("%s: unreadable bake file (%s). Fix: bake again" % (path, e)) from None
     if pos.ndim != 2 or pos.shape[1:] != (3,) or nrm.shape != pos.shape or tri.ndim != 2 or \
@@ -112,7 +128,12 @@ def read(path, key=None):
         raise CacheError("%s: damaged bake file (array shapes or indices). Fix: bake again" % path)
     if mats and (midx.shape != (len(tri),) or (len(tri) and int(midx.max()) >= len(mats))):
         raise CacheError("%s: damaged bake file (material indices). Fix: bake again" % path)
-    return CachedMesh(pos, nrm, tri, meta.get("resolution", 0), midx, mats)
+    if cn is not None and (cn.shape != tri.shape or sn.ndim != 2 or sn.shape[1:] != (3,) or
+                           (len(cn) and int(cn.max()) >= len(pos) + len(sn))):
+        raise CacheError("%s: damaged bake file (corner normals). Fix: bake again" % path)
+    m = CachedMesh(pos, nrm, tri, meta.get("resolution", 0), midx, mats)
+    m.corner_normals, m.split_normals = cn, sn
+    return m
 
 
 def frames(folder_):

@@ -36,6 +36,7 @@ STATUS_CANCELLED = 5
 FORMATS = {"auto": 0, "ply": 1, "obj": 2, "stl": 3, "glb": 4}
 MESH_OPEN_BOUNDARY = 1
 MESH_FEATURES = 4  # LB_MESH_FEATURES: keep sharp creases and corners
+MESH_CORNER_NORMALS = 8  # LB_MESH_CORNER_NORMALS: a normal per side of each crease
 
 
 class LibblendError(Exception):
@@ -73,7 +74,9 @@ class _Mesh(ctypes.Structure):
                 ("normals", ctypes.POINTER(ctypes.c_double)),
                 ("triangles", ctypes.POINTER(ctypes.c_uint32)),
                 ("origin", ctypes.c_double * 3), ("cell", ctypes.c_double * 3),
-                ("cells", ctypes.c_uint * 3)]
+                ("cells", ctypes.c_uint * 3),
+                ("nnormals", ctypes.c_size_t),
+                ("corner_normals", ctypes.POINTER(ctypes.c_uint32))]
 
 
 class _PovOptions(ctypes.Structure):
@@ -463,11 +466,13 @@ class Evaluator(_Handle):
         return v
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
-             max_memory=0, cancel=None, edges=False, features=False):
+             max_memory=0, cancel=None, edges=False, features=False, corner_normals=True):
         """Mesh the field over the box [bmin, bmax] (docs/meshing.md). Returns a
         Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called.
         edges=True also fills Mesh.edges and Mesh.corner_edges (lb_mesh_edges);
-        features=True keeps sharp creases and corners (LB_MESH_FEATURES)."""
+        features=True keeps sharp creases and corners (LB_MESH_FEATURES), and
+        with corner_normals (LB_MESH_CORNER_NORMALS) gives each side of a
+        crease its own normal (Mesh.corner_normals, Mesh.loop_normals())."""
         _need_numpy()
         o = _MeshOptions()
         self.lib._c.lb_mesh_options_init(ctypes.byref(o))
@@ -475,7 +480,8 @@ class Evaluator(_Handle):
             o.bmin[i], o.bmax[i] = float(bmin[i]), float(bmax[i])
         o.resolution = int(resolution)
         o.cell_size = float(cell_size)
-        o.flags = (MESH_OPEN_BOUNDARY if open_boundary else 0) | (MESH_FEATURES if features else 0)
+        o.flags = (MESH_OPEN_BOUNDARY if open_boundary else 0) | (MESH_FEATURES if features else 0) \
+            | (MESH_CORNER_NORMALS if features and corner_normals else 0)
         o.threads = int(threads)
         o.max_memory = int(max_memory)
         if cancel is not None:
@@ -495,6 +501,13 @@ class Evaluator(_Handle):
             tri = np.ctypeslib.as_array(m.triangles, shape=(nt, 3)).copy() if nt else \
                 np.zeros((0, 3), dtype=np.uint32)
             mesh = Mesh(pos, nrm, tri, tuple(m.origin), tuple(m.cell), tuple(m.cells))
+            if m.corner_normals and nt:  # features: shading normals per corner
+                mesh.corner_normals = np.ctypeslib.as_array(m.corner_normals,
+                                                            shape=(nt, 3)).copy()
+                extra = m.nnormals - nv
+                mesh.split_normals = np.ctypeslib.as_array(
+                    m.normals, shape=(m.nnormals, 3))[nv:].copy() if extra else \
+                    np.zeros((0, 3))
             if edges:
                 ed = np.empty((3 * nt, 2), dtype=np.uint32)
                 ce = np.empty(3 * nt, dtype=np.uint32)
@@ -522,6 +535,21 @@ class Mesh:
         # set by the add-on when the scene's nodes name materials: each
         # triangle's material index and the materials (Scene.materials)
         self.material_index = self.materials = None
+        # with mesh(features=True): each triangle corner's shading normal as
+        # an index (t, 3) uint32 into normals followed by split_normals
+        # (k, 3), the normals added on the sides of creases (lb_mesh's
+        # corner_normals and nnormals)
+        self.corner_normals = None
+        self.split_normals = np.zeros((0, 3))
+
+    def loop_normals(self):
+        """The shading normal of every triangle corner, (3 t, 3) float64, in
+        the order of triangles.ravel(): the corner normals where there are
+        any, else each corner's vertex normal."""
+        if self.corner_normals is None:
+            return self.normals[self.triangles.ravel().astype(np.int64)]
+        return np.concatenate([self.normals, self.split_normals])[
+            self.corner_normals.ravel().astype(np.int64)]
 
     def volume(self):
         """Enclosed volume (divergence theorem); exact for a closed mesh."""

@@ -73,6 +73,16 @@ def set_custom_normals(me, normals):
     me.normals_split_custom_set_from_vertices(normals)
 
 
+def set_custom_loop_normals(me, normals):
+    """One normal per loop (face corner) as the mesh's custom split normals:
+    a corner on a crease takes its own side's normal, so the crease shades
+    sharp (libblend's corner normals, mesh(features=True))."""
+    if VERSION < (4, 1, 0):
+        me.use_auto_smooth = True
+        me.auto_smooth_angle = 3.14159
+    me.normals_split_custom_set(normals)
+
+
 def clear_custom_normals(me):
     """Blender's own smooth normals on a mesh just refilled after
     clear_geometry (which drops custom normals in every version)."""

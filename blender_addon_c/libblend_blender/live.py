@@ -53,7 +53,7 @@ class _State:
         self.status = ""
         self.error = False
         self.last = {}  # timings of the last update (seconds)
-        self.normals = None  # analytic normals waiting to be set (live updates)
+        self.normals = None  # the mesh whose analytic normals wait to be set (live updates)
         self.t_applied = 0.0
         self.applied_key = None  # mesh_key of the mesh in the Blender mesh now
         self.expect = None  # how long the last run took (predicts the next one)
@@ -67,13 +67,13 @@ class _Job:
     run() touches no Blender data and may run on a worker thread."""
 
     def __init__(self, lib, text, name, bmin, bmax, resolution, open_boundary, threads, paths,
-                 fit=False):
+                 fit=False, features=False):
         self.lib, self.text, self.name = lib, text, name
         self.bmin, self.bmax, self.resolution = bmin, bmax, resolution
         self.open_boundary, self.threads, self.paths = open_boundary, threads, paths
-        self.fit = fit
+        self.fit, self.features = fit, features
         self.key = mesh_key(text, "fit" if fit else bmin, "fit" if fit else bmax, resolution,
-                            open_boundary)
+                            open_boundary, features)
         self.cell = 0.0        # Fit Region's cell size (0: not fitted)
         self.region_note = ""  # why the fit fell back to the box, if it did
         self.clipped = ""      # the region faces the surface reaches ("+z -x"), if any
@@ -109,7 +109,7 @@ class _Job:
         self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
                             cell_size=self.cell, open_boundary=self.open_boundary,
                             threads=self.threads, cancel=self.cancel,
-                            edges=compat.takes_libblend_edges())
+                            edges=compat.takes_libblend_edges(), features=self.features)
         self.clipped = clipped_faces(self.mesh.positions, self.bmin, self.bmax)
         mats = scene.materials()
         if len(mats) > 1 and len(self.mesh.triangles):
@@ -220,9 +220,13 @@ def wants_analytic(normals, ntriangles):
     return normals == "ANALYTIC" or (normals == "AUTO" and ntriangles < AUTO_ANALYTIC)
 
 
-def set_normals(me, normals):
-    """libblend's normals (one per vertex) as custom split normals."""
-    compat.set_custom_normals(me, normals)
+def set_normals(me, mesh):
+    """libblend's normals as custom split normals: one per vertex, or with
+    Sharp Features one per face corner (a crease's two sides apart)."""
+    if getattr(mesh, "corner_normals", None) is not None:
+        compat.set_custom_loop_normals(me, mesh.loop_normals())
+    else:
+        compat.set_custom_normals(me, mesh.normals)
 
 
 def set_mesh_data(me, mesh, normals="AUTO"):
@@ -246,7 +250,7 @@ def set_mesh_data(me, mesh, normals="AUTO"):
         if getattr(mesh, "materials", None):
             set_materials(me, mesh)
         if wants_analytic(normals, nt):
-            set_normals(me, mesh.normals)
+            set_normals(me, mesh)
         else:
             compat.clear_custom_normals(me)
     me.update()
@@ -285,13 +289,17 @@ def set_materials(me, mesh):
 
 # --------------------------------------------------------------------------- jobs
 
-def mesh_key(text, bmin, bmax, resolution, open_boundary):
+def mesh_key(text, bmin, bmax, resolution, open_boundary, features=False):
     """What a mesh is a function of: the scene text, the region, the
-    resolution and the boundary mode. Equal keys, equal meshes; so a field
-    whose key did not change is not meshed again (frames where nothing
-    moved, a driver that did not change its value, a render's first frame)."""
-    h = hashlib.sha256(json.dumps([text, list(bmin), list(bmax), int(resolution),
-                                   bool(open_boundary)]).encode())
+    resolution, the boundary mode and Sharp Features. Equal keys, equal
+    meshes; so a field whose key did not change is not meshed again (frames
+    where nothing moved, a driver that did not change its value, a render's
+    first frame). Without features the key is the one bakes made before
+    the option have."""
+    parts = [text, list(bmin), list(bmax), int(resolution), bool(open_boundary)]
+    if features:
+        parts.append("features")
+    h = hashlib.sha256(json.dumps(parts).encode())
     return h.hexdigest()[:32]
 
 def _state(name):
@@ -328,7 +336,7 @@ def prepare(output, resolution, depsgraph=None):
     bmin, bmax = _region(output)
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
                 output.libblend.open_boundary, libhandle.threads(), paths,
-                fit=output.libblend.fit_region)
+                fit=output.libblend.fit_region, features=output.libblend.sharp_features)
 
 
 def _finish(output, st, job, t_start, defer_normals=False):
@@ -339,7 +347,7 @@ def _finish(output, st, job, t_start, defer_normals=False):
     mode = output.libblend.normals
     st.normals = None
     if defer_normals and wants_analytic(mode, len(job.mesh.triangles)):
-        st.normals = job.mesh.normals
+        st.normals = job.mesh  # its normals, set once the field is idle
         mode = "FACES"
     set_mesh_data(output.data, job.mesh, mode)
     st.applied_key = job.key
@@ -406,7 +414,7 @@ def cached_key(output, depsgraph=None):
     s = output.libblend
     text, _paths = tree.to_json(output, depsgraph, render=False, compact=True)
     bmin, bmax = ("fit", "fit") if s.fit_region else _region(output)
-    return mesh_key(text, bmin, bmax, s.render_resolution, s.open_boundary)
+    return mesh_key(text, bmin, bmax, s.render_resolution, s.open_boundary, s.sharp_features)
 
 
 def from_cache(output, frame, depsgraph=None):

@@ -7,8 +7,9 @@ shared defs, bulge elimination, nesting up to depth 4), from fixed seeds
 (printed, so a failure can be replayed) for the rest of the time budget.
 Each is parsed and compiled through the library (the ctypes binding, no
 process per scene) and meshed at 12 cells on two threads and 20 on one, and
-at 20 on two with sharp features (LB_MESH_FEATURES); every non-empty mesh
-must be closed, oriented and 2-manifold (tests/mesh's numpy checks), and the
+at 20 on two with sharp features (LB_MESH_FEATURES, with corner normals);
+every non-empty mesh must be closed, oriented and 2-manifold (tests/mesh's
+numpy checks), its corner normals within their contract, and the
 scenes found wrong before (by an issue, or by this test's fresh seeds:
 barthe-underflow.json, seed 578775895819, failed to compile) must mesh
 closed at 20, 64 and 97 cells, and at 64 and 97 with sharp features
@@ -69,7 +70,26 @@ def closed(text, name, runs):
                     fail("%s: mesh at %d cells, %d threads%s: %s" %
                          (name, res, th, " with sharp features" if feat else "", c))
                     return n
+                if m.corner_normals is not None and not corners_ok(m):
+                    fail("%s: mesh at %d cells, %d threads: corner normals out of contract" %
+                         (name, res, th))
+                    return n
             return n
+
+
+def corners_ok(m):
+    """lb_mesh.corner_normals' contract: each corner names its own vertex's
+    normal or an added one of unit length that only that vertex's corners
+    use, and every added normal is used"""
+    import numpy as np
+    nv, cn, tri = len(m.positions), m.corner_normals.ravel(), m.triangles.ravel()
+    added = cn >= nv
+    if not np.all(cn[~added] == tri[~added]) or cn.max() >= nv + len(m.split_normals):
+        return False
+    owner = np.full(len(m.split_normals), -1, dtype=np.int64)
+    owner[cn[added] - nv] = tri[added]
+    return bool(np.all(owner[cn[added] - nv] == tri[added]) and np.all(owner >= 0) and
+                np.allclose(np.linalg.norm(m.split_normals, axis=1), 1.0, atol=1e-12))
 
 
 # the scenes an issue found open

@@ -19,8 +19,12 @@ closed, oriented and manifold, and:
   cells, and at most 0.45x the error without --features (measured
   2026-12-04: 0.106, 0.103, 0.075 cells against 0.26, 0.28, 0.29; short of
   the flat shapes' exactness: fans that would fold are left plain).
-Also: the same bytes with 1 and 2 threads, and S1 (smooth: no cell has a
-crease) the same bytes with and without --features."""
+Corner normals (OBJ's f v//n, GLB's vertex copies): on the three box
+shapes every triangle corner carries its own face's normal (the vertex
+normals alone are off by up to 76 degrees at the edges); on the cylinder
+cut by a slab each split corner is within 0.5 h / r radians of its side's
+normal. Also: the same bytes with 1 and 2 threads, and S1 (smooth: no cell
+has a crease) the same bytes with and without --features."""
 import json
 import os
 import subprocess
@@ -73,8 +77,9 @@ def box_distance(p, R, c, a):
     return np.abs(np.linalg.norm(np.maximum(q, 0), axis=1) + np.minimum(q.max(1), 0))
 
 
-def rect_distance(p, d, x, lo, hi):
-    """distance to the rectangle {p[d] = x, other coordinates in [lo, hi]}"""
+def rect_distance(p, d, x, lo, hi, _s=None):
+    """distance to the rectangle {p[d] = x, other coordinates in [lo, hi]}
+    (_s: the side its outward normal points to, unused here)"""
     q = p.copy()
     q[:, d] = x
     for t, i in enumerate([i for i in range(3) if i != d]):
@@ -107,7 +112,7 @@ def union_faces(boxes):
                             pieces.append(([slo[0], lo[1]], [shi[0], slo[1]]))
                         if shi[1] < hi[1]:
                             pieces.append(([slo[0], shi[1]], [shi[0], hi[1]]))
-                rects += [(d, x, l, u) for l, u in pieces]
+                rects += [(d, x, l, u, s) for l, u in pieces]
     return rects
 
 
@@ -119,6 +124,39 @@ def slabs_of(node):
     return R, c, a
 
 
+def box_normal(name):
+    """the outward unit normal of the face of the cube, rotated cube or boxes
+    nearest to each point"""
+    root = scene(name)["root"]
+    if root["type"] == "max":
+        R, c, a = slabs_of(root)
+
+        def normal(p):
+            q = (p - c) @ R.T
+            d = np.argmax(np.abs(q) - a, axis=1)
+            return np.sign(q[np.arange(len(p)), d])[:, None] * R[d]
+        return normal
+    rects = union_faces(box_parts(root))
+
+    def normal(p):
+        k = np.argmin([rect_distance(p, *r) for r in rects], axis=0)
+        out = np.zeros((len(p), 3))
+        for i, (d, _x, _l, _u, s) in enumerate(rects):
+            out[k == i, d] = s
+        return out
+    return normal
+
+
+def box_parts(root):
+    boxes = []
+    for arg in root["args"]:
+        R, _c, a = slabs_of(arg)
+        assert np.allclose(R, np.eye(3))
+        c = np.array([s.get("point", [0, 0, 0])[i] for i, s in enumerate(arg["args"])], float)
+        boxes.append((c, a))
+    return boxes
+
+
 def box_like(name):
     """distance function and convex corners of the cube, rotated cube, boxes"""
     sc = scene(name)
@@ -128,12 +166,7 @@ def box_like(name):
         corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)],
                            float) * a @ R + c
         return (lambda p: box_distance(p, R, c, a)), corners
-    boxes = []
-    for arg in root["args"]:
-        R, _c, a = slabs_of(arg)
-        assert np.allclose(R, np.eye(3))
-        c = np.array([s.get("point", [0, 0, 0])[i] for i, s in enumerate(arg["args"])], float)
-        boxes.append((c, a))
+    boxes = box_parts(root)
     rects = union_faces(boxes)
     corners = []
     for (c, a), (oc, oa) in ((boxes[0], boxes[1]), (boxes[1], boxes[0])):
@@ -166,6 +199,33 @@ for name in ("cube", "rotated-cube", "two-boxes"):
     V, _N, F = meshcheck.read(mesh(name, 64))
     err = dist(samples(V, F)).max() / cell_size(scene(name), 64)
     check(err > 0.05, "%s at 64 without --features: largest error %.2g cells (> 0.05)" % (name, err))
+
+# ---- corner normals: each side of a crease shaded with its own normal ----
+def corner_mesh(name, res, ext):
+    out = os.path.join(WORK, "%s-%d-corners.%s" % (name, res, ext))
+    subprocess.run([BLENDTOOL, "mesh", os.path.join(DATA, name + ".json"), "-o", out,
+                    "--resolution", str(res), "--quiet", "--features"], check=True)
+    return out
+
+
+for name in ("cube", "rotated-cube", "two-boxes"):
+    normal = box_normal(name)
+    for res in (32, 64):
+        tag = "%s at %d" % (name, res)
+        V, N, F, FN = meshcheck.read_obj_corners(corner_mesh(name, res, "obj"))
+        n = normal(V[F].mean(axis=1))  # the face each (flat) triangle lies on
+        cos = np.einsum("tcj,tj->tc", N[FN], n)
+        vcos = np.einsum("tcj,tj->tc", N[F], n)
+        check(cos.min() >= 1 - 1e-8 and vcos.min() < 0.9 and (FN >= len(V)).any(),
+              "%s: every corner's OBJ normal is its face's, cos >= %.12f (bar 1 - 1e-8; the "
+              "vertex normals alone reach down to %.3f; %d corners split)" %
+              (tag, cos.min(), vcos.min(), (FN >= len(V)).sum()))
+        # glTF has one normal per vertex: the same corner normals by copies
+        Vg, Ng, Fg = meshcheck.read_glb(corner_mesh(name, res, "glb"))
+        check(Fg.shape == F.shape and np.abs(Vg[Fg] - V[F]).max() < 1e-6 and
+              np.abs(Ng[Fg] - N[FN]).max() < 1e-6 and len(Vg) == len(N),
+              "%s: the GLB's corners have the OBJ's positions and normals (%d vertices with "
+              "the copies)" % (tag, len(Vg)))
 
 # ---- a tilted cylinder cut by a slab ----
 sc = scene("cylinder-slab")
@@ -235,6 +295,40 @@ def crease_errors(name, res, distance):
         errs.append((d[dc < 1.5 * h].max() / h, d[dc >= 1.5 * h].max() / h))
     return errs
 
+
+def cyl_slab_normal(p):
+    """the outward normal of the piece (side or either cap) nearest to p"""
+    along = p @ ax
+    rv = p - along[:, None] * ax
+    radial = np.linalg.norm(rv, axis=1)
+    q = along[:, None] * ax + rv / radial[:, None] * r
+    dside = np.where(np.abs(q[:, 2] - z0) <= hw, np.abs(radial - r), np.inf)
+    dtop, dbot = np.abs(p[:, 2] - (z0 + hw)), np.abs(p[:, 2] - (z0 - hw))
+    n = rv / radial[:, None]
+    n[(dtop < dside) & (dtop <= dbot)] = [0, 0, 1]
+    n[(dbot < dside) & (dbot < dtop)] = [0, 0, -1]
+    return n
+
+
+for res in (32, 64, 128):
+    # a split corner's normal is its side's, taken a quarter cell from the
+    # point towards its side's triangles; here the closed form is taken a
+    # quarter cell towards the corner's own triangle: the two are at most
+    # half a cell apart, over which the cylinder turns by 0.5 h / r
+    # (measured 2026-12-04: 2.04, 1.07, 0.49 degrees)
+    h = cell_size(sc, res)
+    V, N, F, FN = meshcheck.read_obj_corners(corner_mesh("cylinder-slab", res, "obj"))
+    P = V[F]
+    d = P.mean(axis=1)[:, None, :] - P
+    probe = P + np.minimum(1, 0.25 * h / np.maximum(np.linalg.norm(d, axis=2), 1e-300))[
+        :, :, None] * d
+    split = FN >= len(V)
+    ang = np.degrees(np.arccos(np.clip(np.einsum(
+        "ij,ij->i", N[FN][split], cyl_slab_normal(probe[split])), -1, 1)))
+    bar = np.degrees(0.5 * h / r)
+    check(split.sum() > 100 and ang.max() <= bar,
+          "cylinder-slab at %d: %d split corners, each within %.2f degrees of its side's normal "
+          "(bar %.2f)" % (res, split.sum(), ang.max(), bar))
 
 for res in (32, 64, 128):
     tag = "cylinder-slab at %d" % res

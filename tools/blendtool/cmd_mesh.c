@@ -147,6 +147,10 @@ static int parse_args(int argc, char **argv, mesh_args *A) {
                  A->out);
         return BT_EXIT_BAD_INPUT;
     }
+    /* the formats that carry a normal per triangle corner get them */
+    if ((A->o.flags & LB_MESH_FEATURES) &&
+        (A->format == LB_MESH_FORMAT_OBJ || A->format == LB_MESH_FORMAT_GLB))
+        A->o.flags |= LB_MESH_CORNER_NORMALS;
     return BT_EXIT_OK;
 }
 
@@ -231,7 +235,8 @@ const bt_command bt_cmd_mesh = {
     "                  3x the triangles; the zero set of one piecewise-linear field)\n"
     "  --features      keep sharp creases and corners (of min, max, clean and local\n"
     "                  unions, slabs, the region's cap) exactly: a vertex on the crease\n"
-    "                  or corner of each cell it passes through\n"
+    "                  or corner of each cell it passes through; .obj and .glb also\n"
+    "                  get each side of a crease its own normal (sharp shading)\n"
     "  --set PATH=VALUE  override a scene value first (VALUE is JSON), e.g.\n"
     "                  --set root.args[0].radius=0.5; repeatable, applied in order\n"
     "OUT may be a symbolic link (its target is replaced), a device or a FIFO (written\n"

@@ -63,6 +63,11 @@ extern "C" {
  * still closed, manifold and independent of the thread count (docs/meshing.md,
  * Sharp features). Not with LB_MESH_TETRAHEDRA (ignored there). */
 #define LB_MESH_FEATURES 4u
+/* with LB_MESH_FEATURES: also a normal per side of each crease for the
+ * triangle corners there (lb_mesh.corner_normals), so renderers shade the
+ * crease sharp; costs a third more of the meshing time where many cells
+ * are creased (docs/meshing.md, Sharp features). Ignored without features. */
+#define LB_MESH_CORNER_NORMALS 8u
 
 /* Called on the calling thread with the fraction of work done, in [0, 1];
  * return non-zero to cancel the run (lb_mesh_create then fails with
@@ -91,6 +96,18 @@ typedef struct lb_mesh {
     double origin[3];  /* the first grid node */
     double cell[3];    /* cell size per axis (equal unless the region forced otherwise) */
     unsigned cells[3]; /* cells per axis covering the region */
+    /* Shading normals per triangle corner, so a renderer shows a crease
+     * sharp. With LB_MESH_CORNER_NORMALS, where a feature point's triangles lie on
+     * sides of a crease (their normals more than 26 degrees apart), corner c
+     * of triangle t is shaded with normals[3 * corner_normals[3 t + c] ...];
+     * normals then holds nnormals entries: the nvertices vertex normals
+     * first, then one per side of each such point (the field's unit gradient
+     * a quarter of a cell from the point into that side). A corner's entry
+     * is its own vertex or one of the normals added for that vertex alone.
+     * NULL, with nnormals = nvertices, when no corner needs its own normal
+     * (no crease, or not asked for): shade with the vertex normals. */
+    size_t nnormals;
+    uint32_t *corner_normals; /* 3 per triangle, indices into normals, or NULL */
 } lb_mesh;
 
 /* Defaults: resolution LB_MESH_DEFAULT_RESOLUTION, closed, all CPUs, the
@@ -137,16 +154,21 @@ LB_API lb_status lb_mesh_velocities(const lb_evaluator *ev, const lb_evaluator *
 
 typedef enum lb_mesh_format {
     LB_MESH_FORMAT_AUTO = 0, /* from the file name's extension */
-    LB_MESH_FORMAT_PLY = 1,  /* binary little-endian PLY, float positions and normals */
-    LB_MESH_FORMAT_OBJ = 2,  /* Wavefront OBJ with normals (v, vn, f v//vn) */
+    LB_MESH_FORMAT_PLY = 1,  /* binary little-endian PLY, float positions and vertex normals */
+    LB_MESH_FORMAT_OBJ = 2,  /* Wavefront OBJ with normals (v, vn, f v//vn; corner normals) */
     LB_MESH_FORMAT_STL = 3,  /* binary STL, facet normals from the triangles */
-    LB_MESH_FORMAT_GLB = 4   /* glTF 2.0 binary: POSITION, NORMAL, indices */
+    LB_MESH_FORMAT_GLB = 4   /* glTF 2.0 binary: POSITION, NORMAL, indices (corner normals by
+                                copies of a vertex, one per normal it is shaded with) */
 } lb_mesh_format;
 
 /* Write the mesh to path through an lb_output (libblend/output.h): the file
  * appears only when everything was written, so a failure leaves no partial
  * file; symbolic links are followed, devices and FIFOs written directly,
- * modes kept. An empty mesh is a valid file in every format. */
+ * modes kept. An empty mesh is a valid file in every format. Corner normals
+ * (corner_normals) go to OBJ and glTF; PLY carries one normal per vertex.
+ * A mesh whose triangles or corner normals name an entry out of range is
+ * refused (LB_ERR_INVALID_ARGUMENT, the triangle named) before anything is
+ * written. */
 LB_API lb_status lb_mesh_write(const lb_mesh *mesh, const char *path, lb_mesh_format format,
                                lb_error *err);
 

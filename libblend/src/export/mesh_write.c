@@ -72,14 +72,17 @@ static int write_obj(FILE *f, const lb_mesh *m) {
         if (fprintf(f, "v %.17g %.17g %.17g\n", m->positions[3 * i], m->positions[3 * i + 1],
                     m->positions[3 * i + 2]) < 0)
             return 0;
-    for (size_t i = 0; i < m->nvertices; ++i)
+    const size_t nn = m->corner_normals ? m->nnormals : m->nvertices;
+    for (size_t i = 0; i < nn; ++i)
         if (fprintf(f, "vn %.9g %.9g %.9g\n", m->normals[3 * i], m->normals[3 * i + 1],
                     m->normals[3 * i + 2]) < 0)
             return 0;
+    const uint32_t *cn = m->corner_normals ? m->corner_normals : m->triangles;
     for (size_t t = 0; t < m->ntriangles; ++t) {
-        const unsigned long a = m->triangles[3 * t] + 1ul, b = m->triangles[3 * t + 1] + 1ul,
-                            c = m->triangles[3 * t + 2] + 1ul;
-        if (fprintf(f, "f %lu//%lu %lu//%lu %lu//%lu\n", a, a, b, b, c, c) < 0) return 0;
+        const uint32_t *v = m->triangles + 3 * t, *n = cn + 3 * t;
+        if (fprintf(f, "f %lu//%lu %lu//%lu %lu//%lu\n", v[0] + 1ul, n[0] + 1ul, v[1] + 1ul,
+                    n[1] + 1ul, v[2] + 1ul, n[2] + 1ul) < 0)
+            return 0;
     }
     return 1;
 }
@@ -110,13 +113,18 @@ static int write_stl(FILE *f, const lb_mesh *m) {
 }
 
 /* glTF 2.0 binary: one mesh, one primitive (POSITION, NORMAL, uint32
- * indices), the JSON built with cJSON. */
-static int write_glb(FILE *f, const lb_mesh *m) {
-    const size_t vbytes = 12 * m->nvertices, ibytes = 12 * m->ntriangles;
+ * indices), the JSON built with cJSON. glTF has one normal per vertex, so
+ * with corner normals vertex i < nvertices is vertex i and vertex i >=
+ * nvertices a copy of the vertex whose corners use normal i (owner, from
+ * check_mesh); every corner then names the copy of its normal. */
+static int write_glb(FILE *f, const lb_mesh *m, const uint32_t *owner) {
+    const size_t nout = m->corner_normals ? m->nnormals : m->nvertices;
+    const uint32_t *idx = m->corner_normals ? m->corner_normals : m->triangles;
+    const size_t vbytes = 12 * nout, ibytes = 12 * m->ntriangles;
     const size_t bin = 2 * vbytes + ibytes; /* every part is a multiple of 4 */
     if (bin > UINT32_MAX / 2) return 0;
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (size_t i = 0; i < m->nvertices; ++i)
+    for (size_t i = 0; i < m->nvertices; ++i) /* the copies add no position */
         for (int d = 0; d < 3; ++d) {
             const double x = (float)m->positions[3 * i + d];
             if (i == 0 || x < lo[d]) lo[d] = x;
@@ -175,7 +183,7 @@ static int write_glb(FILE *f, const lb_mesh *m) {
             cJSON_AddItemToArray(accs, a);
             cJSON_AddNumberToObject(a, "bufferView", i);
             cJSON_AddNumberToObject(a, "componentType", i < 2 ? 5126 : 5125);
-            cJSON_AddNumberToObject(a, "count", (double)(i < 2 ? m->nvertices : 3 * m->ntriangles));
+            cJSON_AddNumberToObject(a, "count", (double)(i < 2 ? nout : 3 * m->ntriangles));
             cJSON_AddStringToObject(a, "type", i < 2 ? "VEC3" : "SCALAR");
             if (i == 0) {
                 cJSON_AddItemToObject(a, "min", cJSON_CreateDoubleArray(lo, 3));
@@ -205,19 +213,64 @@ static int write_glb(FILE *f, const lb_mesh *m) {
     memcpy(h + 4, "BIN\0", 4);
     if (fwrite(h, 8, 1, f) != 1) return 0;
     unsigned char buf[12];
-    for (size_t i = 0; i < m->nvertices; ++i) {
-        for (int d = 0; d < 3; ++d) put_f32(buf + 4 * d, m->positions[3 * i + d]);
+    for (size_t i = 0; i < nout; ++i) {
+        const size_t v = i < m->nvertices ? i : owner[i - m->nvertices];
+        for (int d = 0; d < 3; ++d) put_f32(buf + 4 * d, m->positions[3 * v + d]);
         if (fwrite(buf, 12, 1, f) != 1) return 0;
     }
-    for (size_t i = 0; i < m->nvertices; ++i) {
+    for (size_t i = 0; i < nout; ++i) {
         for (int d = 0; d < 3; ++d) put_f32(buf + 4 * d, m->normals[3 * i + d]);
         if (fwrite(buf, 12, 1, f) != 1) return 0;
     }
     for (size_t t = 0; t < m->ntriangles; ++t) {
-        for (int c = 0; c < 3; ++c) put_u32(buf + 4 * c, m->triangles[3 * t + c]);
+        for (int c = 0; c < 3; ++c) put_u32(buf + 4 * c, idx[3 * t + c]);
         if (fwrite(buf, 12, 1, f) != 1) return 0;
     }
     return 1;
+}
+
+/* The mesh's indices in range: every triangle's vertices below nvertices;
+ * with corner normals, each corner's normal its own vertex's or one at or
+ * above nvertices used by corners of one vertex only (its owner, written to
+ * owner[n - nvertices] for glTF's copies). A message naming the first
+ * triangle that breaks this, or LB_OK. */
+static lb_status check_mesh(const lb_mesh *m, const char *where, uint32_t **owner, lb_error *err) {
+    *owner = NULL;
+    if ((m->ntriangles && !m->triangles) || (m->nvertices && (!m->positions || !m->normals)))
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: the mesh's arrays are missing", where);
+    for (size_t c = 0; c < 3 * m->ntriangles; ++c)
+        if (m->triangles[c] >= m->nvertices)
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: triangle %zu names vertex %u of %zu; nothing was written", where,
+                            c / 3, (unsigned)m->triangles[c], m->nvertices);
+    if (!m->corner_normals) return LB_OK;
+    if (m->nnormals < m->nvertices || m->nnormals - m->nvertices > UINT32_MAX)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: nnormals %zu is below nvertices %zu; nothing was written", where,
+                        m->nnormals, m->nvertices);
+    const size_t nx = m->nnormals - m->nvertices;
+    uint32_t *o = malloc((nx ? nx : 1) * sizeof *o);
+    if (!o) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", where);
+    for (size_t i = 0; i < nx; ++i) o[i] = UINT32_MAX;
+    for (size_t c = 0; c < 3 * m->ntriangles; ++c) {
+        const uint32_t n = m->corner_normals[c], v = m->triangles[c];
+        const int ok = n < m->nvertices ? n == v
+                                        : n < m->nnormals && (o[n - m->nvertices] == UINT32_MAX ||
+                                                              o[n - m->nvertices] == v);
+        if (!ok) {
+            free(o);
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: triangle %zu's corner %zu has normal %u, neither its vertex's "
+                            "(%u) nor one of the %zu added normals of that vertex alone; "
+                            "nothing was written",
+                            where, c / 3, c % 3, (unsigned)n, (unsigned)v, nx);
+        }
+        if (n >= m->nvertices) o[n - m->nvertices] = v;
+    }
+    for (size_t i = 0; i < nx; ++i)
+        if (o[i] == UINT32_MAX) o[i] = 0; /* a normal no corner uses: any position will do */
+    *owner = o;
+    return LB_OK;
 }
 
 static lb_mesh_format format_of(const char *path) {
@@ -231,7 +284,8 @@ static lb_mesh_format format_of(const char *path) {
     return LB_MESH_FORMAT_AUTO;
 }
 
-static int write_format(FILE *f, const lb_mesh *mesh, lb_mesh_format format) {
+static int write_format(FILE *f, const lb_mesh *mesh, lb_mesh_format format,
+                        const uint32_t *owner) {
     switch (format) {
     case LB_MESH_FORMAT_PLY:
         return write_ply(f, mesh);
@@ -240,7 +294,7 @@ static int write_format(FILE *f, const lb_mesh *mesh, lb_mesh_format format) {
     case LB_MESH_FORMAT_STL:
         return write_stl(f, mesh);
     default:
-        return write_glb(f, mesh);
+        return write_glb(f, mesh, owner);
     }
 }
 
@@ -255,7 +309,13 @@ lb_status lb_mesh_write_stream(const lb_mesh *mesh, FILE *stream, lb_mesh_format
                         "lb_mesh_write_stream: format %d; allowed: LB_MESH_FORMAT_PLY, _OBJ, "
                         "_STL or _GLB",
                         (int)format);
-    if (!write_format(stream, mesh, format) || fflush(stream) != 0 || ferror(stream))
+    uint32_t *owner = NULL;
+    const lb_status s = check_mesh(mesh, "lb_mesh_write_stream", &owner, err);
+    if (s) return s;
+    const int ok =
+        write_format(stream, mesh, format, owner) && fflush(stream) == 0 && !ferror(stream);
+    free(owner);
+    if (!ok)
         return lb__fail(err, LB_ERR_IO, "lb_mesh_write_stream: writing failed (%s)",
                         strerror(errno));
     return LB_OK;
@@ -275,10 +335,18 @@ lb_status lb_mesh_write(const lb_mesh *mesh, const char *path, lb_mesh_format fo
                         "%s: %s: unknown mesh format; allowed: a name ending in .ply, .obj, "
                         ".stl or .glb",
                         FN, path);
-    lb_output *o = NULL;
-    lb_status s = lb_output_open(path, &o, err);
+    uint32_t *owner = NULL;
+    lb_status s = check_mesh(mesh, FN, &owner, err);
     if (s) return s;
-    if (!write_format(lb_output_stream(o), mesh, format)) {
+    lb_output *o = NULL;
+    s = lb_output_open(path, &o, err);
+    if (s) {
+        free(owner);
+        return s;
+    }
+    const int ok = write_format(lb_output_stream(o), mesh, format, owner);
+    free(owner);
+    if (!ok) {
         const int e = errno;
         lb_output_discard(o);
         return lb__fail(err, LB_ERR_IO, "%s: %s: writing failed (%s); nothing was written", FN,

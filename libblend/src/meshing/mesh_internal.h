@@ -264,6 +264,11 @@ LB_INTERNAL int lb__feature_qef(const double *p, const double *n, int m, const d
  * (feat[v] = 1) into the edge joining the two points, where that keeps
  * both triangles' orientation and makes no edge twice. */
 LB_INTERNAL lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err);
+/* M's corner_normals and nnormals (corners.c): the identity without
+ * feature points (feat NULL), else split normals where a feature point's
+ * triangles lie on sides of a crease. Evaluates ev with threads. */
+LB_INTERNAL lb_status lb__corner_normals(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M,
+                                         const uint8_t *feat, int threads, lb_error *err);
 
 /* One cell (i, j, k) with corner values c (some inside, some outside; bit o
  * of cfg set: corner o inside): its polygons, by the cube cases or by the

@@ -49,6 +49,7 @@ void lb_mesh_free(lb_mesh *mesh) {
     free(mesh->positions);
     free(mesh->normals);
     free(mesh->triangles);
+    free(mesh->corner_normals);
     free(mesh);
 }
 
@@ -1035,10 +1036,11 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: threads = %d; allowed: 0 (one per CPU) or a positive count", FN,
                         opt->threads);
-    if (opt->flags & ~(unsigned)(LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA | LB_MESH_FEATURES))
+    if (opt->flags & ~(unsigned)(LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA | LB_MESH_FEATURES |
+                                 LB_MESH_CORNER_NORMALS))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: flags = %#x; allowed: 0 or LB_MESH_OPEN_BOUNDARY | "
-                        "LB_MESH_TETRAHEDRA | LB_MESH_FEATURES",
+                        "LB_MESH_TETRAHEDRA | LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS",
                         FN, opt->flags);
     lb__grid g;
     lb_status s = make_grid(ev, opt, &g, err);
@@ -1108,15 +1110,15 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
             s = lb__fail(err, LB_ERR_INTERNAL, "%s: %zu blocks not merged", FN,
                          R.nblocks - R.mnext);
     }
+    uint8_t *feat = NULL; /* the feature points (features.c), for the flips and corners.c */
     if (!s && !P.cancelled && R.ms.nfr) { /* sharp features: join them (features.c) */
-        uint8_t *feat = calloc(M->nvertices, 1);
+        feat = calloc(M->nvertices, 1);
         if (!feat) {
             s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
         } else {
             for (size_t i = 0; i < R.ms.nfr; ++i)
                 memset(feat + R.ms.fr[2 * i], 1, R.ms.fr[2 * i + 1]);
             s = lb__feature_flips(M, feat, err);
-            free(feat);
         }
     }
     if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
@@ -1136,6 +1138,10 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         uint32_t *r = realloc(M->triangles, 3 * nt * sizeof *r);
         if (r) M->triangles = r;
     }
+    M->nnormals = M->nvertices;
+    if (!s && !P.cancelled && feat && (opt->flags & LB_MESH_CORNER_NORMALS))
+        s = lb__corner_normals(ev, &g, M, feat, (int)nt, err); /* shading per corner */
+    free(feat);
     if (!s && P.cancelled) s = lb__fail(err, LB_ERR_CANCELLED, "%s: cancelled by the caller", FN);
     if (!s && P.fn && P.fn(1.0, P.user)) {
         /* cancelling at 100 % is too late to matter: the mesh is done */
