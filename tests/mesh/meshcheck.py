@@ -44,26 +44,14 @@ def read_ply(path):
 
 
 def read_obj(path):
-    V, N, F = [], [], []
-    with open(path) as f:
-        for line in f:
-            w = line.split()
-            if not w or w[0].startswith("#"):
-                continue
-            if w[0] == "v":
-                V.append([float(x) for x in w[1:4]])
-            elif w[0] == "vn":
-                N.append([float(x) for x in w[1:4]])
-            elif w[0] == "f":
-                idx = [int(x.split("/")[0]) - 1 for x in w[1:]]
-                assert len(idx) == 3
-                F.append(idx)
-    return np.array(V), (np.array(N) if N else None), np.array(F, dtype=np.int64)
+    V, N, F, _FN = read_obj_corners(path)
+    return V, N, F
 
 
 def read_obj_corners(path):
-    """An OBJ's positions, normals, triangles and each corner's normal index
-    (the n of f v//n), all 0-based: (V, N, F, FN)."""
+    """An OBJ's positions, normals (or None), triangles and each corner's
+    normal index (the n of f v//n; -1 where a corner names none), all
+    0-based: (V, N, F, FN)."""
     V, N, F, FN = [], [], [], []
     with open(path) as f:
         for line in f:
@@ -76,10 +64,11 @@ def read_obj_corners(path):
                 N.append([float(x) for x in w[1:4]])
             elif w[0] == "f":
                 parts = [x.split("/") for x in w[1:]]
-                assert len(parts) == 3 and all(len(q) == 3 and q[1] == "" for q in parts)
+                assert len(parts) == 3
                 F.append([int(q[0]) - 1 for q in parts])
-                FN.append([int(q[2]) - 1 for q in parts])
-    return np.array(V), np.array(N), np.array(F, dtype=np.int64), np.array(FN, dtype=np.int64)
+                FN.append([int(q[2]) - 1 if len(q) == 3 and q[2] else -1 for q in parts])
+    return (np.array(V), (np.array(N) if N else None), np.array(F, dtype=np.int64),
+            np.array(FN, dtype=np.int64))
 
 
 def read_stl(path):
