@@ -61,15 +61,8 @@ static void centroid_from(const lb_mesh *M, size_t t, const double *P, double C[
     const double *a = M->positions + 3 * (size_t)M->triangles[3 * t];
     const double *b = M->positions + 3 * (size_t)M->triangles[3 * t + 1];
     const double *c = M->positions + 3 * (size_t)M->triangles[3 * t + 2];
-    double u[3], v[3];
-    for (int d = 0; d < 3; ++d) {
-        C[d] = (a[d] + b[d] + c[d]) / 3.0 - P[d];
-        u[d] = b[d] - a[d];
-        v[d] = c[d] - a[d];
-    }
-    fn[0] = u[1] * v[2] - u[2] * v[1];
-    fn[1] = u[2] * v[0] - u[0] * v[2];
-    fn[2] = u[0] * v[1] - u[1] * v[0];
+    for (int d = 0; d < 3; ++d) C[d] = (a[d] + b[d] + c[d]) / 3.0 - P[d];
+    lb__facing(a, b, c, fn);
 }
 
 /* A probe PROBE cells (hmin) from P along D (or at P + D when nearer). */

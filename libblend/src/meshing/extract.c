@@ -595,10 +595,8 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
             const uint32_t v = F->e[q], w = F->e[(q + 1) % F->n];
             const double *Pv = B->vpos + 3 * v, *Pw = B->vpos + 3 * w;
             const double *Nv = vertex_normal(B, C, v), *Nw = vertex_normal(B, C, w);
-            const double a[3] = {Pv[0] - X[0], Pv[1] - X[1], Pv[2] - X[2]},
-                         b[3] = {Pw[0] - X[0], Pw[1] - X[1], Pw[2] - X[2]};
-            const double m[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                                 a[0] * b[1] - a[1] * b[0]};
+            double m[3];
+            lb__facing(X, Pv, Pw, m);
             /* against both: a triangle across a crease faces between its
              * sides, so against at most one of them */
             if (!(m[0] * Nv[0] + m[1] * Nv[1] + m[2] * Nv[2] > 0.0) &&

@@ -187,12 +187,7 @@ static size_t ftab_find(fkv *tab, size_t cap, uint64_t key) {
 }
 
 static void tri_normal(const double *P, const uint32_t *t, double nrm[3]) {
-    const double *a = P + 3 * (size_t)t[0], *b = P + 3 * (size_t)t[1], *c = P + 3 * (size_t)t[2];
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                 v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    nrm[0] = u[1] * v[2] - u[2] * v[1];
-    nrm[1] = u[2] * v[0] - u[0] * v[2];
-    nrm[2] = u[0] * v[1] - u[1] * v[0];
+    lb__facing(P + 3 * (size_t)t[0], P + 3 * (size_t)t[1], P + 3 * (size_t)t[2], nrm);
 }
 
 lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err) {

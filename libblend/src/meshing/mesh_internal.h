@@ -113,6 +113,17 @@ typedef struct lb__block {
     uint32_t *tri;
 } lb__block;
 
+/* The facing of triangle (a, b, c): (b - a) x (c - a), not normalised
+ * (features.c's flips, extract.c's fold test, corners.c). */
+static inline void lb__facing(const double a[3], const double b[3], const double c[3],
+                              double n[3]) {
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                 v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n[0] = u[1] * v[2] - u[2] * v[1];
+    n[1] = u[2] * v[0] - u[0] * v[2];
+    n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
 static inline uint64_t lb__node_index(const lb__grid *g, uint64_t x, uint64_t y, uint64_t z) {
     return (z * g->N[1] + y) * g->N[0] + x;
 }
