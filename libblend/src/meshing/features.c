@@ -39,7 +39,9 @@ static void sym_eigen(double A[3][3], int k, double w[3], double V[3][3]) {
         double off = 0.0;
         for (int p = 0; p < k; ++p)
             for (int q = p + 1; q < k; ++q) off += A[p][q] * A[p][q];
-        if (off <= 1e-30 * (A[0][0] * A[0][0] + 1e-300)) break;
+        double diag = 1e-300; /* converged: off-diagonal tiny against the diagonal */
+        for (int p = 0; p < k; ++p) diag += A[p][p] * A[p][p];
+        if (off <= 1e-30 * diag) break;
         for (int p = 0; p < k; ++p)
             for (int q = p + 1; q < k; ++q) {
                 if (A[p][q] == 0.0) continue;
