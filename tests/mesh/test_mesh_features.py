@@ -11,14 +11,14 @@ closed, oriented and manifold, and:
   convex corner has a vertex within 0.01 cells; without --features the same
   meshes are off by more than 0.05 cells (so the check sees the option);
 - a tilted cylinder cut by a slab: near the two crease curves (within 1.5
-  cells) at most 0.06 cells and at most 0.15x the error without --features
-  (measured 2026-12-04: 0.056, 0.031, 0.043 cells against 0.48, 0.41, 0.46;
-  the flat triangles' chord error on the smooth side is 0.022, 0.013,
-  0.006: fans that would turn over are left plain, see docs/meshing.md);
-- the clean union of two spheres: near the crease circle at most 0.12
-  cells, and at most 0.45x the error without --features (measured
-  2026-12-04: 0.106, 0.103, 0.075 cells against 0.26, 0.28, 0.29; short of
-  the flat shapes' exactness: fans that would fold are left plain).
+  cells) at most 1.1x the flat triangles' own chord error on the smooth
+  side and at most 0.15x the error without --features (measured
+  2026-12-04: 0.022, 0.011, 0.0056 cells against chord errors of 0.022,
+  0.013, 0.0061 and 0.48, 0.41, 0.48 without);
+- the clean union of two spheres: near the crease circle at most 0.1
+  cells, and at most 0.4x the error without --features (measured
+  2026-12-04: 0.093, 0.081, 0.064 cells against 0.26, 0.28, 0.29; points
+  whose fans fold are moved off the crease, see docs/meshing.md).
 Corner normals (OBJ's f v//n, GLB's vertex copies): on the three box
 shapes every triangle corner carries its own face's normal (the vertex
 normals alone are off by up to 76 degrees at the edges); on the cylinder
@@ -333,9 +333,9 @@ for res in (32, 64, 128):
 for res in (32, 64, 128):
     tag = "cylinder-slab at %d" % res
     (near, far), (plain, _far) = crease_errors("cylinder-slab", res, cyl_slab_distance)
-    check(near <= 0.06 and near <= 0.15 * plain,
-          "%s: near the creases %.3g cells with --features, %.3g without (bars: 0.06, 0.15x); "
-          "the smooth side's flat triangles %.3g" % (tag, near, plain, far))
+    check(near <= 1.1 * far and near <= 0.15 * plain,
+          "%s: near the creases %.3g cells with --features, %.3g without; the smooth side's "
+          "flat triangles %.3g (bars: 1.1x those, 0.15x without)" % (tag, near, plain, far))
 
 # ---- the clean union of two spheres ----
 sc = scene("clean-union-spheres")
@@ -365,8 +365,8 @@ for res in (32, 64, 128):
     tag = "clean-union-spheres at %d" % res
     (near, _far), (plain, _pfar) = crease_errors("clean-union-spheres", res,
                                                  union_spheres_distance)
-    check(near <= 0.12 and near <= 0.45 * plain,
-          "%s: near the crease %.3g cells with --features, %.3g without (bars: 0.12, 0.45x)" %
+    check(near <= 0.1 and near <= 0.4 * plain,
+          "%s: near the crease %.3g cells with --features, %.3g without (bars: 0.1, 0.4x)" %
           (tag, near, plain))
 
 # ---- thread count, and smooth scenes untouched ----

@@ -582,28 +582,6 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
             C->cz[c] += dx[2];
         }
     }
-    /* a fan whose triangle turns against the surface at both its grid edge
-     * vertices folds over its neighbours (a point placed across a thin
-     * part, or a fillet tighter than a cell: the wheel of hsu2006 Fig. 9 at
-     * m = 0.3 had 30 crossing triangle pairs without this): that polygon
-     * keeps its plain triangles */
-    for (size_t c = 0; c < nc; ++c) {
-        if (state[c] != 1) continue;
-        const face *F = &C->faces[C->cface[c]];
-        const double X[3] = {C->cx[c], C->cy[c], C->cz[c]};
-        for (uint32_t q = 0; q < F->n && state[c] == 1; ++q) {
-            const uint32_t v = F->e[q], w = F->e[(q + 1) % F->n];
-            const double *Pv = B->vpos + 3 * v, *Pw = B->vpos + 3 * w;
-            const double *Nv = vertex_normal(B, C, v), *Nw = vertex_normal(B, C, w);
-            double m[3];
-            lb__facing(X, Pv, Pw, m);
-            /* against both: a triangle across a crease faces between its
-             * sides, so against at most one of them */
-            if (!(m[0] * Nv[0] + m[1] * Nv[1] + m[2] * Nv[2] > 0.0) &&
-                !(m[0] * Nw[0] + m[1] * Nw[1] + m[2] * Nw[2] > 0.0))
-                state[c] = 2;
-        }
-    }
     size_t nfeat = 0;
     for (size_t c = 0; c < nc; ++c) nfeat += state[c] == 1;
     if (!nfeat) return LB_OK;

@@ -114,7 +114,7 @@ typedef struct lb__block {
 } lb__block;
 
 /* The facing of triangle (a, b, c): (b - a) x (c - a), not normalised
- * (features.c's flips, extract.c's fold test, corners.c). */
+ * (features.c's flips and folds, corners.c). */
 static inline void lb__facing(const double a[3], const double b[3], const double c[3],
                               double n[3]) {
     const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
@@ -275,6 +275,13 @@ LB_INTERNAL int lb__feature_qef(const double *p, const double *n, int m, const d
  * (feat[v] = 1) into the edge joining the two points, where that keeps
  * both triangles' orientation and makes no edge twice. */
 LB_INTERNAL lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err);
+/* After the flips: a feature point with a triangle that faces against the
+ * surface at each of its grid-edge vertices (a fold: a fan whose segment
+ * found no neighbour to flip with) moves to the mean of its ring, put on
+ * the surface by Newton steps; where those fail it stays (feat is scratch:
+ * 2 marks such points while it runs, 1 again when done). */
+LB_INTERNAL lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M,
+                                         uint8_t *feat, int threads, lb_error *err);
 /* M's corner_normals and nnormals (corners.c): the identity without
  * feature points (feat NULL), else split normals where a feature point's
  * triangles lie on sides of a crease. Evaluates ev with threads. */

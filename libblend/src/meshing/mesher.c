@@ -1119,6 +1119,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
             for (size_t i = 0; i < R.ms.nfr; ++i)
                 memset(feat + R.ms.fr[2 * i], 1, R.ms.fr[2 * i + 1]);
             s = lb__feature_flips(M, feat, err);
+            if (!s) s = lb__feature_unfold(ev, &g, M, feat, (int)nt, err);
         }
     }
     if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
