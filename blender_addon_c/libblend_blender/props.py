@@ -109,7 +109,7 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
     sharp_features: BoolProperty(name="Sharp Features", description="keep creases and corners "
                                  "(min, max, clean and local unions, slabs) sharp: a vertex on "
                                  "each crease, and a split normal per side so it shades sharp. "
-                                 "Costs up to 1.5x the meshing time on scenes with many creases",
+                                 "Costs up to 1.8x the meshing time on scenes with many creases",
                                  default=False, update=_changed)
     normals: EnumProperty(name="Normals", items=[
         ("AUTO", "Auto", "analytic normals below 250k triangles, Blender's smooth normals above"),
