@@ -292,6 +292,8 @@ lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh 
     /* the points of folded triangles (feat 2) */
     size_t nb = 0;
     for (size_t t = 0; t < nt; ++t) {
+        const uint32_t *T = M->triangles + 3 * t;
+        if (!feat[T[0]] && !feat[T[1]] && !feat[T[2]]) continue; /* no point to move */
         if (!folded(M, feat, t)) continue;
         for (int k = 0; k < 3; ++k) {
             const uint32_t v = M->triangles[3 * t + k];
