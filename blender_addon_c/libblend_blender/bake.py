@@ -22,7 +22,7 @@ import os
 
 import bpy
 
-from . import atomic
+from . import atomic, binding
 
 FORMAT = "libblend-bake"
 VERSION = 1
@@ -59,13 +59,8 @@ class CachedMesh:
         # (binding.Mesh.corner_normals, split_normals)
         self.corner_normals, self.split_normals = None, None
 
-    def loop_normals(self):
-        """As binding.Mesh.loop_normals: each triangle corner's normal."""
-        import numpy as np
-        if self.corner_normals is None:
-            return self.normals[self.triangles.ravel().astype(np.int64)]
-        return np.concatenate([self.normals, self.split_normals])[
-            self.corner_normals.ravel().astype(np.int64)]
+    # each triangle corner's normal, read from the same four arrays
+    loop_normals = binding.Mesh.loop_normals
 
 
 def write(path, mesh, key, frame, resolution, name):
