@@ -97,6 +97,18 @@ static int parse_args(int argc, char **argv, mesh_args *A) {
                 return BT_EXIT_BAD_INPUT;
             }
             A->have_bounds = 1;
+        } else if ((r = bt_option(CMD, argc, argv, &i, "--simplify", &val))) {
+            if (r < 0) return BT_EXIT_BAD_INPUT;
+            char *end = NULL;
+            errno = 0;
+            const double t = strtod(val, &end);
+            if (errno || end == val || *end || !(t > 0.0 && t <= LB_MESH_MAX_SIMPLIFY)) {
+                bt_error(CMD,
+                         "--simplify %s: expected a tolerance in cells, above 0 and at most %g",
+                         val, LB_MESH_MAX_SIMPLIFY);
+                return BT_EXIT_BAD_INPUT;
+            }
+            A->o.simplify = t;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--threads", &val))) {
             if (r < 0 || bt_parse_threads(CMD, val, &A->o.threads)) return BT_EXIT_BAD_INPUT;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--format", &val))) {
@@ -220,7 +232,7 @@ const bt_command bt_cmd_mesh = {
     "usage: blendtool mesh SCENE -o OUT.{ply,obj,stl,glb} [--resolution N | --cell-size H]\n"
     "                      [--bounds x0,y0,z0,x1,y1,z1] [--open] [--threads N] [--quiet]\n"
     "                      [--format ply|obj|stl|glb] [--set PATH=VALUE]... [--tetrahedra]\n"
-    "                      [--features]\n\n"
+    "                      [--features] [--simplify TOL]\n\n"
     "Meshes the scene's surface inside the region (the scene's bounds, or --bounds):\n"
     "closed and manifold, vertices on the surface with normals from the analytic\n"
     "gradient. Where the region cuts the solid the mesh is closed on the region's\n"
@@ -237,6 +249,10 @@ const bt_command bt_cmd_mesh = {
     "                  unions, slabs, the region's cap) exactly: a vertex on the crease\n"
     "                  or corner of each cell it passes through; .obj and .glb also\n"
     "                  get each side of a crease its own normal (sharp shading)\n"
+    "  --simplify TOL  fewer triangles where the surface allows: merge triangles\n"
+    "                  wherever the result stays within TOL cells of the field (0 < TOL\n"
+    "                  <= 1; e.g. 0.1), never across a crease; with --features a flat\n"
+    "                  face becomes a few large triangles\n"
     "  --set PATH=VALUE  override a scene value first (VALUE is JSON), e.g.\n"
     "                  --set root.args[0].radius=0.5; repeatable, applied in order\n"
     "OUT may be a symbolic link (its target is replaced), a device or a FIFO (written\n"

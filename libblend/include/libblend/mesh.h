@@ -49,6 +49,7 @@ extern "C" {
 #define LB_MESH_MAX_CELLS_PER_AXIS 8192
 #define LB_MESH_DEFAULT_RESOLUTION 128
 #define LB_MESH_DEFAULT_MAX_MEMORY ((size_t)8 << 30) /* 8 GiB */
+#define LB_MESH_MAX_SIMPLIFY 1.0                     /* cells: lb_mesh_options.simplify */
 
 /* flags */
 #define LB_MESH_OPEN_BOUNDARY 1u /* do not close the mesh where the region cuts the solid */
@@ -84,6 +85,18 @@ typedef struct lb_mesh_options {
     lb_mesh_progress_fn progress; /* may be NULL */
     void *user;                   /* passed to progress */
     const volatile int *cancel;   /* may be NULL; non-zero cancels (from any thread) */
+    /* > 0: adaptive simplification. Vertices are removed by edge collapses
+     * wherever every moved triangle stays within this many cells (of the
+     * smallest cell side) of the surface, checked against the field itself
+     * by sampling each moved triangle at most a cell apart (64 samples
+     * along an edge at most); never across a crease (edges whose triangles'
+     * normals differ by more than 26 degrees: with LB_MESH_FEATURES, the
+     * kept creases), so corners stay. Still closed, 2-manifold and
+     * independent of the thread count; every vertex stays a vertex of the
+     * unsimplified mesh (on the surface). One thread, after the meshing
+     * (docs/meshing.md, Adaptive simplification). 0 = off; at most
+     * LB_MESH_MAX_SIMPLIFY. */
+    double simplify;
 } lb_mesh_options;
 
 typedef struct lb_mesh {

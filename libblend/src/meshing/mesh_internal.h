@@ -288,6 +288,14 @@ LB_INTERNAL lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid 
 LB_INTERNAL lb_status lb__corner_normals(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M,
                                          const uint8_t *feat, int threads, lb_error *err);
 
+/* Adaptive simplification (simplify.c): half-edge collapses wherever every
+ * moved triangle stays within tolerance cells (of the smallest cell side)
+ * of phi_c, never across a crease; closed and manifold kept; feat (may be
+ * NULL) is compacted with the vertices. Checks *cancel (may be NULL). */
+LB_INTERNAL lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M,
+                                   uint8_t *feat, double tolerance, const volatile int *cancel,
+                                   lb_error *err);
+
 /* One cell (i, j, k) with corner values c (some inside, some outside; bit o
  * of cfg set: corner o inside): its polygons, by the cube cases or by the
  * Kuhn split. 0 when out of memory. */

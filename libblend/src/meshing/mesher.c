@@ -1042,6 +1042,10 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
                         "%s: flags = %#x; allowed: 0 or LB_MESH_OPEN_BOUNDARY | "
                         "LB_MESH_TETRAHEDRA | LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS",
                         FN, opt->flags);
+    if (!(opt->simplify >= 0.0 && opt->simplify <= LB_MESH_MAX_SIMPLIFY))
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: simplify = %g cells; allowed: 0 (off) to %g cells", FN, opt->simplify,
+                        LB_MESH_MAX_SIMPLIFY);
     lb__grid g;
     lb_status s = make_grid(ev, opt, &g, err);
     if (s) return s;
@@ -1122,6 +1126,8 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
             if (!s) s = lb__feature_unfold(ev, &g, M, feat, (int)nt, err);
         }
     }
+    if (!s && !P.cancelled && opt->simplify > 0.0 && M->ntriangles) /* simplify.c */
+        s = lb__simplify(ev, &g, M, feat, opt->simplify, opt->cancel, err);
     if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
         M->positions = malloc(3 * sizeof *M->positions);
         M->normals = malloc(3 * sizeof *M->normals);

@@ -1,0 +1,687 @@
+/* Adaptive simplification (mesh.h: lb_mesh_options.simplify).
+ *
+ * The grid gives a flat face as many triangles as a curved one. This pass
+ * removes vertices by half-edge collapses (vertex u moves onto a neighbour
+ * v, u's triangles follow, the two triangles on edge u-v go) wherever the
+ * result stays within the tolerance of the field itself:
+ *
+ * 1. Kinds. An edge is sharp when its two triangles' normals differ by more
+ *    than the feature threshold (LB__FEATURE_COS, 26 degrees), as on the
+ *    creases that LB_MESH_FEATURES keeps. A vertex with no sharp edge is
+ *    smooth and may move onto any neighbour; one with exactly two is on a
+ *    crease and may move only along it, onto one of those two neighbours;
+ *    any other vertex (a corner: one or three sharp edges or more; the end
+ *    of an open boundary; a vertex of a degenerate triangle) never moves.
+ *    When a crease vertex moves, its two crease neighbours become each
+ *    other's, so a crease stays a chain of sharp edges: never collapsed
+ *    across.
+ * 2. Order. Each movable vertex's cheapest move by the quadric error of
+ *    Garland and Heckbert (the summed squared distances to the planes of the
+ *    triangles merged into the two vertices, area weighted) is kept in a
+ *    heap; the cheapest move is tried first, ties broken by vertex index.
+ * 3. Checks, cheapest first; a move that fails one is not made:
+ *    - topology: the two vertices share exactly the two neighbours opposite
+ *      their edge (the link condition: the mesh stays a closed 2-manifold),
+ *      those two keep at least three triangles, v at least three neighbours;
+ *    - shape: every moved triangle keeps its orientation (its normal turns
+ *      by at most 60 degrees), is not a sliver (area at least 1e-4 of its
+ *      longest edge squared) and faces along the field's normal at each of
+ *      its vertices whose normal is the field's gradient (not feature
+ *      points, whose normal is a mean over a crease);
+ *    - the field: every moved triangle is sampled on a barycentric lattice
+ *      at most a cell apart (at most 64 steps along an edge, so a triangle
+ *      longer than 64 cells is sampled more coarsely) and each sample's
+ *      distance estimate |phi_c| / |grad phi_c| must be within the
+ *      tolerance; phi_c includes the region's cap.
+ *    A vertex whose every move fails waits until a neighbour moves.
+ * 4. The survivors keep their positions and normals (every vertex is still
+ *    a point of the original mesh, on the surface) and their order; the
+ *    triangles keep theirs.
+ *
+ * One thread, in a fixed order on the merged mesh, so the output does not
+ * depend on the thread count. The cost grows with the number of moves tried
+ * times the samples of their triangles: bounded by the 64-step cap per
+ * triangle edge. */
+#include "mesh_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NONE UINT32_MAX
+#define SMOOTH 0
+#define CREASE 1
+#define FIXED 2
+#define GONE 3
+#define MAXSTEPS 64     /* lattice steps along a triangle's edge at most */
+#define TURN_COS 0.5    /* a moved triangle's normal turns by at most 60 degrees */
+#define SLIVER 1e-4     /* a moved triangle's area over its longest edge squared, at least */
+#define CHECK_EVERY 256 /* moves between looks at the cancel flag */
+#define FLAT 1e-6       /* cells: a ring this close to one plane is flat */
+#define TIE 1e-4        /* the edge length's weight in a move's cost (h^2 len^2) */
+
+typedef struct hent {
+    double cost;
+    uint32_t v, stamp;
+} hent;
+
+typedef struct vec32 {
+    uint32_t *a;
+    size_t n, cap;
+} vec32;
+
+typedef struct simp {
+    const lb_evaluator *ev;
+    const lb__grid *g;
+    lb_mesh *M;
+    const uint8_t *feat;
+    double tol, h;
+    uint32_t *next;        /* per corner: the next corner of its vertex (NONE: the last) */
+    uint32_t *head, *tail; /* per vertex: its corner list */
+    uint8_t *tdead;        /* per triangle */
+    uint8_t *kind;         /* per vertex: SMOOTH, CREASE, FIXED, GONE */
+    uint32_t *sn;          /* 2 per vertex: a crease vertex's neighbours along the crease */
+    double *Q;             /* 10 per vertex: the quadric */
+    uint32_t *stamp;       /* per vertex: heap entries with another stamp are stale */
+    hent *heap;
+    size_t nh, hcap;
+    vec32 ru, rv, nu, nv, tmp; /* scratch: rings and neighbour sets */
+    double *s;                 /* samples: 7 arrays of scap */
+    size_t scap;
+    lb_status est;  /* the evaluator's failure */
+    uint32_t *mark; /* per vertex (fresh) */
+    uint32_t tok;
+} simp;
+
+static lb_status nomem(lb_error *err) {
+    return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+}
+
+static int push32(vec32 *v, uint32_t x) {
+    if (v->n == v->cap) {
+        const size_t c = v->cap ? 2 * v->cap : 32;
+        uint32_t *a = realloc(v->a, c * sizeof *a);
+        if (!a) return 0;
+        v->a = a;
+        v->cap = c;
+    }
+    v->a[v->n++] = x;
+    return 1;
+}
+
+static double norm3(const double *a) {
+    return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+}
+
+static const double *P(const simp *S, uint32_t v) {
+    return S->M->positions + 3 * (size_t)v;
+}
+
+/* ---- heap of (cost, vertex), the cheapest first, ties by vertex index */
+
+static int hless(const hent *a, const hent *b) {
+    return a->cost < b->cost || (a->cost == b->cost && a->v < b->v);
+}
+
+static int hpush(simp *S, double cost, uint32_t v) {
+    if (S->nh == S->hcap) {
+        const size_t c = S->hcap ? 2 * S->hcap : 1024;
+        hent *h = realloc(S->heap, c * sizeof *h);
+        if (!h) return 0;
+        S->heap = h;
+        S->hcap = c;
+    }
+    size_t i = S->nh++;
+    const hent e = {cost, v, S->stamp[v]};
+    while (i > 0) {
+        const size_t p = (i - 1) / 2;
+        if (!hless(&e, &S->heap[p])) break;
+        S->heap[i] = S->heap[p];
+        i = p;
+    }
+    S->heap[i] = e;
+    return 1;
+}
+
+static hent hpop(simp *S) {
+    const hent top = S->heap[0], e = S->heap[--S->nh];
+    size_t i = 0;
+    for (;;) {
+        size_t c = 2 * i + 1;
+        if (c >= S->nh) break;
+        if (c + 1 < S->nh && hless(&S->heap[c + 1], &S->heap[c])) ++c;
+        if (!hless(&S->heap[c], &e)) break;
+        S->heap[i] = S->heap[c];
+        i = c;
+    }
+    if (S->nh) S->heap[i] = e;
+    return top;
+}
+
+/* ---- rings */
+
+/* The live triangles at u into r (dead ones leave u's list on the way). */
+static int ring(simp *S, uint32_t u, vec32 *r) {
+    r->n = 0;
+    uint32_t prev = NONE;
+    for (uint32_t c = S->head[u]; c != NONE;) {
+        const uint32_t nx = S->next[c];
+        if (S->tdead[c / 3]) {
+            if (prev == NONE)
+                S->head[u] = nx;
+            else
+                S->next[prev] = nx;
+            if (S->tail[u] == c) S->tail[u] = prev;
+        } else {
+            if (!push32(r, c / 3)) return 0;
+            prev = c;
+        }
+        c = nx;
+    }
+    return 1;
+}
+
+/* A fresh mark: vertices w with mark[w] == the result are marked. */
+static uint32_t fresh(simp *S) {
+    if (++S->tok == 0) { /* wrapped: clear */
+        memset(S->mark, 0, S->M->nvertices * sizeof *S->mark);
+        S->tok = 1;
+    }
+    return S->tok;
+}
+
+/* The distinct vertices other than u of the triangles r, in ring order. */
+static int neighbours(simp *S, uint32_t u, const vec32 *r, vec32 *n) {
+    n->n = 0;
+    const uint32_t m = fresh(S);
+    for (size_t i = 0; i < r->n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t w = S->M->triangles[3 * (size_t)r->a[i] + k];
+            if (w == u || S->mark[w] == m) continue;
+            S->mark[w] = m;
+            if (!push32(n, w)) return 0;
+        }
+    return 1;
+}
+
+/* Mark the vertices of n (with a fresh mark, returned). */
+static uint32_t mark_all(simp *S, const vec32 *n) {
+    const uint32_t m = fresh(S);
+    for (size_t i = 0; i < n->n; ++i) S->mark[n->a[i]] = m;
+    return m;
+}
+
+/* ---- costs */
+
+static double qcost(const double *Q, const double *x) {
+    return Q[0] * x[0] * x[0] + 2 * Q[1] * x[0] * x[1] + 2 * Q[2] * x[0] * x[2] + 2 * Q[3] * x[0] +
+           Q[4] * x[1] * x[1] + 2 * Q[5] * x[1] * x[2] + 2 * Q[6] * x[1] + Q[7] * x[2] * x[2] +
+           2 * Q[8] * x[2] + Q[9];
+}
+
+/* u moved onto v by the quadrics of both. */
+static double move_cost(const simp *S, uint32_t u, uint32_t v) {
+    double Q[10];
+    for (int i = 0; i < 10; ++i) Q[i] = S->Q[10 * (size_t)u + i] + S->Q[10 * (size_t)v + i];
+    const double c = qcost(Q, P(S, v));
+    const double *a = P(S, u), *b = P(S, v);
+    const double e2 = (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                      (a[2] - b[2]) * (a[2] - b[2]);
+    /* ties (flat regions: no quadric error) go to the shorter edge, so the
+     * triangles grow evenly and each region is sampled few times over */
+    return (c > 0.0 ? c : 0.0) + TIE * S->h * S->h * e2;
+}
+
+/* u's moves (its crease neighbours, or every neighbour of a smooth vertex)
+ * into t, and the cheapest one's cost; 0 when u cannot move (or memory). */
+static int moves(simp *S, uint32_t u, vec32 *t, double *best) {
+    t->n = 0;
+    if (S->kind[u] == CREASE) {
+        if (!push32(t, S->sn[2 * (size_t)u]) || !push32(t, S->sn[2 * (size_t)u + 1])) return 0;
+    } else if (S->kind[u] == SMOOTH) {
+        if (!ring(S, u, &S->ru) || !neighbours(S, u, &S->ru, t)) return 0;
+    } else {
+        return 0;
+    }
+    *best = INFINITY;
+    for (size_t i = 0; i < t->n; ++i) {
+        const double c = move_cost(S, u, t->a[i]);
+        if (c < *best) *best = c;
+    }
+    return t->n > 0;
+}
+
+static int requeue(simp *S, uint32_t u) {
+    ++S->stamp[u];
+    double c;
+    if (!moves(S, u, &S->tmp, &c)) return 1;
+    return hpush(S, c, u);
+}
+
+/* ---- checks */
+
+static int samples_room(simp *S, size_t n) {
+    if (n <= S->scap) return 1;
+    free(S->s);
+    S->s = malloc(7 * n * sizeof *S->s);
+    S->scap = S->s ? n : 0;
+    return S->s != NULL;
+}
+
+/* Lattice steps along the edges of triangle q: a cell apart, 2 to MAXSTEPS. */
+static int steps_of(const double *const q[3], double h) {
+    double L = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        const double *x = q[k], *y = q[(k + 1) % 3];
+        const double e[3] = {y[0] - x[0], y[1] - x[1], y[2] - x[2]};
+        const double l = norm3(e);
+        if (l > L) L = l;
+    }
+    const double n = ceil(L / h);
+    return !(n >= 2.0) ? 2 : n > MAXSTEPS ? MAXSTEPS : (int)n;
+}
+
+static size_t lattice_size(int n) {
+    return (size_t)(n + 1) * (size_t)(n + 2) / 2 - 3; /* without the corners */
+}
+
+/* The triangles of u's ring (S->ru) that u's move onto v keeps, with v for
+ * u: every point of their lattices (but the corners) within the tolerance
+ * of the surface, by one evaluation: 1, else 0; -1 when out of memory, -2
+ * when the evaluator fails (err set). */
+static int near_surface(simp *S, uint32_t u, uint32_t v, lb_error *err) {
+    const uint32_t *T = S->M->triangles;
+    size_t total = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        size_t m = 0;
+        for (size_t i = 0; i < S->ru.n; ++i) {
+            const uint32_t *t = T + 3 * (size_t)S->ru.a[i];
+            if (t[0] == v || t[1] == v || t[2] == v) continue;
+            const double *q[3];
+            for (int k = 0; k < 3; ++k) q[k] = P(S, t[k] == u ? v : t[k]);
+            const int n = steps_of(q, S->h);
+            if (pass == 0) {
+                total += lattice_size(n);
+                continue;
+            }
+            double *x = S->s, *y = x + S->scap, *z = y + S->scap;
+            for (int a = 0; a <= n; ++a)
+                for (int b = 0; a + b <= n; ++b) {
+                    if ((a == 0 && b == 0) || a == n || b == n) continue;
+                    const double wb = (double)a / n, wc = (double)b / n, wa = 1.0 - wb - wc;
+                    x[m] = wa * q[0][0] + wb * q[1][0] + wc * q[2][0];
+                    y[m] = wa * q[0][1] + wb * q[1][1] + wc * q[2][1];
+                    z[m] = wa * q[0][2] + wb * q[1][2] + wc * q[2][2];
+                    ++m;
+                }
+        }
+        if (pass == 0 && !samples_room(S, total)) return -1;
+    }
+    double *x = S->s, *y = x + S->scap, *z = y + S->scap, *f = z + S->scap, *gx = f + S->scap,
+           *gy = gx + S->scap, *gz = gy + S->scap;
+    if ((S->est = lb_evaluator_eval(S->ev, total, x, y, z, f, gx, gy, gz, 1, err)) != LB_OK)
+        return -2;
+    for (size_t i = 0; i < total; ++i) {
+        const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
+        double gp[3];
+        const double ph = lb__mesh_phi(S->g, X, f[i], gf, gp);
+        const double gl = norm3(gp);
+        if (!isfinite(ph) || !(gl > 0.0) || !isfinite(gl) || !(fabs(ph) <= S->tol * gl)) return 0;
+    }
+    return 1;
+}
+
+/* u and its neighbours (S->nu) within FLAT cells of one plane, that of u's
+ * largest triangle (S->ru). */
+static int flat_ring(const simp *S, uint32_t u) {
+    double n[3] = {0, 0, 0}, best = 0.0;
+    for (size_t i = 0; i < S->ru.n; ++i) {
+        const uint32_t *t = S->M->triangles + 3 * (size_t)S->ru.a[i];
+        double f[3];
+        lb__facing(P(S, t[0]), P(S, t[1]), P(S, t[2]), f);
+        const double l = norm3(f);
+        if (l > best) {
+            best = l;
+            for (int d = 0; d < 3; ++d) n[d] = f[d] / l;
+        }
+    }
+    if (!(best > 0.0)) return 0;
+    const double *o = P(S, u), eps = FLAT * S->h;
+    for (size_t i = 0; i < S->nu.n; ++i) {
+        const double *q = P(S, S->nu.a[i]);
+        const double d = n[0] * (q[0] - o[0]) + n[1] * (q[1] - o[1]) + n[2] * (q[2] - o[2]);
+        if (!(fabs(d) <= eps)) return 0;
+    }
+    return 1;
+}
+
+/* Whether u can move onto v now: 1 yes, 0 no, -1 out of memory, -2 the
+ * evaluator failed. Leaves u's ring in S->ru. */
+static int can_move(simp *S, uint32_t u, uint32_t v, lb_error *err) {
+    const uint32_t *T = S->M->triangles;
+    if (!ring(S, u, &S->ru) || !neighbours(S, u, &S->ru, &S->nu) || !ring(S, v, &S->rv) ||
+        !neighbours(S, v, &S->rv, &S->nv))
+        return -1;
+    /* topology: the edge's two triangles and their far vertices */
+    uint32_t opp[2];
+    int no = 0;
+    for (size_t i = 0; i < S->ru.n; ++i) {
+        const uint32_t *t = T + 3 * (size_t)S->ru.a[i];
+        if (t[0] != v && t[1] != v && t[2] != v) continue;
+        if (no == 2) return 0;
+        for (int k = 0; k < 3; ++k)
+            if (t[k] != u && t[k] != v) opp[no] = t[k];
+        ++no;
+    }
+    if (no != 2 || opp[0] == opp[1]) return 0;
+    size_t common = 0;
+    const uint32_t m = mark_all(S, &S->nv);
+    for (size_t i = 0; i < S->nu.n; ++i)
+        if (S->mark[S->nu.a[i]] == m) ++common;
+    if (common != 2 || S->mark[opp[0]] != m || S->mark[opp[1]] != m) return 0;
+    if (S->nu.n + S->nv.n < 4 + 3) return 0;
+    for (int k = 0; k < 2; ++k) {
+        if (!ring(S, opp[k], &S->tmp)) return -1;
+        if (S->tmp.n < 4) return 0;
+    }
+    /* shape */
+    const double *pv = P(S, v);
+    for (size_t i = 0; i < S->ru.n; ++i) {
+        const uint32_t *t = T + 3 * (size_t)S->ru.a[i];
+        if (t[0] == v || t[1] == v || t[2] == v) continue;
+        const double *o[3], *q[3];
+        for (int k = 0; k < 3; ++k) {
+            o[k] = P(S, t[k]);
+            q[k] = t[k] == u ? pv : o[k];
+        }
+        double n0[3], n1[3];
+        lb__facing(o[0], o[1], o[2], n0);
+        lb__facing(q[0], q[1], q[2], n1);
+        const double l0 = norm3(n0), l1 = norm3(n1);
+        double L2 = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            const double *x = q[k], *y = q[(k + 1) % 3];
+            const double e2 = (y[0] - x[0]) * (y[0] - x[0]) + (y[1] - x[1]) * (y[1] - x[1]) +
+                              (y[2] - x[2]) * (y[2] - x[2]);
+            if (e2 > L2) L2 = e2;
+        }
+        if (!(l1 >= 2.0 * SLIVER * L2) || !(l0 > 0.0)) return 0;
+        if ((n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2]) < TURN_COS * l0 * l1) return 0;
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t w = t[k] == u ? v : t[k];
+            if (S->feat && S->feat[w]) continue;
+            const double *N = S->M->normals + 3 * (size_t)w;
+            if (!(N[0] * n1[0] + N[1] * n1[1] + N[2] * n1[2] > 0.0)) return 0;
+        }
+    }
+    /* a flat ring: the moved triangles cover the old ones' polygon exactly
+     * (same plane, none turned over), whose points were checked when they
+     * were made: nothing new to sample */
+    if (flat_ring(S, u)) return 1;
+    /* the field */
+    return near_surface(S, u, v, err);
+}
+
+/* Move u onto v (can_move said yes; S->ru is u's ring, S->nu and S->nv the
+ * two neighbour sets) and requeue the vertices around. */
+static int do_move(simp *S, uint32_t u, uint32_t v) {
+    uint32_t *T = S->M->triangles;
+    for (size_t i = 0; i < S->ru.n; ++i) {
+        uint32_t *t = T + 3 * (size_t)S->ru.a[i];
+        if (t[0] == v || t[1] == v || t[2] == v)
+            S->tdead[S->ru.a[i]] = 1;
+        else
+            for (int k = 0; k < 3; ++k)
+                if (t[k] == u) t[k] = v;
+    }
+    /* u's corners join v's list (its dead ones are dropped by later walks) */
+    if (S->head[u] != NONE) {
+        if (S->head[v] == NONE)
+            S->head[v] = S->head[u];
+        else
+            S->next[S->tail[v]] = S->head[u];
+        S->tail[v] = S->tail[u];
+    }
+    S->head[u] = S->tail[u] = NONE;
+    for (int i = 0; i < 10; ++i) S->Q[10 * (size_t)v + i] += S->Q[10 * (size_t)u + i];
+    if (S->kind[u] == CREASE) {
+        uint32_t *su = S->sn + 2 * (size_t)u;
+        const uint32_t w = su[0] == v ? su[1] : su[0];
+        if (S->kind[v] == CREASE) {
+            uint32_t *s = S->sn + 2 * (size_t)v;
+            if (s[0] == u) s[0] = w;
+            if (s[1] == u) s[1] = w;
+            if (s[0] == s[1]) S->kind[v] = FIXED; /* a crease closed into a loop of two */
+        }
+        if (S->kind[w] == CREASE) {
+            uint32_t *s = S->sn + 2 * (size_t)w;
+            if (s[0] == u) s[0] = v;
+            if (s[1] == u) s[1] = v;
+            if (s[0] == s[1]) S->kind[w] = FIXED;
+        }
+    }
+    S->kind[u] = GONE;
+    ++S->stamp[u];
+    /* requeue v and every neighbour of either (copied: requeue reuses ru) */
+    vec32 around = {NULL, 0, 0};
+    int ok = push32(&around, v);
+    for (size_t i = 0; ok && i < S->nu.n; ++i)
+        if (S->nu.a[i] != v) ok = push32(&around, S->nu.a[i]);
+    const uint32_t m = mark_all(S, &S->nu);
+    for (size_t i = 0; ok && i < S->nv.n; ++i)
+        if (S->nv.a[i] != u && S->mark[S->nv.a[i]] != m) ok = push32(&around, S->nv.a[i]);
+    for (size_t i = 0; ok && i < around.n; ++i) ok = requeue(S, around.a[i]);
+    free(around.a);
+    return ok;
+}
+
+/* ---- setup */
+
+typedef struct hedge {
+    uint64_t key; /* smaller vertex << 32 | larger */
+    uint32_t t;
+} hedge;
+
+static int cmp_hedge(const void *a, const void *b) {
+    const hedge *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return (x->t > y->t) - (x->t < y->t);
+}
+
+static void add_sharp(simp *S, uint32_t *count, uint32_t a, uint32_t b) {
+    if (count[a] < 2) S->sn[2 * (size_t)a + count[a]] = b;
+    ++count[a];
+}
+
+/* Kinds, crease neighbours, quadrics and corner lists. */
+static lb_status setup(simp *S, lb_error *err) {
+    const lb_mesh *M = S->M;
+    const size_t nv = M->nvertices, nt = M->ntriangles;
+    hedge *E = malloc(3 * nt * sizeof *E);
+    double *un = malloc(3 * nt * sizeof *un); /* unit facings, 0 0 0: degenerate */
+    uint32_t *count = calloc(nv, sizeof *count);
+    if (!E || !un || !count) {
+        free(E);
+        free(un);
+        free(count);
+        return nomem(err);
+    }
+    for (size_t t = 0; t < nt; ++t) {
+        const uint32_t *tv = M->triangles + 3 * t;
+        const double *a = P(S, tv[0]), *b = P(S, tv[1]), *c = P(S, tv[2]);
+        double *n = un + 3 * t;
+        lb__facing(a, b, c, n);
+        const double l = norm3(n);
+        if (l > 0.0 && isfinite(l)) {
+            for (int d = 0; d < 3; ++d) n[d] /= l;
+            /* the plane n . x + dd = 0, weighted by the area */
+            const double dd = -(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]), w = 0.5 * l;
+            const double q[10] = {n[0] * n[0], n[0] * n[1], n[0] * n[2], n[0] * dd, n[1] * n[1],
+                                  n[1] * n[2], n[1] * dd,   n[2] * n[2], n[2] * dd, dd * dd};
+            for (int k = 0; k < 3; ++k)
+                for (int i = 0; i < 10; ++i) S->Q[10 * (size_t)tv[k] + i] += w * q[i];
+        } else {
+            n[0] = n[1] = n[2] = 0.0;
+            for (int k = 0; k < 3; ++k) S->kind[tv[k]] = FIXED;
+        }
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t x = tv[k], y = tv[(k + 1) % 3];
+            const uint32_t lo = x < y ? x : y, hi = x < y ? y : x;
+            E[3 * t + k].key = (uint64_t)lo << 32 | hi;
+            E[3 * t + k].t = (uint32_t)t;
+        }
+    }
+    qsort(E, 3 * nt, sizeof *E, cmp_hedge);
+    for (size_t i = 0; i < 3 * nt;) {
+        size_t j = i + 1;
+        while (j < 3 * nt && E[j].key == E[i].key) ++j;
+        const uint32_t a = (uint32_t)(E[i].key >> 32), b = (uint32_t)E[i].key;
+        if (j - i != 2) { /* an open boundary (or worse): its ends stay */
+            S->kind[a] = S->kind[b] = FIXED;
+        } else {
+            const double *n = un + 3 * (size_t)E[i].t, *m = un + 3 * (size_t)E[i + 1].t;
+            if (n[0] * m[0] + n[1] * m[1] + n[2] * m[2] < LB__FEATURE_COS) {
+                add_sharp(S, count, a, b);
+                add_sharp(S, count, b, a);
+            }
+        }
+        i = j;
+    }
+    for (size_t v = 0; v < nv; ++v)
+        if (S->kind[v] != FIXED)
+            S->kind[v] = count[v] == 0 ? SMOOTH : count[v] == 2 ? CREASE : FIXED;
+    free(E);
+    free(un);
+    free(count);
+    /* corner lists, each in corner order */
+    for (size_t v = 0; v < nv; ++v) S->head[v] = S->tail[v] = NONE;
+    for (size_t c = 0; c < 3 * nt; ++c) {
+        const uint32_t v = M->triangles[c];
+        S->next[c] = NONE;
+        if (S->head[v] == NONE)
+            S->head[v] = (uint32_t)c;
+        else
+            S->next[S->tail[v]] = (uint32_t)c;
+        S->tail[v] = (uint32_t)c;
+    }
+    return LB_OK;
+}
+
+/* Drop the moved vertices and the dead triangles, keeping both orders. */
+static void compact(simp *S, uint8_t *feat) {
+    lb_mesh *M = S->M;
+    uint32_t *to = S->stamp; /* reused: new index per vertex */
+    size_t n = 0;
+    for (size_t v = 0; v < M->nvertices; ++v) {
+        if (S->kind[v] == GONE) continue;
+        to[v] = (uint32_t)n;
+        if (n != v) {
+            memcpy(M->positions + 3 * n, M->positions + 3 * v, 3 * sizeof *M->positions);
+            memcpy(M->normals + 3 * n, M->normals + 3 * v, 3 * sizeof *M->normals);
+            if (feat) feat[n] = feat[v];
+        }
+        ++n;
+    }
+    size_t m = 0;
+    for (size_t t = 0; t < M->ntriangles; ++t) {
+        if (S->tdead[t]) continue;
+        for (int k = 0; k < 3; ++k) M->triangles[3 * m + k] = to[M->triangles[3 * t + k]];
+        ++m;
+    }
+    M->nvertices = n;
+    M->ntriangles = m;
+}
+
+lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, uint8_t *feat,
+                       double tolerance, const volatile int *cancel, lb_error *err) {
+    const size_t nv = M->nvertices, nt = M->ntriangles;
+    if (!nt || nv >= NONE || 3 * nt >= NONE) return LB_OK;
+    simp S;
+    memset(&S, 0, sizeof S);
+    S.ev = ev;
+    S.g = g;
+    S.M = M;
+    S.feat = feat;
+    S.h = fmin(g->h[0], fmin(g->h[1], g->h[2]));
+    S.tol = tolerance * S.h;
+    S.next = malloc(3 * nt * sizeof *S.next);
+    S.head = malloc(nv * sizeof *S.head);
+    S.tail = malloc(nv * sizeof *S.tail);
+    S.tdead = calloc(nt, 1);
+    S.kind = calloc(nv, 1);
+    S.sn = malloc(2 * nv * sizeof *S.sn);
+    S.Q = calloc(10 * nv, sizeof *S.Q);
+    S.stamp = calloc(nv, sizeof *S.stamp);
+    S.mark = calloc(nv, sizeof *S.mark);
+    lb_status s = LB_OK;
+    if (!S.next || !S.head || !S.tail || !S.tdead || !S.kind || !S.sn || !S.Q || !S.stamp ||
+        !S.mark)
+        s = nomem(err);
+    if (!s) s = setup(&S, err);
+    vec32 cand = {NULL, 0, 0};
+    double *cost = NULL; /* the moves' costs */
+    size_t ccap = 0;
+    for (size_t v = 0; !s && v < nv; ++v)
+        if (!requeue(&S, (uint32_t)v)) s = nomem(err);
+    size_t moved = 0;
+    while (!s && S.nh) {
+        const hent e = hpop(&S);
+        const uint32_t u = e.v;
+        if (e.stamp != S.stamp[u] || S.kind[u] == GONE) continue;
+        double best;
+        if (!moves(&S, u, &cand, &best)) continue;
+        /* the moves in order of cost (stable: ties in ring order) */
+        if (cand.n > ccap) {
+            free(cost);
+            ccap = cand.cap;
+            if (!(cost = malloc(ccap * sizeof *cost))) {
+                s = nomem(err);
+                break;
+            }
+        }
+        for (size_t i = 0; i < cand.n; ++i) {
+            const uint32_t x = cand.a[i];
+            const double c = move_cost(&S, u, x);
+            size_t j = i;
+            for (; j > 0 && c < cost[j - 1]; --j) {
+                cost[j] = cost[j - 1];
+                cand.a[j] = cand.a[j - 1];
+            }
+            cost[j] = c;
+            cand.a[j] = x;
+        }
+        for (size_t i = 0; i < cand.n; ++i) {
+            const int r = can_move(&S, u, cand.a[i], err);
+            if (r == -1) s = nomem(err);
+            if (r == -2) s = S.est;
+            if (r != 1) {
+                if (s) break;
+                continue;
+            }
+            if (!do_move(&S, u, cand.a[i])) s = nomem(err);
+            if (++moved % CHECK_EVERY == 0 && cancel && *cancel)
+                s = lb__fail(err, LB_ERR_CANCELLED, "lb_mesh_create: cancelled by the caller");
+            break;
+        }
+    }
+    if (!s) compact(&S, feat);
+    free(cand.a);
+    free(cost);
+    free(S.next);
+    free(S.head);
+    free(S.tail);
+    free(S.tdead);
+    free(S.kind);
+    free(S.sn);
+    free(S.Q);
+    free(S.stamp);
+    free(S.mark);
+    free(S.heap);
+    free(S.ru.a);
+    free(S.rv.a);
+    free(S.nu.a);
+    free(S.nv.a);
+    free(S.tmp.a);
+    free(S.s);
+    return s;
+}
