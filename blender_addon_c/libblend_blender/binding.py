@@ -65,7 +65,8 @@ class _MeshOptions(ctypes.Structure):
                 ("resolution", ctypes.c_uint), ("cell_size", ctypes.c_double),
                 ("flags", ctypes.c_uint), ("threads", ctypes.c_int),
                 ("max_memory", ctypes.c_size_t), ("progress", ctypes.c_void_p),
-                ("user", ctypes.c_void_p), ("cancel", ctypes.POINTER(ctypes.c_int))]
+                ("user", ctypes.c_void_p), ("cancel", ctypes.POINTER(ctypes.c_int)),
+                ("simplify", ctypes.c_double)]
 
 
 class _Mesh(ctypes.Structure):
@@ -466,13 +467,16 @@ class Evaluator(_Handle):
         return v
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
-             max_memory=0, cancel=None, edges=False, features=False, corner_normals=True):
+             max_memory=0, cancel=None, edges=False, features=False, corner_normals=True,
+             simplify=0.0):
         """Mesh the field over the box [bmin, bmax] (docs/meshing.md). Returns a
         Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called.
         edges=True also fills Mesh.edges and Mesh.corner_edges (lb_mesh_edges);
         features=True keeps sharp creases and corners (LB_MESH_FEATURES), and
         with corner_normals (LB_MESH_CORNER_NORMALS) gives each side of a
-        crease its own normal (Mesh.corner_normals, Mesh.loop_normals())."""
+        crease its own normal (Mesh.corner_normals, Mesh.loop_normals());
+        simplify > 0 (cells, at most 1) merges triangles wherever the surface
+        stays within that tolerance of the field (lb_mesh_options.simplify)."""
         _need_numpy()
         o = _MeshOptions()
         self.lib._c.lb_mesh_options_init(ctypes.byref(o))
@@ -484,6 +488,7 @@ class Evaluator(_Handle):
             | (MESH_CORNER_NORMALS if features and corner_normals else 0)
         o.threads = int(threads)
         o.max_memory = int(max_memory)
+        o.simplify = float(simplify)
         if cancel is not None:
             o.cancel = ctypes.pointer(cancel._flag)
         out, err = ctypes.POINTER(_Mesh)(), _Error()

@@ -67,13 +67,13 @@ class _Job:
     run() touches no Blender data and may run on a worker thread."""
 
     def __init__(self, lib, text, name, bmin, bmax, resolution, open_boundary, threads, paths,
-                 fit=False, features=False):
+                 fit=False, features=False, simplify=0.0):
         self.lib, self.text, self.name = lib, text, name
         self.bmin, self.bmax, self.resolution = bmin, bmax, resolution
         self.open_boundary, self.threads, self.paths = open_boundary, threads, paths
-        self.fit, self.features = fit, features
+        self.fit, self.features, self.simplify = fit, features, simplify
         self.key = mesh_key(text, "fit" if fit else bmin, "fit" if fit else bmax, resolution,
-                            open_boundary, features)
+                            open_boundary, features, simplify)
         self.cell = 0.0        # Fit Region's cell size (0: not fitted)
         self.region_note = ""  # why the fit fell back to the box, if it did
         self.clipped = ""      # the region faces the surface reaches ("+z -x"), if any
@@ -109,7 +109,8 @@ class _Job:
         self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
                             cell_size=self.cell, open_boundary=self.open_boundary,
                             threads=self.threads, cancel=self.cancel,
-                            edges=compat.takes_libblend_edges(), features=self.features)
+                            edges=compat.takes_libblend_edges(), features=self.features,
+                            simplify=self.simplify)
         self.clipped = clipped_faces(self.mesh.positions, self.bmin, self.bmax)
         mats = scene.materials()
         if len(mats) > 1 and len(self.mesh.triangles):
@@ -289,16 +290,18 @@ def set_materials(me, mesh):
 
 # --------------------------------------------------------------------------- jobs
 
-def mesh_key(text, bmin, bmax, resolution, open_boundary, features=False):
+def mesh_key(text, bmin, bmax, resolution, open_boundary, features=False, simplify=0.0):
     """What a mesh is a function of: the scene text, the region, the
-    resolution, the boundary mode and Sharp Features. Equal keys, equal
-    meshes; so a field whose key did not change is not meshed again (frames
-    where nothing moved, a driver that did not change its value, a render's
-    first frame). Without features the key is the one bakes made before
-    the option have."""
+    resolution, the boundary mode, Sharp Features and Simplify. Equal keys,
+    equal meshes; so a field whose key did not change is not meshed again
+    (frames where nothing moved, a driver that did not change its value, a
+    render's first frame). Without features and simplification the key is
+    the one bakes made before those options have."""
     parts = [text, list(bmin), list(bmax), int(resolution), bool(open_boundary)]
     if features:
         parts.append("features")
+    if simplify > 0.0:
+        parts.append("simplify %r" % float(simplify))
     h = hashlib.sha256(json.dumps(parts).encode())
     return h.hexdigest()[:32]
 
@@ -336,7 +339,8 @@ def prepare(output, resolution, depsgraph=None):
     bmin, bmax = _region(output)
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
                 output.libblend.open_boundary, libhandle.threads(), paths,
-                fit=output.libblend.fit_region, features=output.libblend.sharp_features)
+                fit=output.libblend.fit_region, features=output.libblend.sharp_features,
+                simplify=output.libblend.simplify)
 
 
 def _finish(output, st, job, t_start, defer_normals=False):
@@ -414,7 +418,8 @@ def cached_key(output, depsgraph=None):
     s = output.libblend
     text, _paths = tree.to_json(output, depsgraph, render=False, compact=True)
     bmin, bmax = ("fit", "fit") if s.fit_region else _region(output)
-    return mesh_key(text, bmin, bmax, s.render_resolution, s.open_boundary, s.sharp_features)
+    return mesh_key(text, bmin, bmax, s.render_resolution, s.open_boundary, s.sharp_features,
+                    s.simplify)
 
 
 def from_cache(output, frame, depsgraph=None):

@@ -111,6 +111,11 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
                                  "each crease, and a split normal per side so it shades sharp. "
                                  "Costs up to 1.8x the meshing time on scenes with many creases",
                                  default=False, update=_changed)
+    simplify: FloatProperty(name="Simplify", description="fewer triangles where the surface "
+                            "allows: merge triangles wherever the mesh stays within this many "
+                            "cells of the field, never across a crease (with Sharp Features a "
+                            "flat face becomes a few large triangles). 0 = off", default=0.0,
+                            min=0.0, max=1.0, step=5, precision=2, update=_changed)
     normals: EnumProperty(name="Normals", items=[
         ("AUTO", "Auto", "analytic normals below 250k triangles, Blender's smooth normals above"),
         ("ANALYTIC", "Analytic", "libblend's exact normals as custom split normals"),

@@ -1147,5 +1147,24 @@ check(cached.corner_normals is not None and
       np.abs(cached.loop_normals() - cjob.mesh.loop_normals()).max() < 1e-6,
       "a baked frame keeps the corner normals")
 
+# ---------------------------------------------------------------- Simplify
+# With Simplify (0.1 cells) and Sharp Features the cube is its 12 triangles
+# in Blender, still shaded with each face's normal; the setting is part of
+# the mesh key (a change remeshes; bakes made without it stay valid).
+cube.libblend.simplify = 0.1
+check(live.update_now(cube)[0], "mesh the cube with Simplify")
+simp_cos, simp_corner = face_cos(cube)
+npoly = len(cube.data.polygons)
+check(npoly <= 100 and len(cube.data.vertices) == 8 and simp_cos > 0.9999 and
+      simp_corner < 1e-5,
+      "Simplify: the cube in %d triangles (bar 100), %d vertices, corners kept (%.2g), face "
+      "normals (cos %.6f)" % (npoly, len(cube.data.vertices), simp_corner, simp_cos))
+sjob = live.prepare(cube, 26)
+check(sjob.key != cjob.key and abs(sjob.simplify - 0.1) < 1e-6,
+      "Simplify is part of the mesh key (a bake without it is not reused)")
+cube.libblend.simplify = 0.0
+check(live.update_now(cube)[0] and len(cube.data.polygons) > 1000,
+      "Simplify off again: the full mesh (%d triangles)" % len(cube.data.polygons))
+
 addon_utils.disable(ADDON_NAME)
 print("test_addon: %d checks passed" % addon_env.checks)

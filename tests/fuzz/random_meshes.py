@@ -7,13 +7,14 @@ shared defs, bulge elimination, nesting up to depth 4), from fixed seeds
 (printed, so a failure can be replayed) for the rest of the time budget.
 Each is parsed and compiled through the library (the ctypes binding, no
 process per scene) and meshed at 12 cells on two threads and 20 on one, and
-at 20 on two with sharp features (LB_MESH_FEATURES, with corner normals);
+at 20 on two with sharp features (LB_MESH_FEATURES, with corner normals),
+and at 20 on two with features simplified (simplify = 0.25 cells);
 every non-empty mesh must be closed, oriented and 2-manifold (tests/mesh's
 numpy checks), its corner normals within their contract, and the
 scenes found wrong before (by an issue, or by this test's fresh seeds:
 barthe-underflow.json, seed 578775895819, failed to compile) must mesh
-closed at 20, 64 and 97 cells, and at 64 and 97 with sharp features
-(tests/data/regressions/).
+closed at 20, 64 and 97 cells, and at 64 and 97 with sharp features, and
+at 64 with features simplified (tests/data/regressions/).
 
 usage: random_meshes.py ADDON_DIR SOURCE_DIR FIXED_COUNT EXTRA_SECONDS
 """
@@ -55,24 +56,23 @@ def closed(text, name, runs):
         with ev:
             lo, hi = sc.bounds
             n = 0
-            for res, th, feat in runs:
+            for res, th, feat, simp in runs:
+                how = "%d cells, %d threads%s%s" % (res, th, " with sharp features" if feat else "",
+                                                    ", simplify %g" % simp if simp else "")
                 try:
-                    m = ev.mesh(lo, hi, resolution=res, threads=th, features=feat)
+                    m = ev.mesh(lo, hi, resolution=res, threads=th, features=feat, simplify=simp)
                 except binding.LibblendError as e:  # a valid scene must mesh
-                    fail("%s: mesh at %d cells, %d threads%s: %s" %
-                         (name, res, th, " with sharp features" if feat else "", e))
+                    fail("%s: mesh at %s: %s" % (name, how, e))
                     return n
                 if not len(m.triangles):
                     continue
                 c = meshcheck.check(m.positions, m.triangles)
                 n += 1
                 if not (c["closed"] and c["oriented"] and c["manifold"]):
-                    fail("%s: mesh at %d cells, %d threads%s: %s" %
-                         (name, res, th, " with sharp features" if feat else "", c))
+                    fail("%s: mesh at %s: %s" % (name, how, c))
                     return n
                 if m.corner_normals is not None and not corners_ok(m):
-                    fail("%s: mesh at %d cells, %d threads: corner normals out of contract" %
-                         (name, res, th))
+                    fail("%s: mesh at %s: corner normals out of contract" % (name, how))
                     return n
             return n
 
@@ -94,8 +94,9 @@ def corners_ok(m):
 
 # the scenes an issue found open
 for p in sorted(glob.glob(os.path.join(SRC, "tests", "data", "regressions", "*.json"))):
-    n = closed(open(p).read(), os.path.basename(p), ((20, 1, False), (64, 2, False), (97, 1, False),
-                                                        (64, 2, True), (97, 1, True)))
+    n = closed(open(p).read(), os.path.basename(p),
+               ((20, 1, False, 0), (64, 2, False, 0), (97, 1, False, 0), (64, 2, True, 0),
+                (97, 1, True, 0), (64, 2, True, 0.25)))
     if not n:
         fail("%s: nothing meshed" % p)
 
@@ -105,7 +106,8 @@ stats = {"scenes": 0, "meshes": 0, "refused": 0, "empty": 0}
 
 def run(seed):
     sc, _ = random_scenes.scene(seed)
-    n = closed(json.dumps(sc), "seed %d" % seed, ((12, 2, False), (20, 1, False), (20, 2, True)))
+    n = closed(json.dumps(sc), "seed %d" % seed,
+               ((12, 2, False, 0), (20, 1, False, 0), (20, 2, True, 0), (20, 2, True, 0.25)))
     stats["scenes"] += 1
     if n is None:
         stats["refused"] += 1
