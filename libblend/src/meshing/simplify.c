@@ -286,10 +286,12 @@ static size_t lattice_size(int n) {
 }
 
 /* The triangles of u's ring (S->ru) that u's move onto v keeps, with v for
- * u: every point of their lattices (but the corners) within the tolerance
- * of the surface, by one evaluation: 1, else 0; -1 when out of memory, -2
- * when the evaluator fails (err set). */
-static int near_surface(simp *S, uint32_t u, uint32_t v, lb_error *err) {
+ * u: every point of their lattices (but the corners; at most maxn steps
+ * along an edge) within the tolerance of the surface, by one evaluation: 1,
+ * else 0; -1 when out of memory, -2 when the evaluator fails (err set).
+ * *coarser: some triangle had more steps than maxn allowed. */
+static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser, lb_error *err) {
+    *coarser = 0;
     const uint32_t *T = S->M->triangles;
     size_t total = 0;
     for (int pass = 0; pass < 2; ++pass) {
@@ -299,7 +301,11 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, lb_error *err) {
             if (t[0] == v || t[1] == v || t[2] == v) continue;
             const double *q[3];
             for (int k = 0; k < 3; ++k) q[k] = P(S, t[k] == u ? v : t[k]);
-            const int n = steps_of(q, S->h);
+            int n = steps_of(q, S->h);
+            if (n > maxn) {
+                n = maxn;
+                *coarser = 1;
+            }
             if (pass == 0) {
                 total += lattice_size(n);
                 continue;
@@ -329,6 +335,50 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, lb_error *err) {
         if (!isfinite(ph) || !(gl > 0.0) || !isfinite(gl) || !(fabs(ph) <= S->tol * gl)) return 0;
     }
     return 1;
+}
+
+static double dot3(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* The squared distance from x to triangle (a, b, c): the nearest point by
+ * the region of the triangle's plane x projects into (a corner, an edge or
+ * the inside), from the barycentric signs. */
+static double point_triangle2(const double *x, const double *a, const double *b, const double *c) {
+    const double ab[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                 ac[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]},
+                 ax[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
+    double w[3]; /* weights of a, b, c of the nearest point */
+    const double d1 = dot3(ab, ax), d2 = dot3(ac, ax);
+    const double bx[3] = {x[0] - b[0], x[1] - b[1], x[2] - b[2]},
+                 cx[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+    const double d3 = dot3(ab, bx), d4 = dot3(ac, bx), d5 = dot3(ab, cx), d6 = dot3(ac, cx);
+    const double va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
+    if (d1 <= 0 && d2 <= 0) { /* corner a */
+        w[0] = 1, w[1] = 0, w[2] = 0;
+    } else if (d3 >= 0 && d4 <= d3) { /* corner b */
+        w[0] = 0, w[1] = 1, w[2] = 0;
+    } else if (d6 >= 0 && d5 <= d6) { /* corner c */
+        w[0] = 0, w[1] = 0, w[2] = 1;
+    } else if (vc <= 0 && d1 >= 0 && d3 <= 0) { /* edge ab */
+        const double t = d1 / (d1 - d3);
+        w[0] = 1 - t, w[1] = t, w[2] = 0;
+    } else if (vb <= 0 && d2 >= 0 && d6 <= 0) { /* edge ac */
+        const double t = d2 / (d2 - d6);
+        w[0] = 1 - t, w[1] = 0, w[2] = t;
+    } else if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) { /* edge bc */
+        const double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        w[0] = 0, w[1] = 1 - t, w[2] = t;
+    } else { /* inside */
+        const double den = va + vb + vc;
+        w[1] = vb / den, w[2] = vc / den, w[0] = 1 - w[1] - w[2];
+    }
+    double d = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        const double y = w[0] * a[k] + w[1] * b[k] + w[2] * c[k] - x[k];
+        d += y * y;
+    }
+    return d;
 }
 
 /* u and its neighbours (S->nu) within FLAT cells of one plane, that of u's
@@ -414,12 +464,29 @@ static int can_move(simp *S, uint32_t u, uint32_t v, lb_error *err) {
             if (!(N[0] * n1[0] + N[1] * n1[1] + N[2] * n1[2] > 0.0)) return 0;
         }
     }
+    /* both ways: u's point (on the surface) within the tolerance of the
+     * moved triangles, so no thin part is cut off by triangles that pass
+     * near its base (and most moves that fail are refused before sampling) */
+    double d2 = INFINITY;
+    for (size_t i = 0; i < S->ru.n && d2 > S->tol * S->tol; ++i) {
+        const uint32_t *t = T + 3 * (size_t)S->ru.a[i];
+        if (t[0] == v || t[1] == v || t[2] == v) continue;
+        const double *q[3];
+        for (int k = 0; k < 3; ++k) q[k] = t[k] == u ? pv : P(S, t[k]);
+        const double e = point_triangle2(P(S, u), q[0], q[1], q[2]);
+        if (e < d2) d2 = e;
+    }
+    if (!(d2 <= S->tol * S->tol)) return 0;
     /* a flat ring: the moved triangles cover the old ones' polygon exactly
      * (same plane, none turned over), whose points were checked when they
      * were made: nothing new to sample */
     if (flat_ring(S, u)) return 1;
-    /* the field */
-    return near_surface(S, u, v, err);
+    /* the field: a coarse lattice first (most moves that fail, fail there),
+     * then the full one where that was coarser */
+    int coarser;
+    const int r = near_surface(S, u, v, 3, &coarser, err);
+    if (r != 1 || !coarser) return r;
+    return near_surface(S, u, v, MAXSTEPS, &coarser, err);
 }
 
 /* Move u onto v (can_move said yes; S->ru is u's ring, S->nu and S->nv the
