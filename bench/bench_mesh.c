@@ -5,9 +5,10 @@
  * bench/mesh/run_mesh_bench.py runs it next to the anchors.
  *
  * Usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1]
- *                   [--features | --corner-normals]
+ *                   [--features | --corner-normals] [--simplify TOL]
  * (--features: LB_MESH_FEATURES, sharp creases and corners; --corner-normals:
- * also LB_MESH_CORNER_NORMALS) */
+ * also LB_MESH_CORNER_NORMALS; --simplify: lb_mesh_options.simplify, cells;
+ * the options come last) */
 #define _POSIX_C_SOURCE 200809L
 #include <libblend/libblend.h>
 
@@ -35,6 +36,11 @@ static long rss_kb(void) { /* current resident set, from /proc */
 
 int main(int argc, char **argv) {
     unsigned flags = 0;
+    double simplify = 0.0;
+    if (argc > 2 && strcmp(argv[argc - 2], "--simplify") == 0) {
+        simplify = atof(argv[argc - 1]);
+        argc -= 2;
+    }
     if (argc > 1 && strcmp(argv[argc - 1], "--features") == 0) {
         flags = LB_MESH_FEATURES;
         --argc;
@@ -44,7 +50,7 @@ int main(int argc, char **argv) {
     }
     if (argc != 4 && argc != 10) {
         fprintf(stderr, "usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1] "
-                        "[--features | --corner-normals]\n");
+                        "[--features | --corner-normals] [--simplify TOL]\n");
         return 2;
     }
     lb_error e = {LB_OK, ""};
@@ -59,6 +65,7 @@ int main(int argc, char **argv) {
     o.resolution = (unsigned)atoi(argv[2]);
     o.threads = atoi(argv[3]);
     o.flags = flags;
+    o.simplify = simplify;
     if (argc == 10)
         for (int d = 0; d < 3; ++d) {
             o.bmin[d] = atof(argv[4 + d]);

@@ -1,0 +1,72 @@
+"""The add-on's live update with and without Simplify, in headless Blender
+(bench/run_simplify_bench.sh):
+
+    blender -b --factory-startup --python bench_simplify.py -- ADDON_PARENT SOURCE_DIR
+
+For a CSG scene (two overlapping boxes, with Sharp Features), the stool of
+the bounded-blending paper (with Sharp Features) and S2 (64 spheres), at 64
+and 128 cells: the synchronous update (live.update_now: mesh, then the
+Blender mesh data, Blender's own normals) with Simplify 0 and 0.1 cells,
+alternating, 7 rounds; medians, and of each the libblend and Blender parts.
+Prints one "BENCH {json}" line per configuration, then a table."""
+import json
+import os
+import statistics
+import sys
+import time
+
+import bpy
+import addon_utils
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+ADDON_PARENT, SRC = argv[:2]
+sys.path.insert(0, ADDON_PARENT)
+os.environ.pop("LIBBLEND_LIBRARY", None)
+addon_utils.enable("libblend_blender", default_set=True)
+from libblend_blender import live  # noqa: E402
+
+for o in list(bpy.data.objects):
+    bpy.data.objects.remove(o)
+ROUNDS = 7
+SCENES = (("two boxes (CSG)", os.path.join(SRC, "tests", "data", "features", "two-boxes.json"),
+           True),
+          ("stool", os.path.join(SRC, "scenes", "hsu-bounded-fig7-stool.json"), True),
+          ("S2", os.path.join(SRC, "scenes", "bench-s2-64-spheres.json"), False))
+rows = []
+for name, path, feat in SCENES:
+    bpy.ops.libblend.import_scene(filepath=path, with_render=False)
+    out = bpy.context.view_layer.objects.active
+    out.libblend.live = False
+    out.libblend.sharp_features = feat
+    out.libblend.normals = "FACES"
+    for res in (64, 128):
+        out.libblend.preview_resolution = res
+        t = {0.0: [], 0.1: []}
+        parts = {0.0: [], 0.1: []}
+        tris = {}
+        for _ in range(ROUNDS):
+            for simp in (0.0, 0.1):
+                out.libblend.simplify = simp
+                t0 = time.perf_counter()
+                ok, msg = live.update_now(out)
+                t[simp].append(time.perf_counter() - t0)
+                assert ok, msg
+                parts[simp].append(live.state_of(out).last)
+                tris[simp] = len(out.data.polygons)
+        r = {"scene": name, "cells": res, "features": feat}
+        for simp in (0.0, 0.1):
+            k = "simplified" if simp else "plain"
+            r[k] = {"ms": 1000 * statistics.median(t[simp]), "triangles": tris[simp],
+                    "libblend_ms": 1000 * statistics.median(p["mesh"] for p in parts[simp]),
+                    "blender_ms": 1000 * statistics.median(p["apply"] for p in parts[simp])}
+        print("BENCH " + json.dumps(r), flush=True)
+        rows.append(r)
+
+print("\n| scene | cells | update without (libblend / Blender) | with Simplify 0.1 (libblend / "
+      "Blender) | triangles without / with | with / without |")
+print("|---|---|---|---|---|---|")
+for r in rows:
+    a, b = r["plain"], r["simplified"]
+    print("| %s | %d | %.0f ms (%.0f / %.0f) | %.0f ms (%.0f / %.0f) | %d / %d | %.1fx |" %
+          (r["scene"], r["cells"], a["ms"], a["libblend_ms"], a["blender_ms"], b["ms"],
+           b["libblend_ms"], b["blender_ms"], a["triangles"], b["triangles"], b["ms"] / a["ms"]))
