@@ -89,13 +89,14 @@ typedef struct lb_mesh_options {
      * wherever every moved triangle stays within this many cells (of the
      * smallest cell side) of the surface, checked against the field itself
      * by sampling each moved triangle at most a cell apart (64 samples
-     * along an edge at most); never across a crease (edges whose triangles'
-     * normals differ by more than 26 degrees: with LB_MESH_FEATURES, the
-     * kept creases), so corners stay. Still closed, 2-manifold and
-     * independent of the thread count; every vertex stays a vertex of the
-     * unsimplified mesh (on the surface). One thread, after the meshing
-     * (docs/meshing.md, Adaptive simplification). 0 = off; at most
-     * LB_MESH_MAX_SIMPLIFY. */
+     * along an edge at most), and the removed vertex stays within as much
+     * of the moved triangles; never across a crease (edges whose
+     * triangles' normals differ by more than 26 degrees: with
+     * LB_MESH_FEATURES, the kept creases), so corners stay. Still closed,
+     * 2-manifold and independent of the thread count; every vertex stays a
+     * vertex of the unsimplified mesh (on the surface). One thread, after
+     * the meshing; costs several times the meshing (docs/meshing.md,
+     * Adaptive simplification). 0 = off; at most LB_MESH_MAX_SIMPLIFY. */
     double simplify;
 } lb_mesh_options;
 
