@@ -270,6 +270,9 @@ CASES = [
     ("empty outputs", dict(good, outputs={}), "$.outputs"),
     ("mesh format", dict(good, outputs={"mesh": {"format": "fbx"}}), "$.outputs.mesh.format"),
     ("mesh resolution", dict(good, outputs={"mesh": {"resolution": 0}}), "resolution"),
+    ("mesh features", dict(good, outputs={"mesh": {"features": "yes"}}), "$.outputs.mesh.features"),
+    ("mesh simplify", dict(good, outputs={"mesh": {"simplify": 1.5}}), "$.outputs.mesh.simplify"),
+    ("simplify type", dict(good, outputs={"mesh": {"simplify": "0.1"}}), "$.outputs.mesh.simplify"),
     ("image format", dict(good, outputs={"image": {"format": "jpg"}}), "$.outputs.image.format"),
     ("image bits", dict(good, outputs={"image": {"bits": 12}}), "bits"),
     ("exr bits", dict(good, outputs={"image": {"format": "exr", "bits": 16}}), "$.outputs.image.bits"),
@@ -400,6 +403,29 @@ check(r.returncode == 0 and len(log2) == 7 and log2[-1][-1].endswith("--task 3")
 check(digest(os.path.join(dp, "out")) == {k: v for k, v in digest(os.path.join(dp, "out")).items()}
       and len([n for n in os.listdir(os.path.join(dp, "out")) if n.endswith(".png")]) == 6,
       "parallel: all six images")
+
+# ---- mesh outputs with sharp features and simplification: the cube in 12
+# triangles (each corner with its face's normal in OBJ); a changed setting
+# makes the task's identity differ, so the mesh is made again
+CUBE = os.path.join(SRC, "tests", "data", "features", "cube.json")
+cj = {"format": "libblend-job", "version": 1, "name": "cube", "scene": CUBE,
+      "output_dir": "cube-out",
+      "outputs": {"mesh": {"format": "obj", "resolution": 32, "features": True, "simplify": 0.1}}}
+jsonschema.validate(cj, SCHEMA)
+cdir = os.path.join(WORK, "cube")
+os.makedirs(cdir)
+r = bt("batch", write_job(os.path.join(cdir, "job.json"), cj))
+objs = glob.glob(os.path.join(cdir, "cube-out", "*.obj"))
+faces = [l for l in open(objs[0]).read().splitlines() if l.startswith("f ")] if objs else []
+check(r.returncode == 0 and len(objs) == 1 and len(faces) == 12 and
+      all("//" in f for f in faces),
+      "job mesh output with features and simplify 0.1: the cube in %d triangles %s" %
+      (len(faces), why(r)))
+cj["outputs"]["mesh"]["simplify"] = 0
+r = bt("batch", write_job(os.path.join(cdir, "job.json"), cj))
+faces = [l for l in open(objs[0]).read().splitlines() if l.startswith("f ")] if objs else []
+check(r.returncode == 0 and len(faces) > 1000,
+      "simplify changed to 0: the task is redone, %d triangles %s" % (len(faces), why(r)))
 
 # ---- blendtool compare
 a, b = os.path.join(out1, "cmp_0000.png"), os.path.join(out1, "cmp_0004.png")

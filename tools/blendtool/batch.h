@@ -61,6 +61,8 @@ typedef struct job {
     /* outputs */
     int mesh, mesh_res;
     lb_mesh_format mesh_fmt;
+    int mesh_features;    /* LB_MESH_FEATURES (and corner normals in OBJ / GLB) */
+    double mesh_simplify; /* lb_mesh_options.simplify, cells; 0 = off */
     int pov, pov_w, pov_h;
     int image, img_w, img_h, img_quality, img_alpha, img_fmt, img_antialias, img_mesh;
     /* the Blender renderer (blender: 1): engine, samples, seed, render threads (0: the

@@ -356,7 +356,7 @@ static int parse_outputs(job *J, const cJSON *o) {
     if (rc) return rc;
     const cJSON *m = cJSON_GetObjectItemCaseSensitive(o, "mesh");
     if (m) {
-        static const char *const mk[] = {"format", "resolution", NULL};
+        static const char *const mk[] = {"format", "resolution", "features", "simplify", NULL};
         if (!cJSON_IsObject(m))
             return batch_bad(J, "$.outputs.mesh", "expected an object, found %s", lb__json_kind(m));
         if ((rc = check_keys(J, m, "$.outputs.mesh", mk))) return rc;
@@ -378,6 +378,21 @@ static int parse_outputs(job *J, const cJSON *o) {
         if ((rc = get_int(J, m, "resolution", "$.outputs.mesh", 1, LB_MESH_MAX_CELLS_PER_AXIS, &r)))
             return rc;
         J->mesh_res = (int)r;
+        const cJSON *ft = cJSON_GetObjectItemCaseSensitive(m, "features");
+        if (ft && !cJSON_IsBool(ft))
+            return batch_bad(J, "$.outputs.mesh.features",
+                             "expected true or false, found %s; allowed: true (keep sharp creases "
+                             "and corners) or false",
+                             lb__json_kind(ft));
+        J->mesh_features = cJSON_IsTrue(ft);
+        const cJSON *sp = cJSON_GetObjectItemCaseSensitive(m, "simplify");
+        if (sp && (!cJSON_IsNumber(sp) || !(sp->valuedouble >= 0.0) ||
+                   !(sp->valuedouble <= LB_MESH_MAX_SIMPLIFY)))
+            return batch_bad(J, "$.outputs.mesh.simplify",
+                             "%s; allowed: a tolerance in cells from 0 (off) to %g",
+                             cJSON_IsNumber(sp) ? "out of range" : lb__json_kind(sp),
+                             LB_MESH_MAX_SIMPLIFY);
+        J->mesh_simplify = sp ? sp->valuedouble : 0.0;
     }
     const cJSON *p = cJSON_GetObjectItemCaseSensitive(o, "pov");
     if (p) {

@@ -224,6 +224,12 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
         lb_mesh_options_init(&o);
         o.resolution = (unsigned)J->mesh_res;
         o.threads = threads;
+        o.simplify = J->mesh_simplify;
+        if (J->mesh_features) /* the formats with a normal per corner get them */
+            o.flags = LB_MESH_FEATURES |
+                      (J->mesh_fmt == LB_MESH_FORMAT_OBJ || J->mesh_fmt == LB_MESH_FORMAT_GLB
+                           ? LB_MESH_CORNER_NORMALS
+                           : 0u);
         lb_mesh *m = NULL;
         hashed_out H;
         if (!lb_scene_bounds(sc, o.bmin, o.bmax)) {
