@@ -17,7 +17,8 @@ static int parse_int(const char *cmd, const char *opt, const char *v, long lo, l
 typedef struct povargs {
     const char *scene, *out;
     int include_only, width, height, threads, quality, silhouette, bits, alpha, quiet, antialias,
-        mesh;
+        mesh, features;
+    double simplify;
     const char *pixel;
     bt_set sets[BT_MAX_SETS];
     size_t nsets;
@@ -62,6 +63,20 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
         } else if ((r = bt_option(cmd, argc, argv, &i, "--mesh", &v))) {
             if (r < 0 || parse_int(cmd, "--mesh", v, 1, LB_POV_MAX_MESH_RESOLUTION, &a->mesh))
                 return -1;
+        } else if (strcmp(argv[i], "--features") == 0) {
+            a->features = 1;
+        } else if ((r = bt_option(cmd, argc, argv, &i, "--simplify", &v))) {
+            if (r < 0) return -1;
+            char *end = NULL;
+            errno = 0;
+            a->simplify = strtod(v, &end);
+            if (errno || end == v || *end ||
+                !(a->simplify > 0.0 && a->simplify <= LB_MESH_MAX_SIMPLIFY)) {
+                bt_error(cmd,
+                         "--simplify %s: expected a tolerance in cells, above 0 and at most %g", v,
+                         LB_MESH_MAX_SIMPLIFY);
+                return -1;
+            }
         } else if (!render && strcmp(argv[i], "--include-only") == 0) {
             a->include_only = 1;
         } else if ((r = bt_option(cmd, argc, argv, &i, "--set", &v))) {
@@ -76,6 +91,13 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
         } else if (bt_scene_arg(cmd, argv[i], &a->scene)) {
             return -1;
         }
+    }
+    if ((a->features || a->simplify > 0.0) && !a->mesh) {
+        bt_error(cmd,
+                 "%s without --mesh N; allowed: with --mesh N (they shape libblend's mesh; "
+                 "the isosurface is exact)",
+                 a->features ? "--features" : "--simplify");
+        return -1;
     }
     if (a->mesh && a->include_only) {
         bt_error(cmd, "--mesh with --include-only; allowed: one of them (an include holds only "
@@ -104,9 +126,14 @@ static int export(const char *cmd, const povargs *a, FILE *f, const char *out_na
         return rc;
     }
     lb_error e = {LB_OK, ""};
-    const lb_pov_options o = {
-        a->include_only, a->silhouette, (double)a->width / (double)a->height, 0.0,
-        a->threads,      a->mesh};
+    const lb_pov_options o = {a->include_only,
+                              a->silhouette,
+                              (double)a->width / (double)a->height,
+                              0.0,
+                              a->threads,
+                              a->mesh,
+                              a->features,
+                              a->simplify};
     const lb_status s = lb_scene_write_pov_stream(sc, ev, &o, f, NULL, &e);
     if (s == LB_ERR_IO) {
         bt_error(cmd, "%s: writing the POV-Ray scene failed (%s); nothing was written", out_name,
@@ -169,6 +196,12 @@ static int run_render(int argc, char **argv) {
         char hex[33], settings[128], params[4096], err[1024] = "";
         bt_hash_hex(hash, hex);
         bt_render_settings(settings, sizeof settings, &P, a.silhouette, a.mesh);
+        const size_t sl = strlen(settings); /* the mesh's own options, when given */
+        snprintf(settings + sl, sizeof settings - sl, "%s", a.features ? " features" : "");
+        if (a.simplify > 0.0) {
+            const size_t sl2 = strlen(settings);
+            snprintf(settings + sl2, sizeof settings - sl2, " simplify %g", a.simplify);
+        }
         size_t o = 0;
         params[0] = '\0';
         for (size_t i = 0; i < a.nsets && o + 1 < sizeof params; ++i) {
@@ -201,7 +234,7 @@ const bt_command bt_cmd_pov = {
     "pov", "the scene as a POV-Ray 3.7 file (isosurface with a computed max_gradient)",
     "usage: blendtool pov SCENE -o OUT.pov [--include-only] [--silhouette] [--width W --height "
     "H]\n"
-    "                     [--mesh N] [--set PATH=VALUE]...\n\n"
+    "                     [--mesh N [--features] [--simplify TOL]] [--set PATH=VALUE]...\n\n"
     "Writes a complete POV-Ray 3.7 scene: the field as functions built with\n"
     "libblend.inc, one isosurface over the scene's bounds with a max_gradient\n"
     "computed by libblend, camera, lights and material from the scene's render\n"
@@ -215,6 +248,10 @@ const bt_command bt_cmd_pov = {
     "  --mesh N        the surface as libblend's mesh at N cells (1..1024; smooth\n"
     "                  triangles, within half a cell) instead of the isosurface:\n"
     "                  seconds to render where a soft or local blend takes minutes\n"
+    "  --features      with --mesh: sharp creases and corners kept, each side of a\n"
+    "                  crease shaded with its own normal (normal_indices)\n"
+    "  --simplify TOL  with --mesh: merge triangles within TOL cells of the field\n"
+    "                  (0 < TOL <= 1; as blendtool mesh --simplify)\n"
     "  --width, --height  the image's aspect ratio for the camera (640 x 480)\n"
     "  --set PATH=VALUE  override a scene value first (VALUE is JSON); repeatable\n"
     "Exit status: 0 success, 2 bad scene (or one POV-Ray cannot express) or options, 1\n"
@@ -226,7 +263,8 @@ const bt_command bt_cmd_render = {
     "render", "render the scene with POV-Ray into a PNG",
     "usage: blendtool render SCENE -o OUT.{png,exr} [--width W] [--height H] [--threads N]\n"
     "                        [--quality Q] [--silhouette] [--bits 8|16] [--pixel half|float]\n"
-    "                        [--alpha] [--antialias] [--quiet] [--mesh N]\n"
+    "                        [--alpha] [--antialias] [--quiet]\n"
+    "                        [--mesh N [--features] [--simplify TOL]]\n"
     "                        [--set PATH=VALUE]...\n\n"
     "Exports the scene (as blendtool pov) and runs povray on it; povray's progress\n"
     "streams to standard error (--quiet: into a log, shown only if povray fails).\n"

@@ -39,20 +39,24 @@ extern "C" {
 #define LB_POV_MAX_MESH_RESOLUTION 1024
 
 typedef struct lb_pov_options {
-    int include_only;    /* 1: only the #declare'd functions: the root is LB_Field, and
-                            LB_Surface (< 0 inside), LB_FieldMin, LB_FieldMax,
-                            LB_FieldMaxGradient, LB_FieldAccuracy are declared for a
-                            hand-written scene */
-    int silhouette;      /* 1: white object, black background, no shading (for comparisons) */
-    double aspect;       /* image width / height for the camera (0: 4/3) */
-    double max_gradient; /* > 0: use this instead of computing it */
-    int threads;         /* for the gradient sampling: 0 = all CPUs, 1 = caller only */
-    int mesh_resolution; /* > 0: the surface as a mesh2 of smooth triangles (lb_mesh_create at
-                            this many cells along the region's longest side, normals from the
-                            analytic gradient) instead of the isosurface: renders in seconds
-                            where a soft-object isosurface takes minutes, within half a cell
-                            of the surface; the materials' textures are the same; 0: the
-                            isosurface (exact); ignored with include_only */
+    int include_only;     /* 1: only the #declare'd functions: the root is LB_Field, and
+                             LB_Surface (< 0 inside), LB_FieldMin, LB_FieldMax,
+                             LB_FieldMaxGradient, LB_FieldAccuracy are declared for a
+                             hand-written scene */
+    int silhouette;       /* 1: white object, black background, no shading (for comparisons) */
+    double aspect;        /* image width / height for the camera (0: 4/3) */
+    double max_gradient;  /* > 0: use this instead of computing it */
+    int threads;          /* for the gradient sampling: 0 = all CPUs, 1 = caller only */
+    int mesh_resolution;  /* > 0: the surface as a mesh2 of smooth triangles (lb_mesh_create at
+                             this many cells along the region's longest side, normals from the
+                             analytic gradient) instead of the isosurface: renders in seconds
+                             where a soft-object isosurface takes minutes, within half a cell
+                             of the surface; the materials' textures are the same; 0: the
+                             isosurface (exact); ignored with include_only */
+    int mesh_features;    /* with mesh_resolution, non-zero: sharp creases and corners kept
+                             (LB_MESH_FEATURES) and each side of a crease shaded with its own
+                             normal (LB_MESH_CORNER_NORMALS, as the mesh2's normal_indices) */
+    double mesh_simplify; /* with mesh_resolution: lb_mesh_options.simplify (cells, 0 = off) */
 } lb_pov_options;
 
 /* ---- render defaults every exporter shares (the POV-Ray writer and the

@@ -287,8 +287,7 @@ static lb_status whole_scene(pctx *c, const lb_pov_options *opt, double g, doubl
     }
     if (o.mesh_resolution) {
         int empty = 0;
-        const lb_status s =
-            lb__pov_mesh(b, ev, lo, hi, o.mesh_resolution, o.threads, &empty, c->err);
+        const lb_status s = lb__pov_mesh(b, ev, lo, hi, &o, &empty, c->err);
         if (s) return s;
         if (empty) {
             sb(b, "// no surface in the bounds at mesh_resolution %d\n", o.mesh_resolution);
@@ -340,7 +339,7 @@ static void include_tail(sbuf *b, const lb_scene *scene, double g, double diag) 
 /* The whole .pov text into b (freed by the caller). */
 static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const lb_pov_options *opt,
                           sbuf *out, double *out_gradient, lb_error *err) {
-    lb_pov_options o = {0, 0, 0.0, 0.0, 0, 0};
+    lb_pov_options o = {0, 0, 0.0, 0.0, 0, 0, 0, 0.0};
     if (opt) o = *opt;
     if (!scene->has_bounds)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
