@@ -238,14 +238,29 @@ static void test_scenes_closed_and_accurate(void **state) {
     tally_end(&nrm, 100000);
 }
 
+/* The sharp shapes of tests/data/features, meshed after the scenes. */
+static const char *const sharp[] = {"cube", "rotated-cube", "two-boxes", "cylinder-slab",
+                                    "clean-union-spheres"};
+#define NSHARP (sizeof sharp / sizeof sharp[0])
+
+/* Case s of the scenes then the sharp shapes into path: 0 when papers_only
+ * and s is a scene that is not one of the papers' (skip it). */
+static int case_path(size_t s, int papers_only, char *path, size_t n) {
+    if (s < nscenes) {
+        if (papers_only && !strstr(scene_paths[s], "/scenes/hsu")) return 0;
+        snprintf(path, n, "%s", scene_paths[s]);
+    } else {
+        snprintf(path, n, "%s/tests/data/features/%s.json", SOURCE_DIR, sharp[s - nscenes]);
+    }
+    return 1;
+}
+
 /* The same mesh, bit for bit, for 1, 2 and 3 threads: every scene, and
  * with LB_MESH_FEATURES also the sharp shapes of tests/data/features (the
  * feature points are placed per block and flipped over the merged mesh),
  * then the sharp shapes again simplified (features and simplify = 0.1). */
 static void test_threads_identical(void **state) {
     (void)state;
-    static const char *const sharp[] = {"cube", "rotated-cube", "two-boxes", "cylinder-slab",
-                                        "clean-union-spheres"};
     for (int pass = 0; pass < 3; ++pass) {
         /* 0: the scenes; 1: the scenes and the sharp shapes with features;
          * 2: those again, simplified */
@@ -253,13 +268,9 @@ static void test_threads_identical(void **state) {
         const double simplify = pass == 2 ? 0.1 : 0.0;
         /* pass 2 runs the sharp shapes only: the simplification itself runs on
          * one thread after the same meshing as pass 1 */
-        for (size_t s = pass == 2 ? nscenes : 0; s < nscenes + (pass ? 5 : 0); ++s) {
+        for (size_t s = pass == 2 ? nscenes : 0; s < nscenes + (pass ? NSHARP : 0); ++s) {
             char path[1100];
-            if (s < nscenes)
-                snprintf(path, sizeof path, "%s", scene_paths[s]);
-            else
-                snprintf(path, sizeof path, "%s/tests/data/features/%s.json", SOURCE_DIR,
-                         sharp[s - nscenes]);
+            case_path(s, 0, path, sizeof path);
             built A, B, C;
             build_file_s(path, 40, flags, 1, simplify, &A);
             build_file_s(path, 40, flags, 2, simplify, &B);
@@ -685,19 +696,11 @@ static void test_no_self_intersections(void **state) {
  * and manifold. */
 static void test_no_self_intersections_features(void **state) {
     (void)state;
-    static const char *const sharp[] = {"cube", "rotated-cube", "two-boxes", "cylinder-slab",
-                                        "clean-union-spheres"};
     const unsigned res[2] = {64, 128};
     size_t checked = 0;
-    for (size_t s = 0; s < nscenes + 5; ++s) {
+    for (size_t s = 0; s < nscenes + NSHARP; ++s) {
         char path[1100];
-        if (s < nscenes) {
-            if (!strstr(scene_paths[s], "/scenes/hsu")) continue;
-            snprintf(path, sizeof path, "%s", scene_paths[s]);
-        } else {
-            snprintf(path, sizeof path, "%s/tests/data/features/%s.json", SOURCE_DIR,
-                     sharp[s - nscenes]);
-        }
+        if (!case_path(s, 1, path, sizeof path)) continue;
         for (int r = 0; r < 2; ++r) {
             built B;
             build_file(path, res[r], LB_MESH_FEATURES, 0, &B);
@@ -721,19 +724,11 @@ static void test_no_self_intersections_features(void **state) {
  * free of self-intersections, closed and manifold, and fewer triangles. */
 static void test_no_self_intersections_simplify(void **state) {
     (void)state;
-    static const char *const sharp[] = {"cube", "rotated-cube", "two-boxes", "cylinder-slab",
-                                        "clean-union-spheres"};
     const unsigned res[2] = {64, 128};
     size_t checked = 0, before = 0, after = 0;
-    for (size_t s = 0; s < nscenes + 5; ++s) {
+    for (size_t s = 0; s < nscenes + NSHARP; ++s) {
         char path[1100];
-        if (s < nscenes) {
-            if (!strstr(scene_paths[s], "/scenes/hsu")) continue;
-            snprintf(path, sizeof path, "%s", scene_paths[s]);
-        } else {
-            snprintf(path, sizeof path, "%s/tests/data/features/%s.json", SOURCE_DIR,
-                     sharp[s - nscenes]);
-        }
+        if (!case_path(s, 1, path, sizeof path)) continue;
         for (int r = 0; r < 2; ++r) {
             built A, B;
             build_file_s(path, res[r], LB_MESH_FEATURES, 0, 0.0, &A);
