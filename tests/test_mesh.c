@@ -239,8 +239,8 @@ static void test_scenes_closed_and_accurate(void **state) {
 }
 
 /* The sharp shapes of tests/data/features, meshed after the scenes. */
-static const char *const sharp[] = {"cube", "rotated-cube", "two-boxes", "cylinder-slab",
-                                    "clean-union-spheres"};
+static const char *const sharp[] = {"cube",          "rotated-cube",        "two-boxes",
+                                    "cylinder-slab", "local-union-spheres", "clean-union-spheres"};
 #define NSHARP (sizeof sharp / sizeof sharp[0])
 
 /* Case s of the scenes then the sharp shapes into path: 0 when papers_only

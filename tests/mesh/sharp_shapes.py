@@ -206,10 +206,11 @@ def cylinder_slab():
     return cyl_slab_distance, cyl_slab_normal, r
 
 
-def union_spheres():
-    """distance(p) of the clean union of two spheres: the distance to the
-    surface and to the crease circle"""
-    sc = scene("clean-union-spheres")
+def union_spheres(name="clean-union-spheres"):
+    """distance(p) of the union of two spheres (the clean union, or the
+    local union outside its blending volume): the distance to the surface
+    and to the crease circle"""
+    sc = scene(name)
     (s1, s2) = sc["root"]["args"]
     c1, r1 = np.array(s1["center"], float), s1["radius"]
     c2, r2 = np.array(s2["center"], float), s2["radius"]

@@ -76,9 +76,9 @@ struct lb__bctx {
     double *rnrm;  /* and normals */
     uint32_t cell; /* the cell being cut (face.cell) */
     /* sharp features: candidates (FACE_MAX): their face, position, value
-     * and gradient, and the polygon's normal sums */
+     * and gradient, the polygon's normal sums and the QEF's point */
     uint32_t *cface;
-    double *cx, *cy, *cz, *cv, *cgx, *cgy, *cgz, *cn;
+    double *cx, *cy, *cz, *cv, *cgx, *cgy, *cgz, *cn, *cq;
     uint32_t *perm; /* own edge -> vertex index, when there are orphans */
     face *faces;
     size_t nf; /* polygons so far (< FACE_MAX) */
@@ -317,10 +317,10 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     C->rpos = malloc(3 * EMAP_SIZE * sizeof *C->rpos);
     C->rnrm = malloc(3 * EMAP_SIZE * sizeof *C->rnrm);
     C->cface = malloc(FACE_MAX * sizeof *C->cface);
-    double **cd[8] = {&C->cx, &C->cy, &C->cz, &C->cv, &C->cgx, &C->cgy, &C->cgz, &C->cn};
+    double **cd[9] = {&C->cx, &C->cy, &C->cz, &C->cv, &C->cgx, &C->cgy, &C->cgz, &C->cn, &C->cq};
     int cok = 1;
-    for (int q = 0; q < 8; ++q) {
-        *cd[q] = malloc((q == 7 ? 3 : 1) * FACE_MAX * sizeof(double));
+    for (int q = 0; q < 9; ++q) {
+        *cd[q] = malloc((q >= 7 ? 3 : 1) * FACE_MAX * sizeof(double));
         cok = cok && *cd[q];
     }
     C->perm = malloc(EMAP_SIZE * sizeof *C->perm);
@@ -368,6 +368,7 @@ void lb__bctx_free(lb__bctx *C) {
     free(C->cgy);
     free(C->cgz);
     free(C->cn);
+    free(C->cq);
     free(C->perm);
     free(C->faces);
     lb__mscratch *S = &C->S;
@@ -461,6 +462,113 @@ static inline const double *vertex_normal(const lb__block *B, const bctx *C, uin
     return v < C->ne ? B->vnrm + 3 * v : C->rnrm + 3 * (v - C->ne);
 }
 
+/* The candidates Newton could not settle (state 2), where the surface near
+ * the crease is a fillet far below a cell (a local union's blending
+ * volume: its gradient turns within a fraction of a cell, and the distance
+ * to the curve's polyline has kinks, so the steps go on alternating):
+ * the root of phi along the polygon's mean normal through the QEF's point,
+ * bracketed within half a cell either way and halved to the same tolerance
+ * (|phi| <= tol |grad phi|). Where no sign change is bracketed the
+ * candidate stays rejected. Evaluated in batches (E holds the block's
+ * plan). */
+#define BISECT_ITER 40
+static lb_status settle_by_bisection(const lb_evaluator *ev, const lb__grid *g, bctx *C, size_t nc,
+                                     uint8_t *state, double tol, double hmin, double boxmax,
+                                     lb_error *err) {
+    lb__boxeval *E = &C->S.E;
+    /* cv, cgx, cgy: the bracket's ends (t along the unit normal) and phi's
+     * sign at its lower end; cgz: the unit normal's length (0: none) */
+    size_t nb = 0;
+    for (size_t c = 0; c < nc; ++c) {
+        if (state[c] != 2) continue;
+        const double *n = C->cn + 3 * c;
+        const double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        C->cgz[c] = l > 0.0 && isfinite(l) ? l : 0.0;
+        if (C->cgz[c] > 0.0) {
+            state[c] = 3; /* bracketing */
+            ++nb;
+        }
+    }
+    if (!nb) return LB_OK;
+    /* 21 doubles a candidate, at most one candidate a cell (a cell with two
+     * loops has none): 512 x 21 fit the 10 x EMAP_SIZE of the scratch */
+    double *x = C->S.edges, *y = x + 3 * nb, *z = y + 3 * nb, *v = z + 3 * nb, *gx = v + 3 * nb,
+           *gy = gx + 3 * nb, *gz = gy + 3 * nb;
+    /* phi at t = -h/2, 0, h/2 */
+    size_t j = 0;
+    for (size_t c = 0; c < nc; ++c) {
+        if (state[c] != 3) continue;
+        const double *n = C->cn + 3 * c, *q = C->cq + 3 * c, l = C->cgz[c];
+        for (int k = -1; k <= 1; ++k, ++j) {
+            const double t = 0.5 * k * hmin / l;
+            x[j] = q[0] + t * n[0];
+            y[j] = q[1] + t * n[1];
+            z[j] = q[2] + t * n[2];
+        }
+    }
+    lb_status s = lb__boxeval_run(ev, E, j, x, y, z, v, gx, gy, gz, err);
+    if (s) return s;
+    j = 0;
+    for (size_t c = 0; c < nc; ++c) {
+        if (state[c] != 3) continue;
+        double ph[3];
+        for (int k = 0; k < 3; ++k, ++j) {
+            const double X[3] = {x[j], y[j], z[j]}, gf[3] = {gx[j], gy[j], gz[j]};
+            double gp[3];
+            ph[k] = lb__mesh_phi_in(g, boxmax, X, v[j], gf, gp);
+        }
+        const double h2 = 0.5 * hmin;
+        if (!isfinite(ph[0]) || !isfinite(ph[1]) || !isfinite(ph[2])) {
+            state[c] = 2;
+        } else if ((ph[0] < 0.0) != (ph[1] < 0.0)) {
+            C->cv[c] = -h2, C->cgx[c] = 0.0, C->cgy[c] = ph[0] < 0.0 ? -1.0 : 1.0;
+        } else if ((ph[1] < 0.0) != (ph[2] < 0.0)) {
+            C->cv[c] = 0.0, C->cgx[c] = h2, C->cgy[c] = ph[1] < 0.0 ? -1.0 : 1.0;
+        } else {
+            state[c] = 2; /* no surface crossed within half a cell */
+        }
+    }
+    for (int it = 0; it < BISECT_ITER; ++it) {
+        j = 0;
+        for (size_t c = 0; c < nc; ++c) {
+            if (state[c] != 3) continue;
+            const double *n = C->cn + 3 * c, *q = C->cq + 3 * c, l = C->cgz[c];
+            const double t = 0.5 * (C->cv[c] + C->cgx[c]) / l;
+            x[j] = q[0] + t * n[0];
+            y[j] = q[1] + t * n[1];
+            z[j] = q[2] + t * n[2];
+            ++j;
+        }
+        if (!j) break;
+        if ((s = lb__boxeval_run(ev, E, j, x, y, z, v, gx, gy, gz, err))) return s;
+        j = 0;
+        for (size_t c = 0; c < nc; ++c) {
+            if (state[c] != 3) continue;
+            const double X[3] = {x[j], y[j], z[j]}, gf[3] = {gx[j], gy[j], gz[j]};
+            double gp[3];
+            const double ph = lb__mesh_phi_in(g, boxmax, X, v[j], gf, gp);
+            ++j;
+            const double gl = sqrt(gp[0] * gp[0] + gp[1] * gp[1] + gp[2] * gp[2]);
+            const double mid = 0.5 * (C->cv[c] + C->cgx[c]);
+            if (!isfinite(ph)) {
+                state[c] = 2;
+            } else if (gl > 0.0 && isfinite(gl) && fabs(ph) <= tol * gl) {
+                state[c] = 1;
+                C->cx[c] = X[0];
+                C->cy[c] = X[1];
+                C->cz[c] = X[2];
+            } else if ((ph < 0.0) == (C->cgy[c] < 0.0)) {
+                C->cv[c] = mid;
+            } else {
+                C->cgx[c] = mid;
+            }
+        }
+    }
+    for (size_t c = 0; c < nc; ++c)
+        if (state[c] == 3) state[c] = 2;
+    return LB_OK;
+}
+
 static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__block *B, bctx *C,
                                 lb_error *err) {
     const size_t ne = C->ne, nref = C->nref, np0 = ne - C->norph;
@@ -500,6 +608,7 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
         C->cy[nc] = X[1];
         C->cz[nc] = X[2];
         memcpy(C->cn + 3 * nc, ns, sizeof ns);
+        memcpy(C->cq + 3 * nc, X, sizeof X);
         C->cv[nc] = NAN; /* no earlier point (the crease step, below) */
         ++nc;
     }
@@ -582,6 +691,8 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
             C->cz[c] += dx[2];
         }
     }
+    lb_status s = settle_by_bisection(ev, g, C, nc, state, tol, hmin, boxmax, err);
+    if (s) return s;
     size_t nfeat = 0;
     for (size_t c = 0; c < nc; ++c) nfeat += state[c] == 1;
     if (!nfeat) return LB_OK;
