@@ -816,6 +816,40 @@ static void test_progress_and_cancel(void **state) {
     lb_scene_free(sc);
 }
 
+/* The simplification's own refusals (meshing/simplify.c, called directly
+ * on a mesh of the cube): over the memory cap it fails before allocating,
+ * naming the cap; with the cancel flag set it stops within CHECK_EVERY
+ * vertices tried. */
+static void test_simplify_limits(void **state) {
+    (void)state;
+    char path[1100];
+    snprintf(path, sizeof path, "%s/tests/data/features/cube.json", SOURCE_DIR);
+    built B;
+    build_file(path, 64, LB_MESH_FEATURES, 0, &B);
+    lb__grid g;
+    memset(&g, 0, sizeof g);
+    for (int d = 0; d < 3; ++d) {
+        g.origin[d] = B.m->origin[d];
+        g.h[d] = B.m->cell[d];
+        g.cells[d] = B.m->cells[d];
+        g.N[d] = B.m->cells[d] + 1;
+    }
+    g.closed = 1;
+    assert_true(lb_scene_bounds(B.sc, g.bmin, g.bmax));
+    lb_error e = {LB_OK, ""};
+    const size_t nt = B.m->ntriangles;
+    assert_int_equal(lb__simplify(B.ev, &g, B.m, NULL, 0.1, (size_t)1 << 20, NULL, &e),
+                     LB_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(e.message, "simplifying"));
+    assert_non_null(strstr(e.message, "memory cap of 1 MiB"));
+    assert_int_equal(B.m->ntriangles, nt); /* untouched */
+    volatile int flag = 1;
+    assert_int_equal(lb__simplify(B.ev, &g, B.m, NULL, 0.1, (size_t)1 << 30, &flag, &e),
+                     LB_ERR_CANCELLED);
+    assert_non_null(strstr(e.message, "cancelled"));
+    unbuild(&B);
+}
+
 /* Over the memory cap, the message names the largest resolution that
  * fits: following it works, one more does not. Also an empty region: a
  * valid mesh with no triangles, written in every format. */
@@ -1361,6 +1395,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_no_self_intersections_features),
         cmocka_unit_test(test_no_self_intersections_simplify),
         cmocka_unit_test(test_progress_and_cancel),
+        cmocka_unit_test(test_simplify_limits),
         cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_memory_cap_and_empty),
         cmocka_unit_test(test_min_feature),

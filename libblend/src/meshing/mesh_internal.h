@@ -291,10 +291,11 @@ LB_INTERNAL lb_status lb__corner_normals(const lb_evaluator *ev, const lb__grid 
 /* Adaptive simplification (simplify.c): half-edge collapses wherever every
  * moved triangle stays within tolerance cells (of the smallest cell side)
  * of phi_c, never across a crease; closed and manifold kept; feat (may be
- * NULL) is compacted with the vertices. Checks *cancel (may be NULL). */
+ * NULL) is compacted with the vertices. Fails before allocating when its
+ * scratch would exceed max_memory; checks *cancel (may be NULL). */
 LB_INTERNAL lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M,
-                                   uint8_t *feat, double tolerance, const volatile int *cancel,
-                                   lb_error *err);
+                                   uint8_t *feat, double tolerance, size_t max_memory,
+                                   const volatile int *cancel, lb_error *err);
 
 /* One cell (i, j, k) with corner values c (some inside, some outside; bit o
  * of cfg set: corner o inside): its polygons, by the cube cases or by the

@@ -1127,7 +1127,7 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         }
     }
     if (!s && !P.cancelled && opt->simplify > 0.0 && M->ntriangles) /* simplify.c */
-        s = lb__simplify(ev, &g, M, feat, opt->simplify, opt->cancel, err);
+        s = lb__simplify(ev, &g, M, feat, opt->simplify, max_memory, opt->cancel, err);
     if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
         M->positions = malloc(3 * sizeof *M->positions);
         M->normals = malloc(3 * sizeof *M->normals);

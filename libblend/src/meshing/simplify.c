@@ -69,9 +69,15 @@
 #define MAXSTEPS 64     /* lattice steps along a triangle's edge at most */
 #define TURN_COS 0.5    /* a moved triangle's normal turns by at most 60 degrees */
 #define SLIVER 1e-4     /* a moved triangle's area over its longest edge squared, at least */
-#define CHECK_EVERY 256 /* moves between looks at the cancel flag */
-#define FLAT 1e-6       /* cells: a ring this close to one plane is flat */
-#define TIE 1e-4        /* the edge length's weight in a move's cost (h^2 len^2) */
+#define CHECK_EVERY 256 /* vertices tried between looks at the cancel flag */
+/* bytes the pass needs at most per triangle (corner lists, the sorted edges
+ * and facings of the setup) and per vertex (lists' ends, kind, crease
+ * neighbours, quadric, stamps, and its heap entries: one, then about ten
+ * per move nearby), for the memory cap */
+#define TRI_BYTES 96
+#define VERTEX_BYTES 288
+#define FLAT 1e-6 /* cells: a ring this close to one plane is flat */
+#define TIE 1e-4  /* the edge length's weight in a move's cost (h^2 len^2) */
 
 typedef struct hent {
     double cost;
@@ -673,9 +679,17 @@ static void compact(simp *S, uint8_t *feat) {
 }
 
 lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, uint8_t *feat,
-                       double tolerance, const volatile int *cancel, lb_error *err) {
+                       double tolerance, size_t max_memory, const volatile int *cancel,
+                       lb_error *err) {
     const size_t nv = M->nvertices, nt = M->ntriangles;
     if (!nt || nv >= NONE || 3 * nt >= NONE) return LB_OK;
+    const double need = (double)nt * TRI_BYTES + (double)nv * VERTEX_BYTES;
+    if (need > (double)max_memory)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "lb_mesh_create: simplifying %zu triangles needs about %.0f MiB, over the "
+                        "memory cap of %zu MiB; allowed: a lower resolution or a larger "
+                        "max_memory",
+                        nt, need / 1048576.0, max_memory >> 20);
     simp S;
     memset(&S, 0, sizeof S);
     S.ev = ev;
@@ -703,11 +717,15 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     size_t ccap = 0;
     for (size_t v = 0; !s && v < nv; ++v)
         if (!requeue(&S, (uint32_t)v)) s = nomem(err);
-    size_t moved = 0;
+    size_t tried = 0;
     while (!s && S.nh) {
         const hent e = hpop(&S);
         const uint32_t u = e.v;
         if (e.stamp != S.stamp[u] || S.kind[u] == GONE) continue;
+        if (++tried % CHECK_EVERY == 0 && cancel && *cancel) {
+            s = lb__fail(err, LB_ERR_CANCELLED, "lb_mesh_create: cancelled by the caller");
+            break;
+        }
         double best;
         if (!moves(&S, u, &cand, &best)) continue;
         /* the moves in order of cost (stable: ties in ring order) */
@@ -739,8 +757,6 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
                 continue;
             }
             if (!do_move(&S, u, cand.a[i])) s = nomem(err);
-            if (++moved % CHECK_EVERY == 0 && cancel && *cancel)
-                s = lb__fail(err, LB_ERR_CANCELLED, "lb_mesh_create: cancelled by the caller");
             break;
         }
     }
