@@ -816,6 +816,22 @@ static void test_progress_and_cancel(void **state) {
     lb_scene_free(sc);
 }
 
+typedef struct simp_prog {
+    double last;
+    int monotone, in_simplify, cancel; /* calls within (0.5, 0.95]; cancel at the first */
+} simp_prog;
+
+static int on_simp_progress(double f, void *user) {
+    simp_prog *p = user;
+    if (f < p->last) p->monotone = 0;
+    p->last = f;
+    if (f > 0.5 && f <= 0.95) {
+        ++p->in_simplify;
+        return p->cancel;
+    }
+    return 0;
+}
+
 /* The simplification's own refusals (meshing/simplify.c, called directly
  * on a mesh of the cube): over the memory cap it fails before allocating,
  * naming the cap; with the cancel flag set it stops within CHECK_EVERY
@@ -838,16 +854,46 @@ static void test_simplify_limits(void **state) {
     assert_true(lb_scene_bounds(B.sc, g.bmin, g.bmax));
     lb_error e = {LB_OK, ""};
     const size_t nt = B.m->ntriangles;
-    assert_int_equal(lb__simplify(B.ev, &g, B.m, NULL, 0.1, (size_t)1 << 20, NULL, &e),
-                     LB_ERR_INVALID_ARGUMENT);
+    assert_int_equal(
+        lb__simplify(B.ev, &g, B.m, NULL, 0.1, (size_t)1 << 20, NULL, NULL, NULL, 0, 1, &e),
+        LB_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(e.message, "simplifying"));
     assert_non_null(strstr(e.message, "memory cap of 1 MiB"));
     assert_int_equal(B.m->ntriangles, nt); /* untouched */
     volatile int flag = 1;
-    assert_int_equal(lb__simplify(B.ev, &g, B.m, NULL, 0.1, (size_t)1 << 30, &flag, &e),
-                     LB_ERR_CANCELLED);
+    assert_int_equal(
+        lb__simplify(B.ev, &g, B.m, NULL, 0.1, (size_t)1 << 30, &flag, NULL, NULL, 0, 1, &e),
+        LB_ERR_CANCELLED);
     assert_non_null(strstr(e.message, "cancelled"));
     unbuild(&B);
+    /* through lb_mesh_create: the simplification reports progress of its
+     * own (between 0.5 and 0.95, monotone), and a callback returning
+     * non-zero there cancels it */
+    lb_scene *sc = NULL;
+    lb_evaluator *ev = NULL;
+    assert_int_equal(lb_scene_load(path, &sc, &e), LB_OK);
+    assert_int_equal(lb_evaluator_create(sc, &ev, &e), LB_OK);
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    assert_true(lb_scene_bounds(sc, o.bmin, o.bmax));
+    o.resolution = 64;
+    o.flags = LB_MESH_FEATURES;
+    o.simplify = 0.1;
+    simp_prog p = {0.0, 1, 0, 0};
+    o.progress = on_simp_progress;
+    o.user = &p;
+    lb_mesh *m = NULL;
+    assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_OK);
+    assert_true(p.monotone && p.last == 1.0 && p.in_simplify >= 3);
+    assert_int_equal(m->ntriangles, 12);
+    lb_mesh_free(m);
+    simp_prog q = {0.0, 1, 0, 1};
+    o.user = &q;
+    assert_int_equal(lb_mesh_create(ev, &o, &m, &e), LB_ERR_CANCELLED);
+    assert_null(m);
+    assert_true(q.in_simplify == 1);
+    lb_evaluator_free(ev);
+    lb_scene_free(sc);
 }
 
 /* Over the memory cap, the message names the largest resolution that

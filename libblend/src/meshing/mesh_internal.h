@@ -292,10 +292,13 @@ LB_INTERNAL lb_status lb__corner_normals(const lb_evaluator *ev, const lb__grid 
  * moved triangle stays within tolerance cells (of the smallest cell side)
  * of phi_c, never across a crease; closed and manifold kept; feat (may be
  * NULL) is compacted with the vertices. Fails before allocating when its
- * scratch would exceed max_memory; checks *cancel (may be NULL). */
+ * scratch would exceed max_memory; checks *cancel (may be NULL) and calls
+ * progress (may be NULL; non-zero cancels) with fractions rising from base
+ * by at most weight. */
 LB_INTERNAL lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M,
                                    uint8_t *feat, double tolerance, size_t max_memory,
-                                   const volatile int *cancel, lb_error *err);
+                                   const volatile int *cancel, lb_mesh_progress_fn progress,
+                                   void *user, double base, double weight, lb_error *err);
 
 /* One cell (i, j, k) with corner values c (some inside, some outside; bit o
  * of cfg set: corner o inside): its polygons, by the cube cases or by the

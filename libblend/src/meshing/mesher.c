@@ -1103,7 +1103,9 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
             if (!(R.ctx[R.nctx] = lb__bctx_new(ev))) break;
     if (!M || !R.ms.local || !R.ctx || R.nctx < nt)
         s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    P.weight = 0.90;
+    /* with simplification, the blocks take the first half of the bar and
+     * the simplification (often several times the meshing) the second */
+    P.weight = opt->simplify > 0.0 ? 0.45 : 0.90;
     if (!s && !P.cancelled) s = blocks_run(&R, nt, &P);
     if (s && R.err_block != SIZE_MAX && err) *err = R.err;
     if (!s && !P.cancelled) {
@@ -1127,7 +1129,8 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         }
     }
     if (!s && !P.cancelled && opt->simplify > 0.0 && M->ntriangles) /* simplify.c */
-        s = lb__simplify(ev, &g, M, feat, opt->simplify, max_memory, opt->cancel, err);
+        s = lb__simplify(ev, &g, M, feat, opt->simplify, max_memory, opt->cancel, P.fn, P.user,
+                         P.base, 0.95 - P.base, err);
     if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
         M->positions = malloc(3 * sizeof *M->positions);
         M->normals = malloc(3 * sizeof *M->normals);

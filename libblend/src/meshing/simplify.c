@@ -680,6 +680,7 @@ static void compact(simp *S, uint8_t *feat) {
 
 lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, uint8_t *feat,
                        double tolerance, size_t max_memory, const volatile int *cancel,
+                       lb_mesh_progress_fn progress, void *user, double base, double weight,
                        lb_error *err) {
     const size_t nv = M->nvertices, nt = M->ntriangles;
     if (!nt || nv >= NONE || 3 * nt >= NONE) return LB_OK;
@@ -718,13 +719,18 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     for (size_t v = 0; !s && v < nv; ++v)
         if (!requeue(&S, (uint32_t)v)) s = nomem(err);
     size_t tried = 0;
+    double shown = 0.0; /* the fraction last reported: tried over tried and the heap left */
     while (!s && S.nh) {
         const hent e = hpop(&S);
         const uint32_t u = e.v;
         if (e.stamp != S.stamp[u] || S.kind[u] == GONE) continue;
-        if (++tried % CHECK_EVERY == 0 && cancel && *cancel) {
-            s = lb__fail(err, LB_ERR_CANCELLED, "lb_mesh_create: cancelled by the caller");
-            break;
+        if (++tried % CHECK_EVERY == 0) {
+            const double f = (double)tried / (double)(tried + S.nh);
+            if (f > shown) shown = f;
+            if ((cancel && *cancel) || (progress && progress(base + weight * shown, user))) {
+                s = lb__fail(err, LB_ERR_CANCELLED, "lb_mesh_create: cancelled by the caller");
+                break;
+            }
         }
         double best;
         if (!moves(&S, u, &cand, &best)) continue;
