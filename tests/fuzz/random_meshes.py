@@ -8,7 +8,9 @@ shared defs, bulge elimination, nesting up to depth 4), from fixed seeds
 Each is parsed and compiled through the library (the ctypes binding, no
 process per scene) and meshed at 12 cells on two threads and 20 on one, and
 at 20 on two with sharp features (LB_MESH_FEATURES, with corner normals),
-and at 20 on two with features simplified (simplify = 0.25 cells);
+and, for one seed in four, at 20 on two with features simplified
+(simplify = 0.25 cells: the pass samples the field far more than the
+meshing, and every seed would add 90 s);
 every non-empty mesh must be closed, oriented and 2-manifold (tests/mesh's
 numpy checks), its corner normals within their contract, and the
 scenes found wrong before (by an issue, or by this test's fresh seeds:
@@ -106,8 +108,10 @@ stats = {"scenes": 0, "meshes": 0, "refused": 0, "empty": 0}
 
 def run(seed):
     sc, _ = random_scenes.scene(seed)
-    n = closed(json.dumps(sc), "seed %d" % seed,
-               ((12, 2, False, 0), (20, 1, False, 0), (20, 2, True, 0), (20, 2, True, 0.25)))
+    runs = ((12, 2, False, 0), (20, 1, False, 0), (20, 2, True, 0))
+    if seed % 4 == 0:
+        runs += ((20, 2, True, 0.25),)
+    n = closed(json.dumps(sc), "seed %d" % seed, runs)
     stats["scenes"] += 1
     if n is None:
         stats["refused"] += 1
