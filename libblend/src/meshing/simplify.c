@@ -425,12 +425,11 @@ static int flat_ring(const simp *S, uint32_t u) {
 }
 
 /* Whether u can move onto v now: 1 yes, 0 no, -1 out of memory, -2 the
- * evaluator failed. Leaves u's ring in S->ru. */
+ * evaluator failed. S->ru and S->nu hold u's ring and neighbours (the same
+ * for every move of u tried); v's go into S->rv and S->nv. */
 static int can_move(simp *S, uint32_t u, uint32_t v, lb_error *err) {
     const uint32_t *T = S->M->triangles;
-    if (!ring(S, u, &S->ru) || !neighbours(S, u, &S->ru, &S->nu) || !ring(S, v, &S->rv) ||
-        !neighbours(S, v, &S->rv, &S->nv))
-        return -1;
+    if (!ring(S, v, &S->rv) || !neighbours(S, v, &S->rv, &S->nv)) return -1;
     /* topology: the edge's two triangles and their far vertices */
     uint32_t opp[2];
     int no = 0;
@@ -753,6 +752,11 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
             }
             cost[j] = c;
             cand.a[j] = x;
+        }
+        /* u's ring and neighbours, once for all its moves (can_move) */
+        if (!ring(&S, u, &S.ru) || !neighbours(&S, u, &S.ru, &S.nu)) {
+            s = nomem(err);
+            break;
         }
         for (size_t i = 0; i < cand.n; ++i) {
             const int r = can_move(&S, u, cand.a[i], err);
