@@ -1,4 +1,6 @@
-/* The two calls of platform.h, per system. */
+/* The calls of platform.h, per system. */
+/* madvise and its MADV_HUGEPAGE (a BSD and Linux extension) */
+#define _DEFAULT_SOURCE
 #include "platform.h"
 
 #include <errno.h>
@@ -44,9 +46,16 @@ int lb__is_directory(const char *path) {
     return a != INVALID_FILE_ATTRIBUTES && (a & FILE_ATTRIBUTE_DIRECTORY);
 }
 
+void lb__huge_pages(void *p, size_t bytes) {
+    (void)p;
+    (void)bytes;
+}
+
 #else
 #include "glibc_compat.h"
 
+#include <stdint.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -62,5 +71,20 @@ size_t lb__cpu_count(void) {
 
 FILE *lb__fopen(const char *path, const char *mode) {
     return fopen(path, mode);
+}
+
+void lb__huge_pages(void *p, size_t bytes) {
+#ifdef MADV_HUGEPAGE
+    /* the whole pages the block lies on: a large block is a mapping of its
+     * own, and advising all of it keeps it one mapping, which realloc can
+     * then grow by moving pages (mremap) instead of copying them; the
+     * system puts huge pages on its aligned 2 MiB parts */
+    const uintptr_t P = (uintptr_t)sysconf(_SC_PAGESIZE), a = (uintptr_t)p & ~(P - 1),
+                    b = ((uintptr_t)p + bytes + P - 1) & ~(P - 1);
+    if (p && bytes >= ((size_t)2 << 20)) (void)madvise((void *)a, b - a, MADV_HUGEPAGE);
+#else
+    (void)p;
+    (void)bytes;
+#endif
 }
 #endif

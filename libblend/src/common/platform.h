@@ -18,6 +18,13 @@ LB_INTERNAL size_t lb__cpu_count(void);
  * NULL with errno set on failure (EILSEQ: not UTF-8). */
 LB_INTERNAL FILE *lb__fopen(const char *path, const char *mode);
 
+/* Advice that the memory at p (bytes long; the caller's, e.g. a large
+ * malloc block) be backed by huge pages where the system offers them
+ * (Linux's transparent huge pages in madvise mode): a mesh's arrays are
+ * written once, page by page, and a fault per 4 KiB page cost more than the
+ * writing (docs/meshing.md, Incremental remeshing). Nothing elsewhere. */
+LB_INTERNAL void lb__huge_pages(void *p, size_t bytes);
+
 /* Whether a UTF-8 path names a folder. */
 LB_INTERNAL int lb__is_directory(const char *path);
 

@@ -673,6 +673,11 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     const int ok = grow((void **)&M->positions, S->vcap, vc, 3 * sizeof(double)) &&
                    grow((void **)&M->normals, S->vcap, vc, 3 * sizeof(double)) &&
                    grow((void **)&M->triangles, S->tcap, tc, 3 * sizeof(uint32_t));
+    if (ok && vc != S->vcap) { /* written page by page once: huge pages fault far less */
+        lb__huge_pages(M->positions, vc * 3 * sizeof(double));
+        lb__huge_pages(M->normals, vc * 3 * sizeof(double));
+    }
+    if (ok && tc != S->tcap) lb__huge_pages(M->triangles, tc * 3 * sizeof(uint32_t));
     if (M->positions && M->normals) S->vcap = vc; /* both grown (or neither needed to) */
     if (ok) S->tcap = tc;
     if (!ok || (no && !tab_fit(S, S->used + no))) {
