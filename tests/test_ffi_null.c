@@ -294,6 +294,34 @@ static lb_status c_mesh(unsigned mask, int size, lb_error *err, int *hs) {
     lb_mesh_free(m);
     return s;
 }
+/* through a cache (NULL: the plain mesher), twice: the second run takes
+ * its blocks from the first's */
+static lb_status c_mesh_cached(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    lb_mesh_options o;
+    small_options(&o);
+    lb_mesh_cache *cache = NULL;
+    if (lb_mesh_cache_create(&cache, NULL)) return LB_ERR_NO_MEMORY;
+    lb_status s = LB_OK;
+    for (int round = 0; round < 2; ++round) {
+        lb_mesh *m = NULL;
+        s = lb_mesh_create_cached(P(0, C.ev), P(1, &o), P(2, cache), P(3, &m), P(4, err));
+        lb_mesh_free(m);
+    }
+    lb_mesh_cache_stats st;
+    lb_mesh_cache_stats_get(P(2, cache), P(1, &st));
+    lb_mesh_cache_free(cache);
+    return s;
+}
+static lb_status c_mesh_cache_create(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    lb_mesh_cache *cache = NULL;
+    lb_status s = lb_mesh_cache_create(P(0, &cache), P(1, err));
+    lb_mesh_cache_free(cache);
+    return s;
+}
 static lb_status c_mesh_edges(unsigned mask, int size, lb_error *err, int *hs) {
     (void)size;
     *hs = 1;
@@ -397,6 +425,8 @@ static const fn_case CASES[] = {
     {"lb_evaluator_extent", 7, 0x3f, c_extent},
     {"lb_scene_unused_m", 2, 0x00, c_unused_m},
     {"lb_mesh_create", 4, 0x07, c_mesh},
+    {"lb_mesh_create_cached", 5, 0x0b, c_mesh_cached},
+    {"lb_mesh_cache_create", 2, 0x01, c_mesh_cache_create},
     {"lb_mesh_write / _stream", 4, 0x07, c_mesh_write},
     {"lb_mesh_edges", 5, 0x0f, c_mesh_edges},
     {"lb_mesh_velocities", 6, 0x19, c_velocities},

@@ -1425,6 +1425,106 @@ static void test_bad_options(void **state) {
     lb_scene_free(sc);
 }
 
+/* Incremental remeshing (lb_mesh_cache): a lattice of spheres in a blend,
+ * its first two in a local union, meshed through one cache while one sphere
+ * moves step by step (and then another), each mesh byte-identical to a
+ * full lb_mesh_create of the same evaluator (positions, normals, triangles,
+ * corner normals), with and without sharp features, on 1, 2 and 3 threads;
+ * most blocks come from the cache, all of them for the same scene again. */
+static char *lattice_text(int moved, double dx) {
+    const size_t cap = 16384;
+    char *t = malloc(cap);
+    assert_non_null(t);
+    int w = snprintf(t, cap,
+                     "{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": \"zero\", "
+                     "\"bounds\": {\"min\": [-2, -2, -2], \"max\": [2, 2, 2]}, \"root\": "
+                     "{\"type\": \"displacement\", \"op\": \"union\", \"r\": 0.15, \"p\": 2, "
+                     "\"m\": 1, \"args\": [{\"type\": \"local_union\", \"args\": ["
+                     "{\"type\": \"sphere\", \"center\": [-1.2, -1.2, -1.2], \"radius\": 0.4}, "
+                     "{\"type\": \"sphere\", \"center\": [-0.7, -1.2, -1.2], \"radius\": 0.3}]}");
+    for (int q = 0; q < 27; ++q) {
+        double c[3] = {-1.2 + 1.2 * (q % 3), -1.2 + 1.2 * (q / 3 % 3), -1.2 + 1.2 * (q / 9)};
+        if (q == 0) continue; /* the local union's */
+        if (q == moved) c[0] += dx;
+        w += snprintf(t + w, cap - (size_t)w,
+                      ", {\"type\": \"sphere\", \"center\": [%.17g, %.17g, %.17g], \"radius\": "
+                      "0.3}",
+                      c[0], c[1], c[2]);
+    }
+    snprintf(t + w, cap - (size_t)w, "]}}");
+    return t;
+}
+
+static int same_mesh(const lb_mesh *a, const lb_mesh *b) {
+    if (a->nvertices != b->nvertices || a->ntriangles != b->ntriangles ||
+        a->nnormals != b->nnormals || !a->corner_normals != !b->corner_normals)
+        return 0;
+    return !memcmp(a->positions, b->positions, 3 * a->nvertices * sizeof(double)) &&
+           !memcmp(a->normals, b->normals, 3 * a->nnormals * sizeof(double)) &&
+           !memcmp(a->triangles, b->triangles, 3 * a->ntriangles * sizeof(uint32_t)) &&
+           (!a->corner_normals ||
+            !memcmp(a->corner_normals, b->corner_normals, 3 * a->ntriangles * sizeof(uint32_t)));
+}
+
+static void test_mesh_cache(void **state) {
+    (void)state;
+    /* (moved sphere, its x offset) in turn: the same scene, steps of 1 %
+     * of the region, another sphere, back to the start */
+    static const int moved[] = {-1, -1, 13, 13, 13, 5, -1};
+    static const double dx[] = {0.0, 0.0, 0.04, 0.08, 0.12, -0.04, 0.0};
+    enum { NSTEP = sizeof moved / sizeof moved[0] };
+    size_t reused_total = 0, blocks_total = 0;
+    for (int variant = 0; variant < 2; ++variant)
+        for (int threads = 1; threads <= 3; ++threads) {
+            lb_error e = {LB_OK, ""};
+            lb_mesh_cache *cache = NULL;
+            assert_int_equal(lb_mesh_cache_create(&cache, &e), LB_OK);
+            lb_mesh_options o;
+            lb_mesh_options_init(&o);
+            for (int d = 0; d < 3; ++d) {
+                o.bmin[d] = -2.0;
+                o.bmax[d] = 2.0;
+            }
+            o.resolution = 64;
+            o.threads = threads;
+            o.flags = variant ? LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS : 0u;
+            for (int step = 0; step < NSTEP; ++step) {
+                char *text = lattice_text(moved[step], dx[step]);
+                lb_scene *sc = NULL;
+                lb_evaluator *ev = NULL;
+                lb_mesh *mc = NULL, *mf = NULL;
+                if (lb_scene_parse(text, strlen(text), "lattice.json", &sc, &e) ||
+                    lb_evaluator_create(sc, &ev, &e) ||
+                    lb_mesh_create_cached(ev, &o, cache, &mc, &e) ||
+                    lb_mesh_create(ev, &o, &mf, &e))
+                    fail_msg("step %d: %s", step, e.message);
+                lb_mesh_cache_stats st;
+                lb_mesh_cache_stats_get(cache, &st);
+                if (!same_mesh(mc, mf))
+                    fail_msg("variant %d, %d threads, step %d: the cached mesh differs from the "
+                             "full one (%zu of %zu blocks from the cache)",
+                             variant, threads, step, st.reused, st.blocks);
+                if (step == 1 && st.reused != st.blocks)
+                    fail_msg("the same scene again: %zu of %zu blocks", st.reused, st.blocks);
+                if (step >= 1) {
+                    reused_total += st.reused;
+                    blocks_total += st.blocks;
+                }
+                lb_mesh_free(mc);
+                lb_mesh_free(mf);
+                lb_evaluator_free(ev);
+                lb_scene_free(sc);
+                free(text);
+            }
+            lb_mesh_cache_free(cache);
+        }
+    printf("mesh cache: %zu of %zu blocks from the cache\n", reused_total, blocks_total);
+    assert_true(reused_total >= blocks_total / 2);
+    lb_mesh_cache_stats st;
+    lb_mesh_cache_stats_get(NULL, &st);
+    assert_int_equal(st.blocks, 0);
+}
+
 /* With no argument every case runs; with names (e.g. "test_threads_identical"),
  * only those: the ThreadSanitizer build runs the cases that start threads
  * (tests/CMakeLists.txt, test_mesh_threaded). An unknown name fails. */
@@ -1448,6 +1548,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_edges),
         cmocka_unit_test(test_corner_normals),
         cmocka_unit_test(test_wide_union),
+        cmocka_unit_test(test_mesh_cache),
     };
     enum { NALL = sizeof all / sizeof all[0] };
     if (argc < 2) return cmocka_run_group_tests(all, setup, NULL);

@@ -135,6 +135,53 @@ LB_API lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *o
 
 LB_API void lb_mesh_free(lb_mesh *mesh);
 
+/* Incremental remeshing: a cache of the last mesh's blocks, so that
+ * meshing an edited scene (a primitive moved, resized or reparameterised,
+ * an argument added or removed, a blend's r, p or m changed) recomputes
+ * only the blocks whose field can differ and takes every other block's
+ * output from the cache. The result is byte-identical to lb_mesh_create
+ * with the same evaluator and options: same vertices, normals and
+ * triangles in the same order.
+ *
+ * Which blocks are recomputed (docs/meshing.md, Incremental remeshing): a
+ * block's node values, vertices and triangles are a function of the grid
+ * and of its plan, the instructions and blend arguments that the interval
+ * passes keep for the block's box, with their parameters. The cache keeps
+ * each block's plan as the instructions' contents (primitive, transform,
+ * operator and parameters, local unions' curves) and their arguments' own
+ * contents, recursively; a block is taken from the cache only when its plan
+ * and the plans of the blocks within two blocks after it on each axis
+ * (whose values and vertices its far faces share) are identical, content
+ * for content, and those blocks are kept in both meshes. Anything else
+ * (another grid, region, resolution or flags, another convention) meshes
+ * everything again. The passes after the blocks (sharp-feature flips,
+ * corner normals, simplification) run over the whole mesh every time.
+ *
+ * The cache is the caller's: lb_mesh_cache_create makes an empty one,
+ * lb_mesh_cache_free frees it (NULL is fine). It holds no pointer to an
+ * evaluator (the last one may be freed) and about as much memory as the
+ * last mesh, plus each block's plan and shared faces
+ * (lb_mesh_cache_stats.bytes). Use one cache from one thread at a time
+ * (lb_mesh_create_cached uses opt->threads internally); several caches may
+ * be used at once. A failed or cancelled run leaves the cache as it was. */
+typedef struct lb_mesh_cache lb_mesh_cache;
+
+typedef struct lb_mesh_cache_stats {
+    size_t blocks;   /* blocks of the last mesh */
+    size_t reused;   /* of them, taken from the cache */
+    size_t recycled; /* runs so far that took at least one block from the cache */
+    size_t bytes;    /* memory the cache holds */
+} lb_mesh_cache_stats;
+
+LB_API lb_status lb_mesh_cache_create(lb_mesh_cache **out, lb_error *err);
+LB_API void lb_mesh_cache_free(lb_mesh_cache *cache);
+/* lb_mesh_create through the cache (NULL: lb_mesh_create itself); on
+ * success the cache holds this mesh's blocks. */
+LB_API lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *opt,
+                                       lb_mesh_cache *cache, lb_mesh **out, lb_error *err);
+/* The cache's figures (all 0 for NULL). */
+LB_API void lb_mesh_cache_stats_get(const lb_mesh_cache *cache, lb_mesh_cache_stats *out);
+
 /* The mesh's undirected edges and the edge of every triangle corner, for
  * hosts that store edges (Blender's meshes do). Corner c of triangle t
  * (index 3t + c) runs from triangles[3t + c] to triangles[3t + (c + 1) % 3];

@@ -111,7 +111,65 @@ typedef struct lb__block {
     uint32_t *rref;
     double *vpos, *vnrm;
     uint32_t *tri;
+    /* incremental remeshing (cache.c): the output above is the cache's
+     * (okey, vpos, vnrm and tri are not freed by the merge) */
+    int borrowed;
 } lb__block;
+
+/* ---- incremental remeshing (cache.c; lb_mesh_cache in mesh.h) ----
+ * A cached block: its plan in the cached evaluator's instruction indices
+ * with its argument places, its output (rref's first entry is the offset
+ * code c of the next block referred to, 1..7, not a block index), and what
+ * the blocks before it read of it: its near-face nodes that were evaluated
+ * (local node index, then value and gradient) and its near-face vertex
+ * table's written entries. */
+typedef struct lb__cblock {
+    uint64_t id;
+    lb__cplan plan;
+    uint32_t *argpos;
+    size_t nargpos;
+    size_t nv, np, nref, nt, nfeat;
+    uint64_t *okey;
+    uint32_t *rref;
+    double *vpos, *vnrm;
+    uint32_t *tri;
+    uint32_t nnode, nface;
+    uint16_t *node;
+    double *ndata; /* 4 per node */
+    uint16_t *fe;
+    lb__fent *fent;
+} lb__cblock;
+
+/* Frees what E holds (not E). */
+LB_INTERNAL void lb__cblock_free(lb__cblock *E);
+/* The cache's blocks are usable for ev on grid g: made for the same grid,
+ * convention and culling. */
+LB_INTERNAL int lb__cache_usable(const lb_mesh_cache *C, const lb_evaluator *ev, const lb__grid *g);
+/* ev's instructions matched against the cache's (usable: lb__cache_usable;
+ * else only ev's records are made, for the commit). */
+typedef struct lb__cmatch lb__cmatch;
+LB_INTERNAL lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usable,
+                                     lb__cmatch **out, lb_error *err);
+LB_INTERNAL void lb__cmatch_free(lb__cmatch *M);
+/* uint32_t entries of the scratch lb__cache_same_plan needs. */
+LB_INTERNAL size_t lb__cmatch_scratch(const lb__cmatch *M);
+/* The cache's blocks, sorted by id (*n of them). */
+LB_INTERNAL const lb__cblock *lb__cache_blocks(const lb_mesh_cache *C, size_t *n);
+/* Is plan P (M's evaluator) the cached block's plan, content for content?
+ * (M's memo is written: one thread.) */
+LB_INTERNAL int lb__cache_same_plan(const lb_mesh_cache *C, lb__cmatch *M, const lb__cblock *E,
+                                    const lb__cplan *P, uint32_t *scratch);
+/* E's node and face records from block B (done: its node data final and
+ * its near-face table published). 0 when out of memory. */
+LB_INTERNAL int lb__cache_export(const lb__block *B, lb__cblock *E);
+/* The records of E into B's node data (B's vals, grads, nmask, ftab and
+ * fvalid set up for the block's size, nmask and fvalid cleared). */
+LB_INTERNAL void lb__cache_import(const lb__cblock *E, lb__block *B);
+/* The cache becomes this run's: n blocks (sorted by id, plans in M's
+ * evaluator's indices; moved in, the array too) on grid g, M consumed;
+ * reused counts the ones taken from it. On failure the cache is emptied. */
+LB_INTERNAL lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g,
+                                       lb__cblock *blocks, size_t n, size_t reused, lb_error *err);
 
 /* The facing of triangle (a, b, c): (b - a) x (c - a), not normalised
  * (features.c's flips and folds, corners.c). */

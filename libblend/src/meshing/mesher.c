@@ -281,6 +281,10 @@ typedef struct mstate {
     /* the feature points' vertex ranges (first, count), for the flips */
     size_t *fr;
     size_t nfr, frcap;
+    /* with a cache: each block's entry, which takes its output once merged
+     * (its references as offset codes, by nbr) */
+    lb__cblock *keep;
+    uint32_t (*nbr)[8];
     lb_status s;
     lb_error err;
 } mstate;
@@ -320,6 +324,14 @@ typedef struct run {
     pthread_mutex_t mlock;
     size_t mnext;
     mstate ms;
+    /* incremental remeshing (cache.c): the cache, the cached entry each
+     * block is taken from (NULL: computed), whether a block taken from the
+     * cache is read by a computed one (its shared faces are loaded) */
+    lb_mesh_cache *cache;
+    lb__cmatch *match;
+    const lb__cblock **from;
+    uint8_t *want;
+    size_t nreused;
 } run;
 
 static lb__block *find_block(run *R, const uint32_t b[3]) {
@@ -444,6 +456,21 @@ static void slot_release(run *R, size_t i) {
     pthread_mutex_unlock(&R->lock);
 }
 
+/* Block B's node data in slot base: marks and the table's written bits
+ * cleared. */
+static void slot_setup(lb__block *B, unsigned char *base) {
+    const size_t n = (size_t)(B->nc[0] + 1) * (B->nc[1] + 1) * (B->nc[2] + 1);
+    B->vals = (double *)(void *)base;
+    B->grads = B->vals + SLAB_NODES;
+    B->ftab = (lb__fent *)(void *)(base + FTAB_OFFSET);
+    B->nmask = base + MASK_OFFSET;
+    B->cmask = B->nmask + SLAB_NODES;
+    B->fvalid = B->cmask + LB__MB * LB__MB * LB__MB;
+    memset(B->nmask, 0, n);
+    memset(B->cmask, 0, (size_t)B->nc[0] * B->nc[1] * B->nc[2]);
+    memset(B->fvalid, 0, FVALID_BYTES);
+}
+
 /* The node values of a block: its plan (from the block selection's
  * descent), mark() with sub-box passes under that plan, then the marked
  * nodes evaluated octant by octant under the octants' plans (or the block's
@@ -459,15 +486,7 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
      * the core's cache): fetch it for writing while mark() runs, instead of
      * stalling on the scattered stores of the node values below */
     for (size_t off = 0; off < FTAB_OFFSET; off += 64) __builtin_prefetch(base + off, 1, 3);
-    B->vals = (double *)(void *)base;
-    B->grads = B->vals + SLAB_NODES;
-    B->ftab = (lb__fent *)(void *)(base + FTAB_OFFSET);
-    B->nmask = base + MASK_OFFSET;
-    B->cmask = B->nmask + SLAB_NODES;
-    B->fvalid = B->cmask + LB__MB * LB__MB * LB__MB;
-    memset(B->nmask, 0, n);
-    memset(B->cmask, 0, (size_t)B->nc[0] * B->nc[1] * B->nc[2]);
-    memset(B->fvalid, 0, FVALID_BYTES);
+    slot_setup(B, base);
     lb__boxeval *E = &S->E;
     lb__boxeval_load(ev, &B->plan, E);
     const uint32_t zero[3] = {0, 0, 0};
@@ -740,12 +759,39 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     }
     M->ntriangles += B->nt;
     M->nvertices = nv;
-    /* merged: the block's copy goes (its memory serves the next blocks) */
-    free(B->okey);
+    if (S->keep && !B->borrowed) { /* the cache takes the output */
+        lb__cblock *E = &S->keep[bi];
+        for (size_t r = 0; r < B->nref; ++r)
+            for (int c = 1; c < 8; ++c)
+                if (S->nbr[bi][c] == B->rref[2 * r] + 1) {
+                    B->rref[2 * r] = (uint32_t)c;
+                    break;
+                }
+        E->nv = B->nv;
+        E->np = B->np;
+        E->nref = B->nref;
+        E->nt = B->nt;
+        E->nfeat = B->nfeat;
+        E->okey = B->okey;
+        E->rref = B->rref;
+        E->vpos = B->vpos;
+        E->vnrm = B->vnrm;
+        E->tri = B->tri;
+        B->okey = NULL;
+        B->rref = NULL;
+        B->vpos = B->vnrm = NULL;
+        B->tri = NULL;
+        return 1;
+    }
+    /* merged: the block's copy goes (its memory serves the next blocks);
+     * one taken from the cache stays there */
+    if (!B->borrowed) {
+        free(B->okey);
+        free(B->vpos);
+        free(B->vnrm);
+        free(B->tri);
+    }
     free(B->rref);
-    free(B->vpos);
-    free(B->vnrm);
-    free(B->tri);
     B->okey = NULL;
     B->rref = NULL;
     B->vpos = B->vnrm = NULL;
@@ -791,6 +837,23 @@ static void fail_block(run *R, size_t i, const lb_error *e) {
  * blocks' values may not be done yet: finish_block waits for them. */
 static int start_block(run *R, size_t i, size_t t) {
     lb_error e = {LB_OK, ""};
+    if (R->from && R->from[i]) { /* from the cache: what the blocks before it read */
+        lb__block *B = &R->blocks[i];
+        lb_status s = LB_OK;
+        if (R->want[i]) {
+            unsigned char *base = slot_get(R);
+            if (!base) {
+                s = lb__fail(&e, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+                fail_block(R, i, &e);
+            } else {
+                slot_setup(B, base);
+                lb__cache_import(R->from[i], B);
+            }
+        }
+        atomic_store(&R->ready[i], 1);
+        wake(R);
+        return !s;
+    }
     /* the +z block's near face, read by block_share right after this block's
      * node values, was computed about a layer of blocks ago: fetch it now
      * (its node data is readable once it is ready) */
@@ -813,6 +876,30 @@ static int start_block(run *R, size_t i, size_t t) {
     return !s;
 }
 
+/* Block i's output from its cached entry (the arrays borrowed, the
+ * references' offset codes made block indices); 0 when out of memory. */
+static int take_cached(run *R, size_t i, lb_error *e) {
+    lb__block *B = &R->blocks[i];
+    const lb__cblock *E = R->from[i];
+    B->nv = E->nv;
+    B->np = E->np;
+    B->nref = E->nref;
+    B->nt = E->nt;
+    B->nfeat = E->nfeat;
+    B->okey = E->okey;
+    B->vpos = E->vpos;
+    B->vnrm = E->vnrm;
+    B->tri = E->tri;
+    B->borrowed = 1;
+    B->rref = malloc(2 * (E->nref ? E->nref : 1) * sizeof *B->rref);
+    if (!B->rref) return !lb__fail(e, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    for (size_t r = 0; r < E->nref; ++r) {
+        B->rref[2 * r] = R->nbr[i][E->rref[2 * r]] - 1; /* kept: the rule checked it */
+        B->rref[2 * r + 1] = E->rref[2 * r + 1];
+    }
+    return 1;
+}
+
 /* Are block i's next blocks done (their output and near-face tables)? */
 static int next_done(run *R, size_t i) {
     for (int c = 1; c < 8; ++c)
@@ -827,14 +914,26 @@ static int next_done(run *R, size_t i) {
 static void finish_block(run *R, size_t i, size_t t) {
     lb_error e = {LB_OK, ""};
     lb__block *B = &R->blocks[i];
-    block_share(R, i);
-    int gnext = 0;
-    for (int d = 0; d < 3; ++d) gnext |= (B->b[d] + 1 < R->nb[d]) << d;
-    const int ok = !lb__mesh_block(R->ev, R->g, B, R->blocks, R->nbr[i], gnext, R->ctx[t], &e);
+    int ok = 1;
+    if (R->from && R->from[i]) {
+        ok = take_cached(R, i, &e);
+    } else {
+        block_share(R, i);
+        int gnext = 0;
+        for (int d = 0; d < 3; ++d) gnext |= (B->b[d] + 1 < R->nb[d]) << d;
+        ok = !lb__mesh_block(R->ev, R->g, B, R->blocks, R->nbr[i], gnext, R->ctx[t], &e);
+        /* the cache keeps what the blocks before it read */
+        if (ok && R->cache && !lb__cache_export(B, &R->ms.keep[i]))
+            ok = !lb__fail(&e, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    }
     if (!ok) fail_block(R, i, &e);
     for (int c = 1; c < 8; ++c)
         if (R->nbr[i][c]) slot_release(R, R->nbr[i][c] - 1);
     slot_release(R, i);
+    if (R->cache) { /* the cache keeps the plan */
+        R->ms.keep[i].plan = B->plan;
+        memset(&B->plan, 0, sizeof B->plan);
+    }
     lb__cplan_free(&B->plan);
     free(B->octmem);
     B->octmem = NULL;
@@ -935,6 +1034,69 @@ static void *worker(void *arg) {
     return NULL;
 }
 
+/* Which blocks the cache gives (cache.c states the rule): block i when its
+ * plan and those of the blocks at offsets 0..2 on each axis are the cached
+ * ones, content for content, and the same of those blocks are kept; and
+ * which of them computed blocks read (want). The two block lists are both
+ * sorted by id: one walk pairs them, and each changed place (a block kept
+ * in one mesh only, or with another plan) rules out the blocks up to two
+ * before it on each axis. 0 when out of memory. */
+static int decide(run *R) {
+    const size_t n = R->nblocks;
+    size_t nold = 0;
+    const lb__cblock *old = lb__cache_blocks(R->cache, &nold);
+    const lb__cblock **cand = calloc(n ? n : 1, sizeof *cand);
+    uint64_t *changed = malloc((n + nold ? n + nold : 1) * sizeof *changed);
+    uint32_t *scratch = malloc(lb__cmatch_scratch(R->match) * sizeof *scratch);
+    R->from = calloc(n ? n : 1, sizeof *R->from);
+    R->want = calloc(n ? n : 1, 1);
+    if (!cand || !changed || !scratch || !R->from || !R->want) {
+        free(cand);
+        free(changed);
+        free(scratch);
+        return 0;
+    }
+    size_t nch = 0, j = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const uint64_t id = R->blocks[i].id;
+        while (j < nold && old[j].id < id) changed[nch++] = old[j++].id; /* old only */
+        if (j < nold && old[j].id == id) cand[i] = &old[j++];
+        if (cand[i] &&
+            lb__cache_same_plan(R->cache, R->match, cand[i], &R->blocks[i].plan, scratch))
+            R->from[i] = cand[i];
+        else
+            changed[nch++] = id;
+    }
+    while (j < nold) changed[nch++] = old[j++].id;
+    free(scratch);
+    for (size_t q = 0; q < nch; ++q) {
+        const uint64_t id = changed[q];
+        const uint32_t p[3] = {(uint32_t)(id % R->nb[0]), (uint32_t)(id / R->nb[0] % R->nb[1]),
+                               (uint32_t)(id / R->nb[0] / R->nb[1])};
+        for (int c = 0; c < 27; ++c) {
+            uint32_t b[3];
+            int in = 1;
+            for (int d = 0, w = c; d < 3; ++d, w /= 3) {
+                in &= p[d] >= (uint32_t)(w % 3);
+                b[d] = p[d] - (uint32_t)(w % 3);
+            }
+            const lb__block *O = in ? find_block(R, b) : NULL;
+            if (O) R->from[O - R->blocks] = NULL;
+        }
+    }
+    free(changed);
+    free(cand);
+    for (size_t i = 0; i < n; ++i) {
+        if (R->from[i]) {
+            ++R->nreused;
+            continue;
+        }
+        for (int c = 1; c < 8; ++c)
+            if (R->nbr[i][c]) R->want[R->nbr[i][c] - 1] = 1;
+    }
+    return 1;
+}
+
 /* Every block on nt threads (nt - 1 workers, fewer if the system refuses
  * threads: the calling thread works too and is the only one that reports
  * progress, between its own blocks). Nothing waits on a block taken later,
@@ -973,6 +1135,11 @@ static lb_status blocks_run(run *R, size_t nt, progress *P) {
             R->nbr[i][c] = (uint32_t)(j + 1);
             atomic_fetch_add(&R->refs[j], 1);
         }
+    R->ms.nbr = R->nbr;
+    if (R->match && !decide(R)) {
+        R->err_block = 0;
+        return lb__fail(&R->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    }
     pthread_mutex_init(&R->wm, NULL);
     pthread_cond_init(&R->wc, NULL);
     pthread_t tid[256];
@@ -1034,6 +1201,11 @@ static unsigned largest_fit(const lb_evaluator *ev, const lb_mesh_options *opt, 
 
 lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_mesh **out,
                          lb_error *err) {
+    return lb_mesh_create_cached(ev, opt, NULL, out, err);
+}
+
+lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *opt,
+                                lb_mesh_cache *cache, lb_mesh **out, lb_error *err) {
     if (out) *out = NULL;
     if (!ev || !opt || !out)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "%s: ev, opt and out must be non-NULL", FN);
@@ -1091,6 +1263,20 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
     if (L.n) qsort(L.b, L.n, sizeof *L.b, cmp_block); /* an empty mesh is valid output */
     R.blocks = L.b;
     R.nblocks = L.n;
+    lb__cmatch *match = NULL;
+    if (cache) { /* each block's entry for the cache; the matches for its rule */
+        R.cache = cache;
+        R.ms.keep = calloc(R.nblocks ? R.nblocks : 1, sizeof *R.ms.keep);
+        if (!R.ms.keep) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        const int usable = lb__cache_usable(cache, ev, &g);
+        if (!s) s = lb__cmatch_new(cache, ev, usable, &match, err);
+        if (usable) R.match = match;
+        if (s) {
+            free(R.ms.keep);
+            blist_free(&L);
+            return s;
+        }
+    }
     pthread_mutex_init(&R.lock, NULL);
     pthread_mutex_init(&R.mlock, NULL);
     size_t nt = opt->threads == 0 ? lb__cpu_count() : (size_t)opt->threads;
@@ -1158,16 +1344,47 @@ lb_status lb_mesh_create(const lb_evaluator *ev, const lb_mesh_options *opt, lb_
         s = lb__corner_normals(ev, &g, M, feat, (int)nt, err); /* shading per corner */
     free(feat);
     if (!s && P.cancelled) s = lb__fail(err, LB_ERR_CANCELLED, "%s: cancelled by the caller", FN);
+    if (!s && cache) { /* the cache becomes this mesh's */
+        for (size_t i = 0; i < R.nblocks; ++i) {
+            lb__cblock *E = &R.ms.keep[i];
+            if (R.from && R.from[i]) { /* moved over from the cached entry, with the new plan */
+                lb__cblock *old = (lb__cblock *)(uintptr_t)R.from[i];
+                const lb__cplan plan = E->plan;
+                lb__cplan_free(&old->plan);
+                *E = *old;
+                E->plan = plan;
+                memset(old, 0, sizeof *old);
+            }
+            E->id = R.blocks[i].id;
+        }
+        lb_error ce;
+        const lb_status cs =
+            lb__cache_commit(cache, match, &g, R.ms.keep, R.nblocks, R.nreused, &ce);
+        match = NULL;
+        if (cs) {
+            /* out of memory for the records: the cache is emptied (the next
+             * run meshes everything), the mesh is still good */
+        }
+        R.ms.keep = NULL;
+    }
     if (!s && P.fn && P.fn(1.0, P.user)) {
         /* cancelling at 100 % is too late to matter: the mesh is done */
     }
+    if (R.ms.keep) /* a failed run: the cache stays as it was */
+        for (size_t i = 0; i < R.nblocks; ++i) lb__cblock_free(&R.ms.keep[i]);
+    free(R.ms.keep);
+    lb__cmatch_free(match);
+    free(R.from);
+    free(R.want);
     for (size_t i = 0; i < R.nblocks; ++i) {
         lb__block *B = &R.blocks[i];
-        free(B->okey);
+        if (!B->borrowed) {
+            free(B->okey);
+            free(B->vpos);
+            free(B->vnrm);
+            free(B->tri);
+        }
         free(B->rref);
-        free(B->vpos);
-        free(B->vnrm);
-        free(B->tri);
         free(B->octmem);
         lb__cplan_free(&B->plan);
     }

@@ -1,0 +1,596 @@
+/* The mesh cache (lb_mesh_cache, mesh.h): what incremental remeshing keeps
+ * of the last mesh, and the rule that decides which blocks it may give back.
+ *
+ * The rule. A block's work (mesher.c: its node values, mark()'s sub-box
+ * passes, the refinement, sharp features, the extraction) runs under its
+ * plan alone: the instructions and blend arguments the block selection's
+ * interval passes kept for its box, in tape order. An instruction's result
+ * is a function of its content (kind, primitive or operator with every
+ * parameter, its transform, local unions' curves) and of its arguments'
+ * results. So two plans whose instructions have equal contents and equal
+ * arguments (recursively, compared byte for byte, never by a hash alone),
+ * in the same order with the same blend arguments kept, compute the same
+ * bits at every point: the block's node values, vertices and triangles
+ * are the same, on the same grid. Registers and instruction indices differ
+ * between two evaluators and are not part of a content; arguments are
+ * named by the matched instruction of the cached evaluator.
+ *
+ * A block also reads its next blocks (offsets 1 along some axes): their
+ * near-face node values (its far faces take them) and their near-face
+ * vertices (their index in the next block, position and normal). A next
+ * block's vertex numbering follows its own cells, whose far corners come
+ * from the blocks after it: so a block's output depends on the plans of
+ * the blocks at offsets 0..2 on each axis, and on which of them are kept.
+ * mesher.c takes a block from the cache only when all of those are the
+ * same in both meshes.
+ *
+ * The records. For each instruction of the evaluator last meshed, its
+ * content with arguments as instruction indices of that evaluator (a
+ * record), in one buffer, with a hash table over the records for the
+ * matching. A new evaluator's instruction is matched by writing its record
+ * with its arguments replaced by their matches (no match: no match for it
+ * either) and looking that record up. */
+#include "mesh_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "../operators/registry.h"
+
+#define NONE UINT32_MAX
+
+/* ---- records ---- */
+
+typedef struct buf {
+    uint8_t *p;
+    size_t n, cap;
+    int oom;
+} buf;
+
+static void put(buf *b, const void *x, size_t n) {
+    if (b->oom || !n) return;
+    if (b->n + n > b->cap) {
+        size_t c = b->cap ? b->cap : 1024;
+        while (c < b->n + n) c *= 2;
+        uint8_t *q = realloc(b->p, c);
+        if (!q) {
+            b->oom = 1;
+            return;
+        }
+        b->p = q;
+        b->cap = c;
+    }
+    memcpy(b->p + b->n, x, n);
+    b->n += n;
+}
+
+static void put_i(buf *b, long long v) {
+    put(b, &v, sizeof v);
+}
+
+static void put_d(buf *b, const double *v, size_t n) {
+    put(b, v, n * sizeof *v);
+}
+
+/* An argument: its match (map) or its own index (map NULL); 0 when it has
+ * no match. */
+static int put_ref(buf *b, const uint32_t *map, uint32_t j) {
+    const uint32_t r = map ? map[j] : j;
+    put(b, &r, sizeof r);
+    return r != NONE;
+}
+
+static void put_curves(buf *b, const struct lb__curves *c) {
+    put_i(b, c != NULL);
+    if (!c) return;
+    put_i(b, (long long)c->nv);
+    put_i(b, (long long)c->ncomp);
+    put_i(b, (long long)c->nseg);
+    put_i(b, (long long)c->nnodes);
+    put_d(b, c->pts, 3 * c->nv);
+    for (size_t i = 0; i < c->ncomp; ++i) {
+        const lb__component *q = &c->comp[i];
+        put_i(b, (long long)q->first);
+        put_i(b, (long long)q->count);
+        put_i(b, q->closed);
+        const double v[] = {q->length, q->diameter, q->R, q->v1, q->v2, q->d1, q->d2, q->p, q->q};
+        put_d(b, v, sizeof v / sizeof *v);
+    }
+    put(b, c->seg, 2 * c->nseg * sizeof *c->seg);
+    put(b, c->segc, c->nseg * sizeof *c->segc);
+    for (size_t i = 0; i < c->nnodes; ++i) {
+        const bvh_node *q = &c->bvh[i];
+        put_d(b, q->lo, 3);
+        put_d(b, q->hi, 3);
+        put(b, &q->left, sizeof q->left);
+        put(b, &q->right, sizeof q->right);
+        put_i(b, q->leaf);
+    }
+    put_d(b, &c->rmax, 1);
+    put_d(b, &c->scene_size, 1);
+}
+
+/* Instruction i's record into b (from b->n on); 0 when an instruction it
+ * names has no match (map) and so it has none either. Every field that
+ * evaluation reads is written, field by field (no padding bytes);
+ * registers, the exports' node identity, the plan offset (aoff) and the
+ * messages' path are not. args: also its arguments (srci); without them
+ * (a plan's own record) a plan compares its arguments by their places in
+ * the plan. Bounding solids and cones (the instructions that bulge
+ * elimination and local unions re-run) are always named. */
+static int record(const lb_evaluator *ev, uint32_t i, const uint32_t *map, int args, buf *b) {
+    const lb__instr *in = &ev->ins[i];
+    put_i(b, in->code);
+    put_i(b, in->identity);
+    put_i(b, in->fast);
+    put_i(b, in->mode);
+    put_d(b, &in->lip, 1);
+    put_d(b, &in->cost, 1);
+    put_d(b, in->ia, 3);
+    const lb_primitive *P = &in->prim;
+    put_i(b, P->kind);
+    put_i(b, P->kernel);
+    put_d(b, P->c, 3);
+    put_d(b, P->a, 3);
+    put_d(b, P->n, 3);
+    put_d(b, P->q, 3);
+    put_d(b, &P->s0, 1);
+    put_d(b, &P->s1, 1);
+    put_d(b, in->A.M, 9);
+    put_d(b, in->A.t, 3);
+    if (in->code != LB__I_OP) return 1;
+    const lb__op *o = in->op;
+    put_i(b, o->family);
+    put_i(b, o->op);
+    put_i(b, (long long)o->k);
+    const double *arr[3] = {o->r, o->p, o->m};
+    for (int a = 0; a < 3; ++a) {
+        put_i(b, arr[a] != NULL);
+        if (arr[a]) put_d(b, arr[a], o->k);
+    }
+    put_d(b, &o->shape, 1);
+    put_i(b, o->bulge);
+    const lb_bulge_params *bp = &o->bp;
+    put_d(b, bp->r, 2);
+    put_d(b, bp->p, 2);
+    put_d(b, &bp->conic_p, 1);
+    put_d(b, bp->m, 2);
+    put_d(b, &bp->omega, 1);
+    put_i(b, bp->flags);
+    const lb__local_params *lp = &o->lp;
+    put_i(b, lp->has_feature);
+    put_d(b, lp->feature, 2);
+    put_i(b, lp->has_limits);
+    put_d(b, lp->limits, 2);
+    put_d(b, &lp->radius, 1);
+    put_i(b, lp->feature_support);
+    const double lv[] = {lp->support, lp->exponent, lp->alpha[0], lp->alpha[1], lp->zero_scale};
+    put_d(b, lv, sizeof lv / sizeof *lv);
+    int ok = 1;
+    if (args)
+        for (size_t a = 0; a < o->k; ++a) ok &= put_ref(b, map, in->srci[a]);
+    put_i(b, in->srcb != NULL);
+    if (in->srcb)
+        for (size_t a = 0; a < o->k; ++a) ok &= put_ref(b, map, in->srcb[a]);
+    put_i(b, in->ncone[0]);
+    put_i(b, in->ncone[1]);
+    if (in->cone)
+        for (uint32_t q = 0; q < in->ncone[0] + in->ncone[1]; ++q)
+            ok &= put_ref(b, map, in->cone[q]);
+    put_curves(b, in->curves);
+    return ok;
+}
+
+/* FNV-1a over a record: for tables and quick rejection only (equality is
+ * decided on the bytes) */
+static uint64_t hash(const uint8_t *p, size_t n) {
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+    return h;
+}
+
+/* A set of records, one per instruction: record i is p[off[i], off[i + 1]),
+ * h[i] its hash; bad[i]: it names an instruction without a match (equal
+ * to none). */
+typedef struct recs {
+    size_t n;
+    uint8_t *p;
+    size_t *off;
+    uint64_t *h;
+    uint8_t *bad;
+} recs;
+
+static void recs_free(recs *R) {
+    free(R->p);
+    free(R->off);
+    free(R->h);
+    free(R->bad);
+    memset(R, 0, sizeof *R);
+}
+
+/* ev's records (args: with arguments; map: names through it, else as
+ * ev's own indices). 0 when out of memory. */
+static int recs_make(const lb_evaluator *ev, const uint32_t *map, int args, recs *R) {
+    buf b = {NULL, 0, 0, 0};
+    R->n = ev->n;
+    R->off = malloc((ev->n + 1) * sizeof *R->off);
+    R->h = malloc((ev->n ? ev->n : 1) * sizeof *R->h);
+    R->bad = calloc(ev->n ? ev->n : 1, 1);
+    if (!R->off || !R->h || !R->bad) {
+        recs_free(R);
+        return 0;
+    }
+    for (size_t i = 0; i < ev->n && !b.oom; ++i) {
+        R->off[i] = b.n;
+        R->bad[i] = !record(ev, (uint32_t)i, map, args, &b);
+        if (!b.oom) R->h[i] = hash(b.p + R->off[i], b.n - R->off[i]);
+    }
+    R->off[ev->n] = b.n;
+    R->p = b.p;
+    if (b.oom) {
+        recs_free(R);
+        return 0;
+    }
+    return 1;
+}
+
+/* Are record i of A and record j of B the same bytes? */
+static int recs_equal(const recs *A, size_t i, const recs *B, size_t j) {
+    const size_t la = A->off[i + 1] - A->off[i], lb = B->off[j + 1] - B->off[j];
+    return !A->bad[i] && !B->bad[j] && A->h[i] == B->h[j] && la == lb &&
+           !memcmp(A->p + A->off[i], B->p + B->off[j], la);
+}
+
+struct lb_mesh_cache {
+    int valid;
+    /* what the blocks were made for */
+    double origin[3], h[3], bmin[3], bmax[3];
+    uint32_t cells[3];
+    int closed, soft, tetrahedra, features, conv, cullable;
+    /* the records of the evaluator last meshed (with and without
+     * arguments), a table over the full ones */
+    size_t nins;
+    recs full, self;
+    uint32_t *tab; /* instruction + 1, 0: empty; tcap (a power of 2) slots */
+    size_t tcap;
+    lb__cblock *blocks; /* sorted by id */
+    size_t nblocks;
+    lb_mesh_cache_stats stats;
+};
+
+/* The matching of an evaluator against the cache (mesher.c's rule):
+ * deep[i], the cached instruction with the same record with arguments
+ * (UINT32_MAX: none); own records (arguments by place) written through
+ * deep for the comparison (cmp) and as they are for the next cache (self,
+ * deep records in full); same[i], the cached instruction whose own record
+ * was found equal (a memo); pos and stamp, a plan's places. */
+struct lb__cmatch {
+    const lb_evaluator *ev;
+    int usable;
+    uint32_t *deep, *same, *pos, *stamp, round;
+    recs cmp, self, full;
+};
+
+void lb__cmatch_free(lb__cmatch *M) {
+    if (!M) return;
+    free(M->deep);
+    free(M->same);
+    free(M->pos);
+    free(M->stamp);
+    recs_free(&M->cmp);
+    recs_free(&M->self);
+    recs_free(&M->full);
+    free(M);
+}
+
+lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usable,
+                         lb__cmatch **out, lb_error *err) {
+    *out = NULL;
+    lb__cmatch *M = calloc(1, sizeof *M);
+    const size_t n = ev->n ? ev->n : 1;
+    int ok = M != NULL;
+    if (ok) {
+        M->ev = ev;
+        M->usable = usable;
+        M->deep = malloc(n * sizeof *M->deep);
+        M->same = malloc(n * sizeof *M->same);
+        M->pos = malloc(n * sizeof *M->pos);
+        M->stamp = calloc(n, sizeof *M->stamp);
+        ok = M->deep && M->same && M->pos && M->stamp && recs_make(ev, NULL, 1, &M->full) &&
+             recs_make(ev, NULL, 0, &M->self);
+    }
+    if (ok && usable) {
+        /* deep matches in tape order: an instruction's arguments come first */
+        buf b = {NULL, 0, 0, 0};
+        for (size_t i = 0; i < ev->n && !b.oom; ++i) {
+            M->deep[i] = M->same[i] = NONE;
+            b.n = 0;
+            if (!record(ev, (uint32_t)i, M->deep, 1, &b) || b.oom) continue;
+            const uint64_t h = hash(b.p, b.n);
+            for (size_t s = h & (C->tcap - 1); C->tab[s]; s = (s + 1) & (C->tcap - 1)) {
+                const uint32_t j = C->tab[s] - 1;
+                const size_t len = C->full.off[j + 1] - C->full.off[j];
+                if (C->full.h[j] == h && len == b.n &&
+                    !memcmp(C->full.p + C->full.off[j], b.p, len)) {
+                    M->deep[i] = j;
+                    break;
+                }
+            }
+        }
+        ok = !b.oom;
+        free(b.p);
+        ok = ok && recs_make(ev, M->deep, 0, &M->cmp);
+    }
+    if (!ok) {
+        lb__cmatch_free(M);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create_cached: out of memory");
+    }
+    *out = M;
+    return LB_OK;
+}
+
+/* ---- blocks ---- */
+
+void lb__cblock_free(lb__cblock *E) {
+    lb__cplan_free(&E->plan);
+    free(E->okey);
+    free(E->rref);
+    free(E->vpos);
+    free(E->vnrm);
+    free(E->tri);
+    free(E->node);
+    free(E->ndata);
+    free(E->fe);
+    free(E->fent);
+    free(E->argpos);
+    memset(E, 0, sizeof *E);
+}
+
+static void blocks_free(lb_mesh_cache *C) {
+    for (size_t i = 0; i < C->nblocks; ++i) lb__cblock_free(&C->blocks[i]);
+    free(C->blocks);
+    C->blocks = NULL;
+    C->nblocks = 0;
+}
+
+const lb__cblock *lb__cache_blocks(const lb_mesh_cache *C, size_t *n) {
+    *n = C->nblocks;
+    return C->blocks;
+}
+
+/* P's argument places into out (at most ev->total_k entries), returning
+ * how many: per listed operator, the place in P->list of each argument it
+ * reads (a fast kernel's kept ones, another operator's all k:
+ * eval_points.c), UINT32_MAX where that argument is not listed. */
+static size_t arg_places(lb__cmatch *M, const lb__cplan *P, uint32_t *out) {
+    const lb_evaluator *ev = M->ev;
+    if (++M->round == 0) {
+        memset(M->stamp, 0, (ev->n ? ev->n : 1) * sizeof *M->stamp);
+        M->round = 1;
+    }
+    for (uint32_t q = 0; q < P->nlist; ++q) {
+        M->pos[P->list[q]] = q;
+        M->stamp[P->list[q]] = M->round;
+    }
+    size_t w = 0;
+    const uint16_t *act = P->act;
+    for (uint32_t q = 0; q < P->nlist; ++q) {
+        const lb__instr *in = &ev->ins[P->list[q]];
+        if (in->code != LB__I_OP) continue;
+        const uint16_t na = *act++;
+        const size_t k = in->fast ? na : in->op->k;
+        for (size_t t = 0; t < k; ++t) {
+            const uint32_t a = in->srci[in->fast ? act[t] : t];
+            out[w++] = M->stamp[a] == M->round ? M->pos[a] : NONE;
+        }
+        act += na;
+    }
+    return w;
+}
+
+size_t lb__cmatch_scratch(const lb__cmatch *M) {
+    return M->ev->total_k ? M->ev->total_k : 1;
+}
+
+int lb__cache_same_plan(const lb_mesh_cache *C, lb__cmatch *M, const lb__cblock *E,
+                        const lb__cplan *P, uint32_t *scratch) {
+    if (!M->usable || E->plan.nlist != P->nlist || E->plan.nact_total != P->nact_total || !P->nlist)
+        return 0;
+    /* the root last in both (its register is the value read) */
+    if (P->list[P->nlist - 1] != M->ev->n - 1 || E->plan.list[P->nlist - 1] != C->nins - 1)
+        return 0;
+    for (uint32_t q = 0; q < P->nlist; ++q) {
+        const uint32_t i = P->list[q], j = E->plan.list[q];
+        if (M->same[i] == j) continue;
+        if (!recs_equal(&M->cmp, i, &C->self, j)) return 0;
+        M->same[i] = j;
+    }
+    if (P->nact_total && memcmp(E->plan.act, P->act, P->nact_total * sizeof *P->act)) return 0;
+    const size_t na = arg_places(M, P, scratch);
+    if (na != E->nargpos) return 0;
+    for (size_t t = 0; t < na; ++t)
+        if (scratch[t] == NONE || scratch[t] != E->argpos[t]) return 0;
+    return 1;
+}
+
+/* E's argument places from its plan (ev's, M's evaluator); 0 when out of
+ * memory. */
+static int set_places(lb__cmatch *M, lb__cblock *E, uint32_t *scratch) {
+    free(E->argpos); /* a reused block's: the same places, made again */
+    E->argpos = NULL;
+    E->nargpos = arg_places(M, &E->plan, scratch);
+    if (!E->nargpos) return 1;
+    E->argpos = malloc(E->nargpos * sizeof *E->argpos);
+    if (!E->argpos) return 0;
+    memcpy(E->argpos, scratch, E->nargpos * sizeof *E->argpos);
+    return 1;
+}
+
+int lb__cache_usable(const lb_mesh_cache *C, const lb_evaluator *ev, const lb__grid *g) {
+    if (!C || !C->valid || C->conv != (int)ev->conv || C->cullable != ev->cullable) return 0;
+    if (C->closed != g->closed || C->soft != g->soft || C->tetrahedra != g->tetrahedra ||
+        C->features != g->features)
+        return 0;
+    for (int d = 0; d < 3; ++d)
+        if (C->origin[d] != g->origin[d] || C->h[d] != g->h[d] || C->cells[d] != g->cells[d] ||
+            (g->closed && (C->bmin[d] != g->bmin[d] || C->bmax[d] != g->bmax[d])))
+            return 0;
+    return 1;
+}
+
+/* A near-face node of block B: local coordinate 0 on some axis. */
+static int near_face(const uint32_t l[3]) {
+    return !l[0] || !l[1] || !l[2];
+}
+
+int lb__cache_export(const lb__block *B, lb__cblock *E) {
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1, D2 = B->nc[2] + 1;
+    uint32_t nn = 0, nf = 0;
+    if (B->nmask)
+        for (uint32_t k = 0; k < D2; ++k)
+            for (uint32_t j = 0; j < D1; ++j)
+                for (uint32_t i = 0; i < D0; ++i) {
+                    const uint32_t l[3] = {i, j, k};
+                    nn += near_face(l) && B->nmask[((size_t)k * D1 + j) * D0 + i];
+                }
+    if (B->fvalid)
+        for (size_t e = 0; e < LB__FACE_ENTRIES; ++e) nf += (B->fvalid[e >> 3] >> (e & 7)) & 1;
+    E->nnode = nn;
+    E->nface = nf;
+    E->node = nn ? malloc(nn * sizeof *E->node) : NULL;
+    E->ndata = nn ? malloc(4 * nn * sizeof *E->ndata) : NULL;
+    E->fe = nf ? malloc(nf * sizeof *E->fe) : NULL;
+    E->fent = nf ? malloc(nf * sizeof *E->fent) : NULL;
+    if ((nn && (!E->node || !E->ndata)) || (nf && (!E->fe || !E->fent))) return 0;
+    uint32_t w = 0;
+    for (uint32_t k = 0; k < D2 && nn; ++k)
+        for (uint32_t j = 0; j < D1; ++j)
+            for (uint32_t i = 0; i < D0; ++i) {
+                const uint32_t l[3] = {i, j, k};
+                const size_t q = ((size_t)k * D1 + j) * D0 + i;
+                if (!near_face(l) || !B->nmask[q]) continue;
+                E->node[w] = (uint16_t)q;
+                E->ndata[4 * w] = B->vals[q];
+                memcpy(E->ndata + 4 * w + 1, B->grads + 3 * q, 3 * sizeof(double));
+                ++w;
+            }
+    w = 0;
+    for (size_t e = 0; e < LB__FACE_ENTRIES && nf; ++e)
+        if ((B->fvalid[e >> 3] >> (e & 7)) & 1) {
+            E->fe[w] = (uint16_t)e;
+            E->fent[w++] = B->ftab[e];
+        }
+    return 1;
+}
+
+void lb__cache_import(const lb__cblock *E, lb__block *B) {
+    for (uint32_t w = 0; w < E->nnode; ++w) {
+        const size_t q = E->node[w];
+        B->nmask[q] = 1;
+        B->vals[q] = E->ndata[4 * w];
+        memcpy(B->grads + 3 * q, E->ndata + 4 * w + 1, 3 * sizeof(double));
+    }
+    for (uint32_t w = 0; w < E->nface; ++w) {
+        const size_t e = E->fe[w];
+        B->ftab[e] = E->fent[w];
+        B->fvalid[e >> 3] |= (uint8_t)(1u << (e & 7));
+    }
+}
+
+static size_t cblock_bytes(const lb__cblock *E) {
+    return sizeof *E + E->plan.nlist * sizeof(uint32_t) + E->plan.nact_total * sizeof(uint16_t) +
+           (E->nv - E->np) * sizeof(uint64_t) + 2 * E->nref * sizeof(uint32_t) +
+           3 * (E->nv + E->nref) * sizeof(double) + 3 * E->nv * sizeof(double) +
+           3 * E->nt * sizeof(uint32_t) + E->nnode * (sizeof(uint16_t) + 4 * sizeof(double)) +
+           E->nface * (sizeof(uint16_t) + sizeof(lb__fent)) + E->nargpos * sizeof(uint32_t);
+}
+
+lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, lb__cblock *blocks,
+                           size_t n, size_t reused, lb_error *err) {
+    const lb_evaluator *ev = M->ev;
+    blocks_free(C);
+    C->valid = 0;
+    size_t cap = 16;
+    while (cap < 2 * ev->n) cap *= 2;
+    uint32_t *tab = calloc(cap, sizeof *tab);
+    uint32_t *scratch = malloc(lb__cmatch_scratch(M) * sizeof *scratch);
+    int ok = tab && scratch;
+    for (size_t i = 0; i < n && ok; ++i) ok = set_places(M, &blocks[i], scratch);
+    free(scratch);
+    if (!ok) {
+        free(tab);
+        for (size_t i = 0; i < n; ++i) lb__cblock_free(&blocks[i]);
+        free(blocks);
+        lb__cmatch_free(M);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create_cached: out of memory");
+    }
+    recs_free(&C->full);
+    recs_free(&C->self);
+    free(C->tab);
+    C->full = M->full;
+    C->self = M->self;
+    memset(&M->full, 0, sizeof M->full);
+    memset(&M->self, 0, sizeof M->self);
+    lb__cmatch_free(M);
+    for (size_t i = 0; i < ev->n; ++i) {
+        size_t h = C->full.h[i] & (cap - 1);
+        while (tab[h]) h = (h + 1) & (cap - 1);
+        tab[h] = (uint32_t)i + 1;
+    }
+    C->tab = tab;
+    C->tcap = cap;
+    C->nins = ev->n;
+    C->blocks = blocks;
+    C->nblocks = n;
+    C->valid = 1;
+    for (int d = 0; d < 3; ++d) {
+        C->origin[d] = g->origin[d];
+        C->h[d] = g->h[d];
+        C->cells[d] = g->cells[d];
+        C->bmin[d] = g->bmin[d];
+        C->bmax[d] = g->bmax[d];
+    }
+    C->closed = g->closed;
+    C->soft = g->soft;
+    C->tetrahedra = g->tetrahedra;
+    C->features = g->features;
+    C->conv = (int)ev->conv;
+    C->cullable = ev->cullable;
+    size_t bytes = sizeof *C + C->full.off[C->nins] + C->self.off[C->nins] +
+                   2 * C->nins * (sizeof(size_t) + sizeof(uint64_t) + 1) +
+                   C->tcap * sizeof(uint32_t);
+    for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
+    C->stats.blocks = n;
+    C->stats.reused = reused;
+    C->stats.recycled += reused > 0;
+    C->stats.bytes = bytes;
+    return LB_OK;
+}
+
+/* ---- the public side ---- */
+
+lb_status lb_mesh_cache_create(lb_mesh_cache **out, lb_error *err) {
+    if (!out)
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "lb_mesh_cache_create: out must be non-NULL");
+    *out = calloc(1, sizeof **out);
+    if (!*out) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_cache_create: out of memory");
+    return LB_OK;
+}
+
+void lb_mesh_cache_free(lb_mesh_cache *C) {
+    if (!C) return;
+    blocks_free(C);
+    recs_free(&C->full);
+    recs_free(&C->self);
+    free(C->tab);
+    free(C);
+}
+
+void lb_mesh_cache_stats_get(const lb_mesh_cache *C, lb_mesh_cache_stats *out) {
+    if (!out) return;
+    if (!C) {
+        memset(out, 0, sizeof *out);
+        return;
+    }
+    *out = C->stats;
+}
