@@ -101,6 +101,11 @@ class _Stats(ctypes.Structure):
                 ("operators", ctypes.c_size_t), ("depth", ctypes.c_size_t)]
 
 
+class _CacheStats(ctypes.Structure):
+    _fields_ = [("blocks", ctypes.c_size_t), ("reused", ctypes.c_size_t),
+                ("recycled", ctypes.c_size_t), ("bytes", ctypes.c_size_t)]
+
+
 _P = ctypes.c_void_p
 _D = ctypes.POINTER(ctypes.c_double)
 _ERR = ctypes.POINTER(_Error)
@@ -136,6 +141,11 @@ _SIGNATURES = {
     "lb_mesh_create": (ctypes.c_int, [_P, ctypes.POINTER(_MeshOptions),
                                       ctypes.POINTER(ctypes.POINTER(_Mesh)), _ERR]),
     "lb_mesh_free": (None, [ctypes.POINTER(_Mesh)]),
+    "lb_mesh_cache_create": (ctypes.c_int, [ctypes.POINTER(_P), _ERR]),
+    "lb_mesh_cache_free": (None, [_P]),
+    "lb_mesh_create_cached": (ctypes.c_int, [_P, ctypes.POINTER(_MeshOptions), _P,
+                                             ctypes.POINTER(ctypes.POINTER(_Mesh)), _ERR]),
+    "lb_mesh_cache_stats_get": (None, [_P, ctypes.POINTER(_CacheStats)]),
     "lb_mesh_edges": (ctypes.c_int, [ctypes.POINTER(_Mesh), _U32, _U32,
                                      ctypes.POINTER(ctypes.c_size_t), _ERR]),
     "lb_mesh_write": (ctypes.c_int, [ctypes.POINTER(_Mesh), ctypes.c_char_p, ctypes.c_int, _ERR]),
@@ -257,6 +267,15 @@ class Library:
         self._check(st, err, "scene")
         return Scene(self, out)
 
+    def mesh_cache(self):
+        """An empty MeshCache (lb_mesh_cache): pass it to Evaluator.mesh(cache=)
+        so that meshing an edited scene recomputes only the blocks that
+        changed, with the same result as without it."""
+        out, err = _P(), _Error()
+        st = self._c.lb_mesh_cache_create(ctypes.byref(out), ctypes.byref(err))
+        self._check(st, err, "mesh cache")
+        return MeshCache(self, out)
+
     def load_scene(self, path):
         """Read, parse and validate a scene file."""
         out, err = _P(), _Error()
@@ -294,6 +313,19 @@ class _Handle:
         if self._p is None:
             raise LibblendError("%s used after close()" % type(self).__name__, 1)
         return self._p
+
+
+class MeshCache(_Handle):
+    """The blocks of the last mesh made through it (lb_mesh_cache). Use from
+    one thread at a time."""
+    _free = "lb_mesh_cache_free"
+
+    @property
+    def stats(self):
+        """(blocks, reused, recycled, bytes) of the last mesh (lb_mesh_cache_stats)."""
+        st = _CacheStats()
+        self.lib._c.lb_mesh_cache_stats_get(self.ptr, ctypes.byref(st))
+        return st.blocks, st.reused, st.recycled, st.bytes
 
 
 class Scene(_Handle):
@@ -469,7 +501,7 @@ class Evaluator(_Handle):
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
              max_memory=0, cancel=None, edges=False, features=False, corner_normals=True,
-             simplify=0.0):
+             simplify=0.0, cache=None):
         """Mesh the field over the box [bmin, bmax] (docs/meshing.md). Returns a
         Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called.
         edges=True also fills Mesh.edges and Mesh.corner_edges (lb_mesh_edges);
@@ -477,7 +509,9 @@ class Evaluator(_Handle):
         with corner_normals (LB_MESH_CORNER_NORMALS) gives each side of a
         crease its own normal (Mesh.corner_normals, Mesh.loop_normals());
         simplify > 0 (cells, at most 1) merges triangles wherever the surface
-        stays within that tolerance of the field (lb_mesh_options.simplify)."""
+        stays within that tolerance of the field (lb_mesh_options.simplify);
+        cache (a MeshCache) remeshes only the blocks that changed since the
+        last mesh made through it (lb_mesh_create_cached), byte-identical."""
         _need_numpy()
         o = _MeshOptions()
         self.lib._c.lb_mesh_options_init(ctypes.byref(o))
@@ -493,8 +527,12 @@ class Evaluator(_Handle):
         if cancel is not None:
             o.cancel = ctypes.pointer(cancel._flag)
         out, err = ctypes.POINTER(_Mesh)(), _Error()
-        st = self.lib._c.lb_mesh_create(self.ptr, ctypes.byref(o), ctypes.byref(out),
-                                        ctypes.byref(err))
+        if cache is not None:
+            st = self.lib._c.lb_mesh_create_cached(self.ptr, ctypes.byref(o), cache.ptr,
+                                                   ctypes.byref(out), ctypes.byref(err))
+        else:
+            st = self.lib._c.lb_mesh_create(self.ptr, ctypes.byref(o), ctypes.byref(out),
+                                            ctypes.byref(err))
         self.lib._check(st, err, "mesh")
         try:
             m = out.contents

@@ -74,6 +74,12 @@ int main(void) {
     FIELD(lb_scene_stats, operators);
     FIELD(lb_scene_stats, depth);
     END();
+    BEGIN(lb_mesh_cache_stats, "_CacheStats");
+    FIELD(lb_mesh_cache_stats, blocks);
+    FIELD(lb_mesh_cache_stats, reused);
+    FIELD(lb_mesh_cache_stats, recycled);
+    FIELD(lb_mesh_cache_stats, bytes);
+    END();
     printf("}\n");
     return 0;
 }
