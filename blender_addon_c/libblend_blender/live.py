@@ -59,6 +59,18 @@ class _State:
         self.expect = None  # how long the last run took (predicts the next one)
         self.region = None  # (bmin, bmax) the last mesh was made in (Fit Region: the fitted box)
         self.clip_warning = ""  # why the surface is cut flat at the region, if it is
+        # the last mesh's blocks (lb_mesh_cache): the next run of this field
+        # (an edit, the next frame) recomputes only the blocks that changed,
+        # with the same result; one run at a time uses it (the lock: a
+        # cancelled run still on its thread finishes first)
+        self.cache = None
+        self.cache_lock = threading.Lock()
+
+    def mesh_cache(self, lib):
+        """(cache, lock) for runs of this field with library lib"""
+        if self.cache is None or self.cache.lib is not lib:
+            self.cache = lib.mesh_cache()
+        return self.cache, self.cache_lock
 
 
 class _Job:
@@ -67,11 +79,12 @@ class _Job:
     run() touches no Blender data and may run on a worker thread."""
 
     def __init__(self, lib, text, name, bmin, bmax, resolution, open_boundary, threads, paths,
-                 fit=False, features=False, simplify=0.0):
+                 fit=False, features=False, simplify=0.0, cache=(None, None)):
         self.lib, self.text, self.name = lib, text, name
         self.bmin, self.bmax, self.resolution = bmin, bmax, resolution
         self.open_boundary, self.threads, self.paths = open_boundary, threads, paths
         self.fit, self.features, self.simplify = fit, features, simplify
+        self.cache, self.cache_lock = cache
         self.key = mesh_key(text, "fit" if fit else bmin, "fit" if fit else bmax, resolution,
                             open_boundary, features, simplify)
         self.cell = 0.0        # Fit Region's cell size (0: not fitted)
@@ -106,11 +119,11 @@ class _Job:
 
     def _mesh(self, scene, ev):
         import numpy as np
-        self.mesh = ev.mesh(self.bmin, self.bmax, resolution=self.resolution,
-                            cell_size=self.cell, open_boundary=self.open_boundary,
-                            threads=self.threads, cancel=self.cancel,
-                            edges=compat.takes_libblend_edges(), features=self.features,
-                            simplify=self.simplify)
+        if self.cache is None:
+            self.mesh = self._mesh_with(ev, None)
+        else:
+            with self.cache_lock:
+                self.mesh = self._mesh_with(ev, self.cache)
         self.clipped = clipped_faces(self.mesh.positions, self.bmin, self.bmax)
         mats = scene.materials()
         if len(mats) > 1 and len(self.mesh.triangles):
@@ -118,6 +131,12 @@ class _Job:
             P = self.mesh.positions[self.mesh.triangles.astype(np.int64)].mean(axis=1)
             self.mesh.material_index = scene.material_index(ev, P)
             self.mesh.materials = mats
+
+    def _mesh_with(self, ev, cache):
+        return ev.mesh(self.bmin, self.bmax, resolution=self.resolution, cell_size=self.cell,
+                       open_boundary=self.open_boundary, threads=self.threads, cancel=self.cancel,
+                       edges=compat.takes_libblend_edges(), features=self.features,
+                       simplify=self.simplify, cache=cache)
 
     def _fit(self, ev, text):
         # only local unions read the bounds when meshing: other scenes keep
@@ -340,7 +359,7 @@ def prepare(output, resolution, depsgraph=None):
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
                 output.libblend.open_boundary, libhandle.threads(), paths,
                 fit=output.libblend.fit_region, features=output.libblend.sharp_features,
-                simplify=output.libblend.simplify)
+                simplify=output.libblend.simplify, cache=_state(output.name).mesh_cache(lib))
 
 
 def _finish(output, st, job, t_start, defer_normals=False):

@@ -1166,5 +1166,49 @@ cube.libblend.simplify = 0.0
 check(live.update_now(cube)[0] and len(cube.data.polygons) > 1000,
       "Simplify off again: the full mesh (%d triangles)" % len(cube.data.polygons))
 
+# ---------------------------------------------------------------- incremental remeshing
+# Each field keeps its last mesh's blocks (lb_mesh_cache): moving one sphere
+# of a 27-sphere lattice remeshes only the blocks near it, and the mesh in
+# Blender is the full remesh's, vertex for vertex and triangle for triangle;
+# the same again takes every block from the cache.
+lat_args = [{"type": "sphere", "center": [-1.2 + 1.2 * (q % 3), -1.2 + 1.2 * (q // 3 % 3),
+                                          -1.2 + 1.2 * (q // 9)], "radius": 0.35}
+            for q in range(27)]
+lat_path = os.path.join(WORK, "lattice.json")
+with open(lat_path, "w") as f:
+    json.dump({"format": "libblend-scene", "version": 1, "convention": "zero",
+               "bounds": {"min": [-2, -2, -2], "max": [2, 2, 2]},
+               "root": {"type": "displacement", "op": "union", "r": 0.2, "p": 2, "m": 1,
+                        "args": lat_args}}, f)
+check(bpy.ops.libblend.import_scene(filepath=lat_path, with_render=False) == {"FINISHED"},
+      "import the lattice")
+lat = active()
+lat.libblend.live = False
+lat.libblend.preview_resolution = 96
+check(live.update_now(lat)[0], "mesh the lattice")
+spheres = sorted((o for o in lat.children_recursive if tree.is_node(o) and
+                  o.libblend.kind == "PRIMITIVE"), key=lambda o: o.name)
+check(len(spheres) == 27, "27 sphere objects (%d)" % len(spheres))
+mid = min(spheres, key=lambda o: o.matrix_world.translation.length)
+mid.location.x += 0.04  # 1 % of the region
+bpy.context.view_layer.update()
+check(live.update_now(lat)[0], "mesh the lattice with one sphere moved")
+blocks, reused, _recycled, nbytes = live.state_of(lat).cache.stats
+V, F = blender_mesh(lat)
+full = live.prepare(lat, 96)
+full.cache = None  # the full remesh, without the cache
+full.run()
+same = (not full.error and V.shape == full.mesh.positions.shape and
+        np.array_equal(V.astype(np.float32), full.mesh.positions.astype(np.float32)) and
+        np.array_equal(F, full.mesh.triangles.astype(np.int64)))
+print("incremental remeshing in Blender: %d of %d blocks from the cache (%.1f MiB), same mesh: %s"
+      % (reused, blocks, nbytes / 2.0**20, same))
+check(same, "the cached live update is the full remesh's mesh")
+check(reused >= 0.6 * blocks, "the live update took %d of %d blocks from the cache" % (
+    reused, blocks))
+check(live.update_now(lat, force=True)[0] and
+      live.state_of(lat).cache.stats[1] == live.state_of(lat).cache.stats[0],
+      "the same field again: every block from the cache")
+
 addon_utils.disable(ADDON_NAME)
 print("test_addon: %d checks passed" % addon_env.checks)
