@@ -255,6 +255,7 @@ struct lb_mesh_cache {
     size_t tcap;
     lb__cblock *blocks; /* sorted by id */
     size_t nblocks;
+    size_t counts[2]; /* the merged mesh's vertices and triangles */
     lb_mesh_cache_stats stats;
 };
 
@@ -416,8 +417,7 @@ int lb__cache_same_plan(const lb_mesh_cache *C, lb__cmatch *M, const lb__cblock 
 /* E's argument places from its plan (ev's, M's evaluator); 0 when out of
  * memory. */
 static int set_places(lb__cmatch *M, lb__cblock *E, uint32_t *scratch) {
-    free(E->argpos); /* a reused block's: the same places, made again */
-    E->argpos = NULL;
+    if (E->argpos) return 1; /* a block from the cache: its plan's places, checked equal */
     E->nargpos = arg_places(M, &E->plan, scratch);
     if (!E->nargpos) return 1;
     E->argpos = malloc(E->nargpos * sizeof *E->argpos);
@@ -505,8 +505,13 @@ static size_t cblock_bytes(const lb__cblock *E) {
            E->nface * (sizeof(uint16_t) + sizeof(lb__fent)) + E->nargpos * sizeof(uint32_t);
 }
 
+void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt) {
+    *nv = C->counts[0];
+    *nt = C->counts[1];
+}
+
 lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, lb__cblock *blocks,
-                           size_t n, size_t reused, lb_error *err) {
+                           size_t n, size_t reused, const size_t counts[2], lb_error *err) {
     const lb_evaluator *ev = M->ev;
     blocks_free(C);
     C->valid = 0;
@@ -540,6 +545,8 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     C->tab = tab;
     C->tcap = cap;
     C->nins = ev->n;
+    C->counts[0] = counts[0];
+    C->counts[1] = counts[1];
     C->blocks = blocks;
     C->nblocks = n;
     C->valid = 1;

@@ -112,7 +112,8 @@ typedef struct lb__block {
     double *vpos, *vnrm;
     uint32_t *tri;
     /* incremental remeshing (cache.c): the output above is the cache's
-     * (okey, vpos, vnrm and tri are not freed by the merge) */
+     * (not freed by the merge; rref's blocks are offset codes, as in
+     * lb__cblock) */
     int borrowed;
 } lb__block;
 
@@ -167,9 +168,14 @@ LB_INTERNAL int lb__cache_export(const lb__block *B, lb__cblock *E);
 LB_INTERNAL void lb__cache_import(const lb__cblock *E, lb__block *B);
 /* The cache becomes this run's: n blocks (sorted by id, plans in M's
  * evaluator's indices; moved in, the array too) on grid g, M consumed;
- * reused counts the ones taken from it. On failure the cache is emptied. */
+ * reused counts the ones taken from it, counts are the merged mesh's
+ * vertices and triangles. On failure the cache is emptied. */
 LB_INTERNAL lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g,
-                                       lb__cblock *blocks, size_t n, size_t reused, lb_error *err);
+                                       lb__cblock *blocks, size_t n, size_t reused,
+                                       const size_t counts[2], lb_error *err);
+/* The vertices and triangles of the cached mesh once merged (before the
+ * passes after it). */
+LB_INTERNAL void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt);
 
 /* The facing of triangle (a, b, c): (b - a) x (c - a), not normalised
  * (features.c's flips and folds, corners.c). */

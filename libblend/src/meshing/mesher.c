@@ -285,6 +285,7 @@ typedef struct mstate {
      * (its references as offset codes, by nbr) */
     lb__cblock *keep;
     uint32_t (*nbr)[8];
+    size_t vhint, thint; /* first capacities: the cached mesh's counts, a sixteenth more */
     lb_status s;
     lb_error err;
 } mstate;
@@ -644,9 +645,11 @@ static int grow(void **p, size_t cap, size_t c, size_t sz) {
  * 4.5 % of S2's time at 256 cells. */
 #define FIRST_BYTES ((size_t)32 << 20)
 
-/* A capacity (elements of sz bytes) of at least need, doubling cap. */
-static size_t doubled(size_t cap, size_t need, size_t sz) {
-    size_t c = cap ? cap : FIRST_BYTES / sz;
+/* A capacity (elements of sz bytes) of at least need, doubling cap; the
+ * first one at least hint (the cached mesh's size: a mesh through a cache
+ * mostly fits without growing). */
+static size_t doubled(size_t cap, size_t need, size_t sz, size_t hint) {
+    size_t c = cap ? cap : FIRST_BYTES / sz > hint ? FIRST_BYTES / sz : hint;
     while (c < need) c *= 2;
     return c;
 }
@@ -687,8 +690,8 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
                         UINT32_MAX);
         return 0;
     }
-    const size_t vc = doubled(S->vcap, M->nvertices + B->nv, 3 * sizeof(double)),
-                 tc = doubled(S->tcap, M->ntriangles + B->nt, 3 * sizeof(uint32_t));
+    const size_t vc = doubled(S->vcap, M->nvertices + B->nv, 3 * sizeof(double), S->vhint),
+                 tc = doubled(S->tcap, M->ntriangles + B->nt, 3 * sizeof(uint32_t), S->thint);
     const int ok = grow((void **)&M->positions, S->vcap, vc, 3 * sizeof(double)) &&
                    grow((void **)&M->normals, S->vcap, vc, 3 * sizeof(double)) &&
                    grow((void **)&M->triangles, S->tcap, tc, 3 * sizeof(uint32_t));
@@ -754,7 +757,8 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
             T[t] = local[u - np];
         } else {
             const uint32_t *r = B->rref + 2 * (u - nown);
-            T[t] = S->base[r[0]] + r[1];
+            /* a cached block names the next block by its offset code */
+            T[t] = S->base[B->borrowed ? S->nbr[bi][r[0]] - 1 : r[0]] + r[1];
         }
     }
     M->ntriangles += B->nt;
@@ -787,11 +791,11 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
      * one taken from the cache stays there */
     if (!B->borrowed) {
         free(B->okey);
+        free(B->rref);
         free(B->vpos);
         free(B->vnrm);
         free(B->tri);
     }
-    free(B->rref);
     B->okey = NULL;
     B->rref = NULL;
     B->vpos = B->vnrm = NULL;
@@ -876,9 +880,10 @@ static int start_block(run *R, size_t i, size_t t) {
     return !s;
 }
 
-/* Block i's output from its cached entry (the arrays borrowed, the
- * references' offset codes made block indices); 0 when out of memory. */
-static int take_cached(run *R, size_t i, lb_error *e) {
+/* Block i's output from its cached entry (the arrays borrowed; its
+ * references name next blocks by offset code, which the merge reads
+ * through nbr: the rule checked that those blocks are kept). */
+static void take_cached(run *R, size_t i) {
     lb__block *B = &R->blocks[i];
     const lb__cblock *E = R->from[i];
     B->nv = E->nv;
@@ -890,14 +895,8 @@ static int take_cached(run *R, size_t i, lb_error *e) {
     B->vpos = E->vpos;
     B->vnrm = E->vnrm;
     B->tri = E->tri;
+    B->rref = E->rref;
     B->borrowed = 1;
-    B->rref = malloc(2 * (E->nref ? E->nref : 1) * sizeof *B->rref);
-    if (!B->rref) return !lb__fail(e, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    for (size_t r = 0; r < E->nref; ++r) {
-        B->rref[2 * r] = R->nbr[i][E->rref[2 * r]] - 1; /* kept: the rule checked it */
-        B->rref[2 * r + 1] = E->rref[2 * r + 1];
-    }
-    return 1;
 }
 
 /* Are block i's next blocks done (their output and near-face tables)? */
@@ -916,7 +915,7 @@ static void finish_block(run *R, size_t i, size_t t) {
     lb__block *B = &R->blocks[i];
     int ok = 1;
     if (R->from && R->from[i]) {
-        ok = take_cached(R, i, &e);
+        take_cached(R, i);
     } else {
         block_share(R, i);
         int gnext = 0;
@@ -1264,11 +1263,17 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     R.blocks = L.b;
     R.nblocks = L.n;
     lb__cmatch *match = NULL;
-    if (cache) { /* each block's entry for the cache; the matches for its rule */
+    size_t merged[2] = {0, 0}; /* the merged mesh's vertices and triangles, for the cache */
+    if (cache) {               /* each block's entry for the cache; the matches for its rule */
         R.cache = cache;
         R.ms.keep = calloc(R.nblocks ? R.nblocks : 1, sizeof *R.ms.keep);
         if (!R.ms.keep) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
         const int usable = lb__cache_usable(cache, ev, &g);
+        if (usable) {
+            lb__cache_counts(cache, &R.ms.vhint, &R.ms.thint);
+            R.ms.vhint += R.ms.vhint / 16;
+            R.ms.thint += R.ms.thint / 16;
+        }
         if (!s) s = lb__cmatch_new(cache, ev, usable, &match, err);
         if (usable) R.match = match;
         if (s) {
@@ -1301,6 +1306,8 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     if (s && R.err_block != SIZE_MAX && err) *err = R.err;
     if (!s && !P.cancelled) {
         try_merge(&R); /* the blocks no worker merged */
+        merged[0] = M->nvertices;
+        merged[1] = M->ntriangles;
         s = R.ms.s;
         if (s && err) *err = R.ms.err;
         if (!s && R.mnext != R.nblocks) /* cannot happen: every block is done */
@@ -1359,7 +1366,7 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         }
         lb_error ce;
         const lb_status cs =
-            lb__cache_commit(cache, match, &g, R.ms.keep, R.nblocks, R.nreused, &ce);
+            lb__cache_commit(cache, match, &g, R.ms.keep, R.nblocks, R.nreused, merged, &ce);
         match = NULL;
         if (cs) {
             /* out of memory for the records: the cache is emptied (the next
@@ -1380,11 +1387,11 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         lb__block *B = &R.blocks[i];
         if (!B->borrowed) {
             free(B->okey);
+            free(B->rref);
             free(B->vpos);
             free(B->vnrm);
             free(B->tri);
         }
-        free(B->rref);
         free(B->octmem);
         lb__cplan_free(&B->plan);
     }
