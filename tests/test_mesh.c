@@ -722,14 +722,21 @@ static void test_no_self_intersections_features(void **state) {
 /* Simplified (features and simplify = 0.25 cells, the moves the largest
  * tolerance here allows): the papers' scenes and the sharp shapes still
  * free of self-intersections, closed and manifold, and fewer triangles. */
+/* Under the sanitizers (LB_TEST_SANITIZERS) at 64 cells only: the memory
+ * checks see the same code there, and the 128-cell geometry is the
+ * Release build's check (the simplification at 128 took 90 s of ASan's). */
+#ifndef LB_TEST_SANITIZERS
+#define LB_TEST_SANITIZERS 0
+#endif
 static void test_no_self_intersections_simplify(void **state) {
     (void)state;
     const unsigned res[2] = {64, 128};
+    const int nres = LB_TEST_SANITIZERS ? 1 : 2;
     size_t checked = 0, before = 0, after = 0;
     for (size_t s = 0; s < nscenes + NSHARP; ++s) {
         char path[1100];
         if (!case_path(s, 1, path, sizeof path)) continue;
-        for (int r = 0; r < 2; ++r) {
+        for (int r = 0; r < nres; ++r) {
             built A, B;
             build_file_s(path, res[r], LB_MESH_FEATURES, 0, 0.0, &A);
             build_file_s(path, res[r], LB_MESH_FEATURES, 0, 0.25, &B);
@@ -754,7 +761,7 @@ static void test_no_self_intersections_simplify(void **state) {
     }
     fprintf(stderr, "  %zu nearby triangle pairs tested; %zu triangles simplified to %zu\n",
             checked, before, after);
-    assert_true(checked > 100000);
+    assert_true(checked > (nres == 2 ? 100000u : 20000u));
 }
 
 /* ---- progress, cancel, bad options ---- */
