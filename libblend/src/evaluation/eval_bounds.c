@@ -332,6 +332,16 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                     if (mn ? a.lo < o.lo : a.lo > o.lo) o.lo = a.lo;
                     if (mn ? a.hi < o.hi : a.hi > o.hi) o.hi = a.hi;
                 }
+                if (child) {
+                    /* among the parent's arguments, as lb__cull_select does:
+                     * an argument whose interval lies wholly beyond the
+                     * extreme of another's is never selected in the box, so
+                     * the kept ones give the same bits (o is unchanged) */
+                    uint16_t *act = child->act + in->aoff, na = 0;
+                    for (uint16_t j = 0; j < pn; ++j)
+                        if (mn ? !(x[pa[j]].lo > o.hi) : !(x[pa[j]].hi < o.lo)) act[na++] = pa[j];
+                    child->nact[i] = na;
+                }
             } else {
                 /* cull among the parent's arguments, as cull() does */
                 const lb__op *n = in->op;
@@ -354,7 +364,6 @@ void lb__bounds_pass_sub(const lb_evaluator *ev, const lb__plan *parent, const d
                     child->nact[i] = na;
                 }
             }
-            if (child && in->fast == LB__FAST_MINMAX) inherit_args(child, parent, in, i);
         } else {
             all_args_bounds(ev, in, bc, br, R, &o);
             if (child) inherit_args(child, parent, in, i);
