@@ -12,7 +12,8 @@ and in full with lb_mesh_create, on 1 or 2 threads, with and without sharp
 features and corner normals; positions, normals, triangles and corner
 normals must be the same bytes. Then fixed cases: a 27-sphere lattice with
 one sphere moved (most blocks taken from the cache, and the same bytes), a
-local union next to a sphere that moves, a sphere moved into the block
+CSG min of 125 spheres with one moved, a local union next to a sphere that
+moves, a sphere moved into the block
 after an unchanged one (the rule's neighbours), another resolution and a
 cancelled run (the cache stays as it was: the next run takes every block
 from it).
@@ -228,10 +229,24 @@ for res, bar in ((64, 0.5), (128, 0.8)):
     check(reused >= bar * blocks, "lattice at %d: only %d of %d blocks reused" % (
         res, reused, blocks))
 
+# a CSG min of 125 spheres, one moved: min drops, in a block's plan, the
+# arguments never selected there
+def csg(b):
+    return {"format": "libblend-scene", "version": 1, "convention": "zero",
+            "root": {"type": "min", "args": [
+                {"type": "sphere", "center": [-1.2 + 0.6 * (q % 5), -1.2 + 0.6 * (q // 5 % 5),
+                                              -1.2 + 0.6 * (q // 25)], "radius": 0.25}
+                for q in range(124)] + [{"type": "sphere", "center": b, "radius": 0.25}]}}
+
+
+_, st = fixed([csg([1.2, 1.2, 1.2]), csg([1.24, 1.2, 1.2])], "CSG min", resolution=128,
+              threads=2)
+print("CSG min of 125 spheres, one moved: %d of %d blocks from the cache" % (st[1][1], st[1][0]))
+check(st[1][1] >= 0.8 * st[1][0], "CSG min: only %d of %d blocks reused" % (st[1][1], st[1][0]))
+
 # a local union (its curves' blocks) beside a sphere that moves, under a
-# blend whose box passes drop the sphere far from it (min and max keep every
-# argument in a block's plan: a CSG min would be remeshed whole); with
-# features
+# blend whose box passes drop the sphere far from it (a local union keeps
+# both children in every plan); with features
 lu = {"format": "libblend-scene", "version": 1, "convention": "zero",
       "bounds": {"min": [-2, -2, -2], "max": [2, 2, 2]},
       "root": {"type": "displacement", "op": "union", "r": 0.1, "p": 2, "m": 1, "args": [
