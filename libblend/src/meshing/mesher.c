@@ -680,6 +680,16 @@ static int tab_fit(mstate *S, size_t n) {
     return 1;
 }
 
+/* Block B's output arrays, unless the cache's (pointers left as they are). */
+static void output_free(lb__block *B) {
+    if (B->borrowed) return;
+    free(B->okey);
+    free(B->rref);
+    free(B->vpos);
+    free(B->vnrm);
+    free(B->tri);
+}
+
 /* Block bi's output appended to the mesh, then freed. 0 on failure (S->s). */
 static int merge_block(mstate *S, lb__block *B, size_t bi) {
     lb_mesh *M = S->M;
@@ -789,13 +799,7 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     }
     /* merged: the block's copy goes (its memory serves the next blocks);
      * one taken from the cache stays there */
-    if (!B->borrowed) {
-        free(B->okey);
-        free(B->rref);
-        free(B->vpos);
-        free(B->vnrm);
-        free(B->tri);
-    }
+    output_free(B);
     B->okey = NULL;
     B->rref = NULL;
     B->vpos = B->vnrm = NULL;
@@ -1385,13 +1389,7 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     free(R.want);
     for (size_t i = 0; i < R.nblocks; ++i) {
         lb__block *B = &R.blocks[i];
-        if (!B->borrowed) {
-            free(B->okey);
-            free(B->rref);
-            free(B->vpos);
-            free(B->vnrm);
-            free(B->tri);
-        }
+        output_free(B);
         free(B->octmem);
         lb__cplan_free(&B->plan);
     }
