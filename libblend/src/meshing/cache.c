@@ -193,7 +193,6 @@ static uint64_t hash(const uint8_t *p, size_t n) {
  * h[i] its hash; bad[i]: it names an instruction without a match (equal
  * to none). */
 typedef struct recs {
-    size_t n;
     uint8_t *p;
     size_t *off;
     uint64_t *h;
@@ -212,7 +211,6 @@ static void recs_free(recs *R) {
  * ev's own indices). 0 when out of memory. */
 static int recs_make(const lb_evaluator *ev, const uint32_t *map, int args, recs *R) {
     buf b = {NULL, 0, 0, 0};
-    R->n = ev->n;
     R->off = malloc((ev->n + 1) * sizeof *R->off);
     R->h = malloc((ev->n ? ev->n : 1) * sizeof *R->h);
     R->bad = calloc(ev->n ? ev->n : 1, 1);
