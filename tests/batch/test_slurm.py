@@ -49,10 +49,28 @@ for c in (cluster, cluster2):
 subprocess.run(["bash", os.path.join(SRC, "scripts", "slurm-cluster.sh"), "stop", cluster2])
 
 
+def proc_stat(pid):
+    """(state letter, start time in clock ticks) of a process, or None"""
+    try:
+        with open("/proc/%s/stat" % pid) as f:
+            rest = f.read().rsplit(")", 1)[1].split()
+        return rest[0], rest[19]
+    except (OSError, IndexError):
+        return None
+
+
+def proc_state(pid, started):
+    """the state letter of the process pid that started at `started`, or
+    None when it is gone (or the pid now names another process)"""
+    st = proc_stat(pid)
+    return st[0] if st and st[1] == started else None
+
+
 def kill_mid_task(shard_log, task, shard):
     """Wait (up to 300 s) until the shard's log says the task started, then
     SIGKILL the array task's blendtool (its command line has `--shard
-    SHARD`). Returns (killed, the pids of its children at that moment)."""
+    SHARD`). Returns (killed, its children at that moment as (pid, start
+    time))."""
     deadline = time.time() + 300
     while time.time() < deadline:
         if os.path.exists(shard_log):
@@ -64,8 +82,8 @@ def kill_mid_task(shard_log, task, shard):
                                           capture_output=True, text=True).stdout.split():
                     try:
                         with open("/proc/%s/task/%s/children" % (pid, pid)) as f:
-                            kids += f.read().split()
-                    except OSError:
+                            kids += [(k, proc_stat(k)[1]) for k in f.read().split()]
+                    except (OSError, TypeError):
                         pass
                 k = subprocess.run(["pkill", "-KILL", "-f", "--", "--shard " + shard])
                 return k.returncode == 0, kids
@@ -191,9 +209,16 @@ try:
     out, err = p.communicate(timeout=600)
     check(killed and workers, "Blender job: array task 1 killed mid-render (its workers %s)" % workers)
     check(p.returncode != 0, "Blender job: sbatch --wait reports the kill: exit %d" % p.returncode)
-    time.sleep(1)
-    alive = [w for w in workers if os.path.exists("/proc/%s" % w)]
-    check(not alive, "the killed array task's Blender ended with it: %s alive" % alive)
+    # a SIGKILLed Blender may take a moment to unmap its memory on a loaded
+    # machine, and once dead it stays a zombie until whoever inherited it
+    # (slurmstepd or the container's init) reaps it: both count as ended
+    deadline = time.time() + 30
+    while True:
+        alive = [(w, proc_state(w, t)) for w, t in workers if proc_state(w, t) not in (None, "Z", "X")]
+        if not alive or time.time() > deadline:
+            break
+        time.sleep(0.2)
+    check(not alive, "the killed array task's Blender ended with it (30 s): %s alive" % alive)
     bout = os.path.join(dbk, "out")
     check(not os.path.exists(os.path.join(bout, "farm_0007.png")) and
           not os.path.exists(os.path.join(bout, ".libblend-manifest", "farm_0007.json")),
