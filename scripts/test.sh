@@ -51,9 +51,10 @@ trap - EXIT
 echo "== build-tsan (ThreadSanitizer: the tests that run threads)"
 cmake -S . -B build-tsan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_TSAN=ON \
   -DLIBBLEND_BENCH=OFF
-cmake --build build-tsan -j "$JOBS" --target test_threads test_scene_eval test_mesh
+cmake --build build-tsan -j "$JOBS" --target test_threads test_scene_eval test_mesh test_level_set
 TSAN_OPTIONS=halt_on_error=1 \
-  ctest --test-dir build-tsan --output-on-failure -R '^(test_threads|test_scene_eval|test_mesh_threaded)$'
+  ctest --test-dir build-tsan --output-on-failure \
+  -R '^(test_threads|test_scene_eval|test_mesh_threaded|test_level_set)$'
 
 echo "== build-fuzz (clang, libFuzzer, ASan + UBSan)"
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLIBBLEND_FUZZ=ON \

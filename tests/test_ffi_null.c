@@ -314,6 +314,24 @@ static lb_status c_mesh_cached(unsigned mask, int size, lb_error *err, int *hs) 
     lb_mesh_cache_free(cache);
     return s;
 }
+static lb_status c_level_set(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    lb_level_set_options o;
+    lb_level_set_options_init(NULL);
+    lb_level_set_options_init(&o);
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -2;
+        o.bmax[d] = 2;
+    }
+    o.resolution = 16;
+    o.threads = 1;
+    o.flags = LB_LEVEL_SET_FIELD | LB_LEVEL_SET_GRADIENT;
+    lb_level_set *ls = NULL;
+    lb_status s = lb_level_set_create(P(0, C.ev), P(1, &o), P(2, &ls), P(3, err));
+    lb_level_set_free(ls);
+    return s;
+}
 static lb_status c_mesh_cache_create(unsigned mask, int size, lb_error *err, int *hs) {
     (void)size;
     *hs = 1;
@@ -427,6 +445,7 @@ static const fn_case CASES[] = {
     {"lb_mesh_create", 4, 0x07, c_mesh},
     {"lb_mesh_create_cached", 5, 0x0b, c_mesh_cached},
     {"lb_mesh_cache_create", 2, 0x01, c_mesh_cache_create},
+    {"lb_level_set_create", 4, 0x07, c_level_set},
     {"lb_mesh_write / _stream", 4, 0x07, c_mesh_write},
     {"lb_mesh_edges", 5, 0x0f, c_mesh_edges},
     {"lb_mesh_velocities", 6, 0x19, c_velocities},

@@ -7,6 +7,7 @@
 #include "primitives.h"
 #include "scene.h"
 #include "mesh.h"
+#include "volume.h"
 #include "pov.h"
 #include "output.h"
 
