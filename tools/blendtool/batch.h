@@ -64,6 +64,11 @@ typedef struct job {
     int mesh_features;    /* LB_MESH_FEATURES (and corner normals in OBJ / GLB) */
     double mesh_simplify; /* lb_mesh_options.simplify, cells; 0 = off */
     int pov, pov_w, pov_h;
+    /* outputs.vdb: a narrow-band level set (voxel size, or voxels along the
+     * longest side; band in voxels; LB_LEVEL_SET_* extra grids) */
+    int vdb, vdb_res;
+    double vdb_voxel, vdb_band;
+    unsigned vdb_grids;
     int image, img_w, img_h, img_quality, img_alpha, img_fmt, img_antialias, img_mesh;
     /* the Blender renderer (blender: 1): engine, samples, seed, render threads (0: the
      * job's), motion blur shutter in frames (0: none) */
@@ -111,8 +116,11 @@ char *batch_anim_value(const axis *X, double frame);
 void batch_job_free(job *J);
 
 /* ---- batch_tasks.c: the task list, outputs, manifests and the log ---- */
-/* the output file names of task T (mesh, pov, image, in that order); their count */
-size_t batch_outputs_of(const job *J, const task *T, char out[3][600]);
+/* the most outputs one task writes */
+#define BATCH_MAX_OUTPUTS 4
+/* the output file names of task T (mesh, pov, vdb, image, in that order: the
+ * image last, for the contact sheet); their count */
+size_t batch_outputs_of(const job *J, const task *T, char out[BATCH_MAX_OUTPUTS][600]);
 /* a JSON-lines log event of kind_ (about T, or the job when T is NULL) */
 cJSON *batch_event(const char *kind_, const task *T);
 /* write e as one JSON line (when logging) and free it */

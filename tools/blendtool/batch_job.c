@@ -347,11 +347,59 @@ static int parse_renderer(job *J, const cJSON *im, long *mres) {
     return 0;
 }
 
+/* outputs.vdb: {"resolution": N | "voxel_size": H, "band": W, "grids": [...]} */
+static int parse_vdb(job *J, const cJSON *v) {
+    static const char *const vk[] = {"resolution", "voxel_size", "band", "grids", NULL};
+    if (!cJSON_IsObject(v))
+        return batch_bad(J, "$.outputs.vdb", "expected an object, found %s", lb__json_kind(v));
+    int rc = check_keys(J, v, "$.outputs.vdb", vk);
+    if (rc) return rc;
+    J->vdb = 1;
+    long r = LB_LEVEL_SET_DEFAULT_RESOLUTION;
+    if ((rc =
+             get_int(J, v, "resolution", "$.outputs.vdb", 1, LB_LEVEL_SET_MAX_VOXELS_PER_AXIS, &r)))
+        return rc;
+    J->vdb_res = (int)r;
+    const cJSON *h = cJSON_GetObjectItemCaseSensitive(v, "voxel_size");
+    if (h && cJSON_GetObjectItemCaseSensitive(v, "resolution"))
+        return batch_bad(J, "$.outputs.vdb.voxel_size",
+                         "given with resolution; allowed: one of them (the voxel size, or the "
+                         "voxels along the longest side)");
+    if (h && (!cJSON_IsNumber(h) || !(h->valuedouble > 0.0) || !isfinite(h->valuedouble)))
+        return batch_bad(J, "$.outputs.vdb.voxel_size", "%s; allowed: a positive number",
+                         cJSON_IsNumber(h) ? "out of range" : lb__json_kind(h));
+    J->vdb_voxel = h ? h->valuedouble : 0.0;
+    const cJSON *b = cJSON_GetObjectItemCaseSensitive(v, "band");
+    if (b && (!cJSON_IsNumber(b) || !(b->valuedouble >= 1.0) ||
+              !(b->valuedouble <= LB_LEVEL_SET_MAX_BAND)))
+        return batch_bad(J, "$.outputs.vdb.band", "%s; allowed: 1 to %g voxels",
+                         cJSON_IsNumber(b) ? "out of range" : lb__json_kind(b),
+                         LB_LEVEL_SET_MAX_BAND);
+    J->vdb_band = b ? b->valuedouble : LB_LEVEL_SET_DEFAULT_BAND;
+    const cJSON *g = cJSON_GetObjectItemCaseSensitive(v, "grids");
+    if (g && !cJSON_IsArray(g))
+        return batch_bad(J, "$.outputs.vdb.grids", "expected an array, found %s", lb__json_kind(g));
+    J->vdb_grids = 0;
+    const cJSON *it;
+    cJSON_ArrayForEach(it, g) {
+        if (cJSON_IsString(it) && !strcmp(it->valuestring, "value"))
+            J->vdb_grids |= LB_LEVEL_SET_FIELD;
+        else if (cJSON_IsString(it) && !strcmp(it->valuestring, "gradient"))
+            J->vdb_grids |= LB_LEVEL_SET_GRADIENT;
+        else if (!(cJSON_IsString(it) && !strcmp(it->valuestring, "surface")))
+            return batch_bad(J, "$.outputs.vdb.grids",
+                             "%s; allowed: \"surface\" (always written), \"value\", "
+                             "\"gradient\"",
+                             cJSON_IsString(it) ? it->valuestring : lb__json_kind(it));
+    }
+    return 0;
+}
+
 static int parse_outputs(job *J, const cJSON *o) {
-    static const char *const keys[] = {"mesh", "pov", "image", "contact_sheet", NULL};
+    static const char *const keys[] = {"mesh", "pov", "vdb", "image", "contact_sheet", NULL};
     if (!cJSON_IsObject(o) || !o->child)
         return batch_bad(J, "$.outputs",
-                         "expected an object with at least one of mesh, pov, image");
+                         "expected an object with at least one of mesh, pov, vdb, image");
     int rc = check_keys(J, o, "$.outputs", keys);
     if (rc) return rc;
     const cJSON *m = cJSON_GetObjectItemCaseSensitive(o, "mesh");
@@ -394,6 +442,8 @@ static int parse_outputs(job *J, const cJSON *o) {
                              LB_MESH_MAX_SIMPLIFY);
         J->mesh_simplify = sp ? sp->valuedouble : 0.0;
     }
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, "vdb");
+    if (v && (rc = parse_vdb(J, v))) return rc;
     const cJSON *p = cJSON_GetObjectItemCaseSensitive(o, "pov");
     if (p) {
         static const char *const pk[] = {"width", "height", NULL};

@@ -210,7 +210,7 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
     lb_status s = LB_OK;
     const int crc = bt_compile(CMD, J->scenes[T->scene], sc, &ev);
     if (crc) return crc;
-    char names[3][600], hexes[3][33];
+    char names[BATCH_MAX_OUTPUTS][600], hexes[BATCH_MAX_OUTPUTS][33];
     const size_t n = batch_outputs_of(J, T, names);
     cJSON *manifest = cJSON_CreateObject();
     cJSON_AddStringToObject(manifest, "identity", ident);
@@ -261,6 +261,32 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
                 rc = hashed_commit(full, &H, hexes[k]);
             }
         }
+        ++k;
+    }
+    if (!rc && J->vdb) {
+        snprintf(full, sizeof full, "%s/%s", J->outdir, names[k]);
+        lb_level_set_options o;
+        lb_level_set_options_init(&o);
+        o.resolution = (unsigned)J->vdb_res;
+        o.voxel_size = J->vdb_voxel;
+        o.band = J->vdb_band;
+        o.flags = J->vdb_grids;
+        o.threads = threads;
+        lb_level_set *ls = NULL;
+        unsigned char *bytes = NULL;
+        size_t len = 0;
+        if (!lb_scene_bounds(sc, o.bmin, o.bmax)) {
+            bt_error(CMD, "%s: the scene has no bounds; allowed: a scene with \"bounds\"",
+                     J->scenes[T->scene]);
+            rc = BT_EXIT_BAD_INPUT;
+        } else if ((s = lb_level_set_create(ev, &o, &ls, &e))) {
+            rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
+        } else if (!(rc = bt_vdb_bytes(CMD, J->scenes[T->scene], ls, scene_hash, T->sets, T->nsets,
+                                       &bytes, &len))) {
+            rc = hashed_bytes(full, bytes, len, hexes[k]);
+        }
+        free(bytes);
+        lb_level_set_free(ls);
         ++k;
     }
     if (!rc && J->image) {
@@ -383,7 +409,7 @@ int batch_contact_sheet(const job *J, size_t ntasks, logger *L) {
     for (size_t i = 0; i < ntasks && !rc; ++i) {
         task T;
         if ((rc = batch_make_task(J, i, &T))) break;
-        char names[3][600], full[8192];
+        char names[BATCH_MAX_OUTPUTS][600], full[8192];
         const size_t n = batch_outputs_of(J, &T, names);
         snprintf(full, sizeof full, "%s/%s", J->outdir, names[n - 1]);
         imgs[i] = batch_dupstr(full);

@@ -111,10 +111,11 @@ static const char *mesh_ext(lb_mesh_format f) {
 }
 
 /* the task's outputs, as file names inside the output folder */
-size_t batch_outputs_of(const job *J, const task *T, char out[3][600]) {
+size_t batch_outputs_of(const job *J, const task *T, char out[BATCH_MAX_OUTPUTS][600]) {
     size_t n = 0;
     if (J->mesh) snprintf(out[n++], 600, "%s.%s", T->name, mesh_ext(J->mesh_fmt));
     if (J->pov) snprintf(out[n++], 600, "%s.pov", T->name);
+    if (J->vdb) snprintf(out[n++], 600, "%s.vdb", T->name);
     if (J->image)
         snprintf(out[n++], 600, "%s.%s", T->name,
                  J->img_fmt == LBI_PNG8 || J->img_fmt == LBI_PNG16 ? "png" : "exr");
@@ -187,7 +188,7 @@ int batch_task_done(const job *J, const task *T, const char *ident) {
     const cJSON *id = cJSON_GetObjectItemCaseSensitive(m, "identity"),
                 *outs = cJSON_GetObjectItemCaseSensitive(m, "outputs");
     if (cJSON_IsString(id) && !strcmp(id->valuestring, ident) && cJSON_IsArray(outs)) {
-        char names[3][600];
+        char names[BATCH_MAX_OUTPUTS][600];
         const size_t n = batch_outputs_of(J, T, names);
         ok = (size_t)cJSON_GetArraySize(outs) == n;
         for (size_t i = 0; i < n && ok; ++i) {

@@ -245,6 +245,14 @@ typedef struct bt_imageio {
                         size_t *size, char *err, size_t errlen);
 } bt_imageio;
 
+/* A module of blendtool's (a C++ library behind a C interface, file
+ * "liblbNAME.so"): $env_var when set, else next to the executable (the build
+ * tree), else in the installed libdir relative to it. The dlopen handle, or
+ * NULL with "cannot load the WHAT (tried ...): why" in why (room: 3 paths
+ * and a message). */
+void *bt_module_open(const char *env_var, const char *file, const char *what, char *why,
+                     size_t whylen);
+
 /* The image functions, or NULL after printing why they cannot be loaded. */
 const bt_imageio *bt_imageio_get(const char *cmd);
 /* The same, silently: NULL with the reason in why. */
@@ -277,7 +285,28 @@ int bt_png_direct(const char *in, const lbi_meta *meta, size_t nmeta, unsigned c
 /* Is help requested anywhere in argv? */
 int bt_wants_help(int argc, char **argv);
 
+/* ---- OpenVDB files (cmd_vdb.c): the lbvdb module, loaded on first use ---- */
+
+#include "lbvdb.h"
+
+typedef struct bt_vdb {
+    int (*write_level_set)(const lb_level_set *ls, const lbv_meta *meta, size_t nmeta,
+                           const char *uuid_seed, unsigned char **data, size_t *size, char *err,
+                           size_t errlen);
+    const char *(*version)(void);
+} bt_vdb;
+/* The OpenVDB functions, or NULL after printing why they cannot be loaded. */
+const bt_vdb *bt_vdb_get(const char *cmd);
+/* The .vdb file of a level set (malloc'd bytes in *data), its grids carrying
+ * the scene's hash, libblend's version, the voxel size and band and the
+ * --set paths; an exit code, after printing why. */
+int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls,
+                 const uint64_t hash[2], const bt_set *sets, size_t nsets, unsigned char **data,
+                 size_t *size);
+/* "x0,y0,z0,x1,y1,z1" (commas or spaces) into bmin, bmax; 0, or -1 */
+int bt_parse_bounds(const char *text, double bmin[3], double bmax[3]);
+
 extern const bt_command bt_cmd_validate, bt_cmd_info, bt_cmd_eval, bt_cmd_mesh, bt_cmd_pov,
-    bt_cmd_render, bt_cmd_batch, bt_cmd_compare, bt_cmd_section;
+    bt_cmd_render, bt_cmd_batch, bt_cmd_compare, bt_cmd_section, bt_cmd_vdb;
 
 #endif

@@ -176,7 +176,7 @@ static int run_list(const job *J, const batch_opts *o, size_t lo, size_t hi) {
         rc = bt_load_scene_set(CMD, J->scenes[T.scene], T.sets, T.nsets, &sc, h);
         lb_scene_free(sc);
         if (!rc) {
-            char hex[33], names[3][600];
+            char hex[33], names[BATCH_MAX_OUTPUTS][600];
             bt_hash_hex(h, hex);
             const size_t n = batch_outputs_of(J, &T, names);
             printf("%zu\t%s\t%s\t", T.id, T.name, hex);
@@ -205,6 +205,7 @@ static int check_selection(job *J, const batch_opts *o, size_t lo, size_t hi) {
         }
         batch_task_free(&T);
     }
+    if (!rc && J->vdb && !bt_vdb_get(CMD)) rc = BT_EXIT_INTERNAL;
     if (!rc && J->image &&
         (rc = bt_image_plan_for(CMD, J->file, J->img_fmt, J->img_alpha, &J->img_plan)) == 0 &&
         J->sheet && !J->img_plan.io) {

@@ -31,7 +31,7 @@ static int progress(double f, void *user) {
     return 0;
 }
 
-static int parse_bounds(const char *text, double bmin[3], double bmax[3]) {
+int bt_parse_bounds(const char *text, double bmin[3], double bmax[3]) {
     double v[6];
     const char *p = text;
     for (int i = 0; i < 6; ++i) {
@@ -92,7 +92,7 @@ static int parse_args(int argc, char **argv, mesh_args *A) {
             }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--bounds", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
-            if (parse_bounds(val, A->o.bmin, A->o.bmax)) {
+            if (bt_parse_bounds(val, A->o.bmin, A->o.bmax)) {
                 bt_error(CMD, "--bounds %s: expected six numbers \"x0,y0,z0,x1,y1,z1\"", val);
                 return BT_EXIT_BAD_INPUT;
             }

@@ -23,10 +23,10 @@
 static bt_imageio api; /* one process, loaded once */
 static int loaded;
 
-const bt_imageio *bt_imageio_try(char *why, size_t whylen) {
-    if (loaded) return &api;
+void *bt_module_open(const char *env_var, const char *file, const char *what, char *why,
+                     size_t whylen) {
     char path[PATH_MAX + 64];
-    const char *env = getenv("LIBBLEND_IMAGEIO");
+    const char *env = getenv(env_var);
     void *h = NULL;
     char tried[3 * (PATH_MAX + 64)] = "";
     if (env && *env) {
@@ -38,16 +38,19 @@ const bt_imageio *bt_imageio_try(char *why, size_t whylen) {
      * libdir relative to it */
     const int have_self = !h && bt_self_dir(self, sizeof self) == 0;
     for (int k = 0; k < 2 && !h && have_self; ++k) {
-        snprintf(path, sizeof path,
-                 k ? "%s/" LIBBLEND_IMAGEIO_REL "/liblbimageio.so" : "%s/liblbimageio.so", self);
+        snprintf(path, sizeof path, k ? "%s/" LIBBLEND_IMAGEIO_REL "/%s" : "%s/%s", self, file);
         h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
         size_t l = strlen(tried);
         snprintf(tried + l, sizeof tried - l, "%s%s", l ? ", " : "", path);
     }
-    if (!h) {
-        snprintf(why, whylen, "cannot load the image module (tried %s): %s", tried, dlerror());
-        return NULL;
-    }
+    if (!h) snprintf(why, whylen, "cannot load the %s (tried %s): %s", what, tried, dlerror());
+    return h;
+}
+
+const bt_imageio *bt_imageio_try(char *why, size_t whylen) {
+    if (loaded) return &api;
+    void *h = bt_module_open("LIBBLEND_IMAGEIO", "liblbimageio.so", "image module", why, whylen);
+    if (!h) return NULL;
     api.convert = (int (*)(const char *, lbi_format, int, const lbi_meta *, size_t,
                            unsigned char **, size_t *, char *, size_t))dlsym(h, "lbi_convert");
     api.contact_sheet = (int (*)(const char *const *, const char *const *, size_t, int, int, int,
@@ -60,9 +63,8 @@ const bt_imageio *bt_imageio_try(char *why, size_t whylen) {
                  size_t, unsigned char **, size_t *, char *, size_t))dlsym(h, "lbi_write_pixels");
     if (!api.convert || !api.contact_sheet || !api.compare || !api.write_pixels) {
         snprintf(why, whylen,
-                 "the image module %s lacks its functions (not the one built "
-                 "with this blendtool)",
-                 tried);
+                 "the image module liblbimageio.so lacks its functions (not the one built "
+                 "with this blendtool)");
         dlclose(h);
         return NULL;
     }

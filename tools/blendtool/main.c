@@ -9,9 +9,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static const bt_command *const COMMANDS[] = {&bt_cmd_validate, &bt_cmd_info,    &bt_cmd_eval,
-                                             &bt_cmd_mesh,     &bt_cmd_pov,     &bt_cmd_render,
-                                             &bt_cmd_batch,    &bt_cmd_compare, &bt_cmd_section};
+static const bt_command *const COMMANDS[] = {
+    &bt_cmd_validate, &bt_cmd_info,  &bt_cmd_eval,    &bt_cmd_mesh,    &bt_cmd_pov,
+    &bt_cmd_render,   &bt_cmd_batch, &bt_cmd_compare, &bt_cmd_section, &bt_cmd_vdb};
 #define NCOMMANDS (sizeof COMMANDS / sizeof COMMANDS[0])
 
 int bt_exit_for(lb_status s) {
