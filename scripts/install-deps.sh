@@ -23,6 +23,8 @@ PACKAGES=(
   time                       # tests: GNU time measures blendtool's peak memory (input limits)
   gcc-mingw-w64-x86-64       # the Windows DLL, cross-compiled (cmake/mingw-w64-x86_64.cmake)
   wine64                     # tests: the Windows build's test programs (scripts/wine-run.sh)
+  libopenvdb-dev             # blendtool vdb: narrow-band level sets written by OpenVDB (tools/vdb, C++)
+  python3-openvdb            # tests: the written .vdb files read back by OpenVDB's own binding
 )
 
 

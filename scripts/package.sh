@@ -8,7 +8,8 @@
 #                                         (Preferences > Add-ons > Install)
 #   libblend-sdk-VERSION-linux-x64.tar.gz blendtool, libblend.so/.a, headers,
 #                                         pkg-config and CMake files,
-#                                         libblend.inc, the image module;
+#                                         libblend.inc, the image and
+#                                         OpenVDB modules;
 #                                         relocatable
 #   libblend-sdk-VERSION-windows-x64.zip  libblend.dll, its import library,
 #                                         libblend.a, headers, CMake files

@@ -130,6 +130,19 @@ on_node "$nb" render default.json -o node.exr --width 8 --height 6 >/dev/null \
   2>"$tmp/node-exr.log" && fail "an EXR render without OpenImageIO succeeded"
 grep -q "OpenEXR needs the image module" "$tmp/node-exr.log" || fail "no clear message for EXR on the node"
 [ ! -e "$tmp/farm node/node.exr" ] || fail "the refused EXR render left a file"
+# no OpenVDB on the node: blendtool vdb says what to install, exit 1, no file
+on_node "$nb" vdb default.json -o node.vdb --resolution 16 >/dev/null 2>"$tmp/node-vdb.log" &&
+  fail "blendtool vdb without OpenVDB succeeded"
+grep -q "cannot load the OpenVDB module.*install OpenVDB 10" "$tmp/node-vdb.log" ||
+  { cat "$tmp/node-vdb.log" >&2; fail "no clear message for vdb on the node"; }
+[ ! -e "$tmp/farm node/node.vdb" ] || fail "the refused vdb left a file"
+# here (OpenVDB installed) the SDK's blendtool finds its own module at
+# lib/libblend/liblbvdb.so; OpenVDB reads the level set back
+env -u LIBBLEND_VDB "$bt" vdb "$src/scenes/default.json" -o "$tmp/sdk.vdb" --resolution 16 -q ||
+  fail "the SDK's blendtool vdb failed here"
+/usr/bin/python3 -c 'import sys, pyopenvdb as v; g = v.read(sys.argv[1], "surface")
+assert g.gridClass == v.GridClass.LEVEL_SET and g.activeVoxelCount() > 100' "$tmp/sdk.vdb" ||
+  fail "the SDK's .vdb is not a level set OpenVDB reads"
 # what the node wrote, read here by OpenImageIO: the libblend metadata, no
 # time stamp, and the pixels of this machine's render (through the image
 # module) within a small threshold (Debian 11 has POV-Ray 3.7.0.8, here 3.7.0.10)
@@ -142,7 +155,7 @@ done
 grep -qi "DateTime\|Render Date\|Software" <<<"$info" && fail "the node's PNG keeps POV-Ray's time stamp"
 "$bt" compare "$tmp/here.png" "$tmp/farm node/node.png" --fail 0.02 --fail-percent 0.5 ||
   fail "the node's image differs from this machine's"
-echo "linux sdk on a bare Debian 11 node (glibc 2.31, POV-Ray, no OpenImageIO): validate, the same mesh, render ($newest)"
+echo "linux sdk on a bare Debian 11 node (glibc 2.31, POV-Ray, no OpenImageIO or OpenVDB): validate, the same mesh, render, vdb refused ($newest); the SDK's vdb here"
 
 # the legacy zip in Blender 3.4, as a user installs it
 env BLENDER_USER_SCRIPTS="$tmp/b3-user" PYTHONDONTWRITEBYTECODE=1 blender -b --factory-startup \
