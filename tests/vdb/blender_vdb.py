@@ -7,7 +7,7 @@ with libblend's mesh; imports an animated job's files as one sequence and
 checks Blender steps through its frames.
 
 usage: blender -b --factory-startup --python-exit-code 1 --python blender_vdb.py --
-       LEVEL_SET.vdb SEQUENCE_DIR OUT.json
+       LEVEL_SET.vdb BLENDER_CENTRED.vdb SEQUENCE_DIR OUT.json
 """
 import json
 import os
@@ -16,7 +16,7 @@ import sys
 import bpy
 
 argv = sys.argv[sys.argv.index("--") + 1:]
-vdb_path, seq_dir, out_path = argv
+vdb_path, blender_path, seq_dir, out_path = argv
 res = {"version": bpy.app.version_string}
 
 
@@ -29,40 +29,46 @@ def imported(filepath, files):
     return new[0]
 
 
-vol_obj = imported(vdb_path, [os.path.basename(vdb_path)])
-vol = vol_obj.data
-vol.grids.load()
-res["grids"] = [{"name": g.name, "type": g.data_type, "channels": g.channels} for g in vol.grids]
-res["load_error"] = vol.grids.error_message
-res["is_sequence"] = vol.is_sequence
+def volume_to_mesh(path):
+    """import path as a Volume, then Volume to Mesh at the grid's own
+    resolution, isovalue 0 (the level set's surface)"""
+    vol_obj = imported(path, [os.path.basename(path)])
+    vol = vol_obj.data
+    vol.grids.load()
+    out = {"grids": [{"name": g.name, "type": g.data_type, "channels": g.channels}
+                     for g in vol.grids],
+           "load_error": vol.grids.error_message, "is_sequence": vol.is_sequence}
+    me = bpy.data.meshes.new("v2m")
+    mesh_obj = bpy.data.objects.new("v2m", me)
+    bpy.context.scene.collection.objects.link(mesh_obj)
+    mod = mesh_obj.modifiers.new("v2m", "VOLUME_TO_MESH")
+    mod.object = vol_obj
+    mod.grid_name = "surface"
+    mod.resolution_mode = "GRID"
+    mod.threshold = 0.0
+    mod.adaptivity = 0.0
+    dg = bpy.context.evaluated_depsgraph_get()
+    ev = mesh_obj.evaluated_get(dg)
+    m = ev.to_mesh()
+    out["vertices"] = [tuple(v.co) for v in m.vertices]
+    # closedness as Blender sees it: every edge in exactly two faces
+    count = {}
+    for p in m.polygons:
+        vs = list(p.vertices)
+        for a, b in zip(vs, vs[1:] + vs[:1]):
+            k = (min(a, b), max(a, b))
+            count[k] = count.get(k, 0) + 1
+    out["faces"] = len(m.polygons)
+    # as triangles (fans), for the distance to the surface
+    out["triangles"] = [(p.vertices[0], p.vertices[k], p.vertices[k + 1])
+                        for p in m.polygons for k in range(1, len(p.vertices) - 1)]
+    out["open_edges"] = sum(1 for c in count.values() if c != 2)
+    ev.to_mesh_clear()
+    return out
 
-# Volume to Mesh at the grid's own resolution, isovalue 0 (the level set's surface)
-me = bpy.data.meshes.new("v2m")
-mesh_obj = bpy.data.objects.new("v2m", me)
-bpy.context.scene.collection.objects.link(mesh_obj)
-mod = mesh_obj.modifiers.new("v2m", "VOLUME_TO_MESH")
-mod.object = vol_obj
-mod.grid_name = "surface"
-mod.resolution_mode = "GRID"
-mod.threshold = 0.0
-mod.adaptivity = 0.0
-dg = bpy.context.evaluated_depsgraph_get()
-ev = mesh_obj.evaluated_get(dg)
-m = ev.to_mesh()
-res["vertices"] = [tuple(v.co) for v in m.vertices]
-# closedness as Blender sees it: every edge in exactly two faces
-count = {}
-for p in m.polygons:
-    vs = list(p.vertices)
-    for a, b in zip(vs, vs[1:] + vs[:1]):
-        k = (min(a, b), max(a, b))
-        count[k] = count.get(k, 0) + 1
-res["faces"] = len(m.polygons)
-# as triangles (fans), for the distance to the surface
-res["triangles"] = [(p.vertices[0], p.vertices[k], p.vertices[k + 1])
-                    for p in m.polygons for k in range(1, len(p.vertices) - 1)]
-res["open_edges"] = sum(1 for c in count.values() if c != 2)
-ev.to_mesh_clear()
+
+res["openvdb"] = volume_to_mesh(vdb_path)
+res["blender"] = volume_to_mesh(blender_path)
 
 # an animated job's files: one Volume object, a sequence of as many frames
 files = sorted(f for f in os.listdir(seq_dir) if f.endswith(".vdb"))

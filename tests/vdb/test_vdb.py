@@ -22,8 +22,9 @@ an animated job's files as one sequence).
 - Blender: the grid imported as a Volume; Volume to Mesh at the grid's
   resolution closed, and OpenVDB's mesh moved by half a voxel on each axis
   (Blender's placement of voxel centres), so within one voxel of libblend's
-  mesh once that is undone; an animated job's vdb files load as one
-  sequence
+  mesh once that is undone; written with --voxel-centres blender, Blender's
+  Volume to Mesh as Blender shows it is within one voxel of libblend's
+  mesh; an animated job's vdb files load as one sequence
 
 usage: test_vdb.py BLENDTOOL SOURCE_DIR WORK_DIR [BLENDER]
 """
@@ -191,7 +192,7 @@ ver = subprocess.run([BT, "--version"], capture_output=True, text=True).stdout
 md = S.metadata
 check(md.get("libblend:version", "?") in ver, "libblend:version %r in %r" % (md.get("libblend:version"), ver))
 check(len(md.get("libblend:scene_hash", "")) == 32, "libblend:scene_hash: %r" % md.get("libblend:scene_hash"))
-check(md.get("libblend:level_set") == "voxel_size %.17g band 3" % h,
+check(md.get("libblend:level_set") == "voxel_size %.17g band 3 voxel_centres openvdb" % h,
       "libblend:level_set: %r" % md.get("libblend:level_set"))
 check(md.get("libblend:parameters") == "", "no parameters: %r" % md.get("libblend:parameters"))
 
@@ -279,7 +280,8 @@ for args, want in ((["--band", "0.5"], "1 to 32"), (["--band", "33"], "1 to 32")
                    (["--voxel-size", "1e-4"], "at most 8192 voxels per axis"),
                    (["--voxel-size", "-1"], "positive"), (["--grids", "density"], "value, gradient"),
                    (["--resolution", "8", "--voxel-size", "0.1"], "one of them"),
-                   (["--bounds", "1,1,1,0,0,0"], "not below")):
+                   (["--bounds", "1,1,1,0,0,0"], "not below"),
+                   (["--voxel-centres", "middle"], "openvdb")):
     r = bt("vdb", SCENE, "-o", bad_out, *args)
     check(r.returncode == 2 and want in r.stderr and not os.path.exists(bad_out),
           "%s: exit 2 with %r and no file: exit %d, %s" % (args, want, r.returncode, r.stderr.strip()))
@@ -310,6 +312,7 @@ check(open(one, "rb").read() == open(os.path.join(jd, "out", "orbit_0001.vdb"), 
       "frame 1 of the job is byte for byte blendtool vdb with the frame's value")
 for bad_vdb, where in (({"band": 0.5}, "$.outputs.vdb.band"), ({"resolution": 9000}, "$.outputs.vdb"),
                        ({"grids": ["density"]}, "$.outputs.vdb.grids"),
+                       ({"voxel_centres": "houdini"}, "$.outputs.vdb.voxel_centres"),
                        ({"resolution": 8, "voxel_size": 0.1}, "$.outputs.vdb.voxel_size")):
     bj = dict(job, outputs={"vdb": bad_vdb}, output_dir="bad-out")
     bf = os.path.join(jd, "bad.json")
@@ -343,17 +346,29 @@ check(len(OV) > 1000 and np.all(ecount == 2) and max(o1, o2) <= h,
       "%.3f, %.3f voxels" % (np.count_nonzero(ecount != 2), o1 / h, o2 / h))
 print("OpenVDB's volumeToMesh: %d vertices, Hausdorff to libblend's mesh %.3f / %.3f voxels" %
       (len(OV), o1 / h, o2 / h))
+# the same grid placed for Blender: the transform moved by -h/2 on each axis
+bout = path("spheres-blender.vdb")
+r = bt("vdb", SCENE, "-o", bout, "--resolution", str(RES), "--voxel-centres", "blender", "-q")
+Sb = read(bout)[0]["surface"]
+check(r.returncode == 0 and np.allclose(Sb.transform.indexToWorld((0, 0, 0)), (-h / 2,) * 3, atol=1e-12)
+      and np.allclose(Sb.transform.indexToWorld((2, 0, 0)), (2 * h - h / 2, -h / 2, -h / 2), atol=1e-12)
+      and Sb.metadata["libblend:level_set"].endswith("voxel_centres blender")
+      and S.metadata["libblend:level_set"].endswith("voxel_centres openvdb"),
+      "--voxel-centres blender: voxel (i, j, k) at ((i - 1/2) h, ...): %s %s" %
+      (r.stderr, Sb.metadata.get("libblend:level_set")))
 root = ["bash", os.path.join(SRC, "scripts", "debian-root.sh"), "trixie-blender4", "run", WORK, SRC, "--"]
 for label, cmd in (("Blender 3.4", [BLENDER]), ("Blender 4.3", root + ["blender"])):
     res = path("blender-%s.json" % label[-3:])
     r = subprocess.run(cmd + ["-b", "--factory-startup", "--python-exit-code", "1", "--python",
-                              os.path.join(HERE, "blender_vdb.py"), "--", out,
+                              os.path.join(HERE, "blender_vdb.py"), "--", out, bout,
                               os.path.join(jd, "out"), res],
                        capture_output=True, text=True, timeout=600)
     check(r.returncode == 0 and os.path.exists(res), "%s ran: %s" % (label, r.stdout[-800:] + r.stderr[-800:]))
     if not os.path.exists(res):
         continue
     R = json.load(open(res))
+    RB = R["blender"]
+    R.update(R.pop("openvdb"))
     names = [(x["name"], x["type"]) for x in R["grids"]]
     check(("surface", "FLOAT") in names and not R["load_error"],
           "%s imports the grids: %s %r" % (label, names, R["load_error"]))
@@ -378,6 +393,18 @@ for label, cmd in (("Blender 3.4", [BLENDER]), ("Blender 4.3", root + ["blender"
         print("%s: Volume to Mesh %d vertices, Hausdorff to libblend's mesh %.3f / %.3f voxels "
               "(%.3f / %.3f with Blender's half-voxel placement)" %
               (label, len(BV), h1 / h, h2 / h, r1 / h, r2 / h))
+    # written with --voxel-centres blender, Blender's own Volume to Mesh as
+    # Blender shows it is within one voxel of libblend's mesh
+    XV, XF = np.array(RB["vertices"]), np.array(RB["triangles"], dtype=np.int64)
+    check(len(XV) > 1000 and RB["open_edges"] == 0 and not RB["load_error"],
+          "%s, --voxel-centres blender: Volume to Mesh closed: %d vertices, %d open edges" %
+          (label, len(XV), RB["open_edges"]))
+    if len(XV):
+        x1, x2 = to_mesh(XV, LV, LF).max(), to_mesh(LV, XV, XF).max()
+        check(max(x1, x2) <= h, "%s, --voxel-centres blender: Volume to Mesh within one voxel of "
+              "libblend's mesh: %.3f, %.3f voxels" % (label, x1 / h, x2 / h))
+        print("%s, --voxel-centres blender: Volume to Mesh as Blender shows it, Hausdorff to "
+              "libblend's mesh %.3f / %.3f voxels" % (label, x1 / h, x2 / h))
     sq = R["sequence"]
     check(sq["is_sequence"] and sq["frame_duration"] == 4 and sq["frame_start"] == 1,
           "%s: the job's files are one sequence of 4 frames: %s" % (label, sq))

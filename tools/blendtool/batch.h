@@ -69,6 +69,7 @@ typedef struct job {
     int vdb, vdb_res;
     double vdb_voxel, vdb_band;
     unsigned vdb_grids;
+    int vdb_blender; /* voxel_centres "blender" */
     int image, img_w, img_h, img_quality, img_alpha, img_fmt, img_antialias, img_mesh;
     /* the Blender renderer (blender: 1): engine, samples, seed, render threads (0: the
      * job's), motion blur shutter in frames (0: none) */

@@ -349,7 +349,8 @@ static int parse_renderer(job *J, const cJSON *im, long *mres) {
 
 /* outputs.vdb: {"resolution": N | "voxel_size": H, "band": W, "grids": [...]} */
 static int parse_vdb(job *J, const cJSON *v) {
-    static const char *const vk[] = {"resolution", "voxel_size", "band", "grids", NULL};
+    static const char *const vk[] = {"resolution", "voxel_size",    "band",
+                                     "grids",      "voxel_centres", NULL};
     if (!cJSON_IsObject(v))
         return batch_bad(J, "$.outputs.vdb", "expected an object, found %s", lb__json_kind(v));
     int rc = check_keys(J, v, "$.outputs.vdb", vk);
@@ -376,6 +377,14 @@ static int parse_vdb(job *J, const cJSON *v) {
                          cJSON_IsNumber(b) ? "out of range" : lb__json_kind(b),
                          LB_LEVEL_SET_MAX_BAND);
     J->vdb_band = b ? b->valuedouble : LB_LEVEL_SET_DEFAULT_BAND;
+    const cJSON *vc = cJSON_GetObjectItemCaseSensitive(v, "voxel_centres");
+    if (vc && !(cJSON_IsString(vc) &&
+                (!strcmp(vc->valuestring, "openvdb") || !strcmp(vc->valuestring, "blender"))))
+        return batch_bad(J, "$.outputs.vdb.voxel_centres",
+                         "%s; allowed: \"openvdb\" (voxel (i, j, k) at (i h, j h, k h)) or "
+                         "\"blender\" (placed for Blender's half-voxel convention)",
+                         cJSON_IsString(vc) ? vc->valuestring : lb__json_kind(vc));
+    J->vdb_blender = vc && !strcmp(vc->valuestring, "blender");
     const cJSON *g = cJSON_GetObjectItemCaseSensitive(v, "grids");
     if (g && !cJSON_IsArray(g))
         return batch_bad(J, "$.outputs.vdb.grids", "expected an array, found %s", lb__json_kind(g));

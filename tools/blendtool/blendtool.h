@@ -290,7 +290,7 @@ int bt_wants_help(int argc, char **argv);
 #include "lbvdb.h"
 
 typedef struct bt_vdb {
-    int (*write_level_set)(const lb_level_set *ls, const lbv_meta *meta, size_t nmeta,
+    int (*write_level_set)(const lb_level_set *ls, double shift, const lbv_meta *meta, size_t nmeta,
                            const char *uuid_seed, unsigned char **data, size_t *size, char *err,
                            size_t errlen);
     const char *(*version)(void);
@@ -298,9 +298,11 @@ typedef struct bt_vdb {
 /* The OpenVDB functions, or NULL after printing why they cannot be loaded. */
 const bt_vdb *bt_vdb_get(const char *cmd);
 /* The .vdb file of a level set (malloc'd bytes in *data), its grids carrying
- * the scene's hash, libblend's version, the voxel size and band and the
- * --set paths; an exit code, after printing why. */
-int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls,
+ * the scene's hash, libblend's version, the voxel size, band and voxel
+ * centres and the --set paths; blender: voxel centres placed for Blender
+ * (the transform moved by half a voxel down each axis). An exit code, after
+ * printing why. */
+int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls, int blender,
                  const uint64_t hash[2], const bt_set *sets, size_t nsets, unsigned char **data,
                  size_t *size);
 /* "x0,y0,z0,x1,y1,z1" (commas or spaces) into bmin, bmax; 0, or -1 */

@@ -22,8 +22,8 @@ const bt_vdb *bt_vdb_get(const char *cmd) {
     void *h = bt_module_open("LIBBLEND_VDB", "liblbvdb.so", "OpenVDB module", why, sizeof why);
     if (h) {
         api.write_level_set =
-            (int (*)(const lb_level_set *, const lbv_meta *, size_t, const char *, unsigned char **,
-                     size_t *, char *, size_t))dlsym(h, "lbv_write_level_set");
+            (int (*)(const lb_level_set *, double, const lbv_meta *, size_t, const char *,
+                     unsigned char **, size_t *, char *, size_t))dlsym(h, "lbv_write_level_set");
         api.version = (const char *(*)(void))dlsym(h, "lbv_version");
         if (!api.write_level_set || !api.version) {
             snprintf(why, sizeof why,
@@ -61,7 +61,7 @@ static int parse_real(const char *opt, const char *val, double lo, double hi, co
 typedef struct vdb_args {
     const char *out, *scene_path;
     lb_level_set_options o;
-    int have_bounds, have_res, quiet;
+    int have_bounds, have_res, quiet, blender;
     bt_set sets[BT_MAX_SETS];
     size_t nsets;
 } vdb_args;
@@ -123,6 +123,17 @@ static int parse_args(int argc, char **argv, vdb_args *A) {
                 return BT_EXIT_BAD_INPUT;
             }
             A->have_bounds = 1;
+        } else if ((r = bt_option(CMD, argc, argv, &i, "--voxel-centres", &val))) {
+            if (r < 0) return BT_EXIT_BAD_INPUT;
+            if (strcmp(val, "openvdb") && strcmp(val, "blender")) {
+                bt_error(CMD,
+                         "--voxel-centres %s; allowed: openvdb (voxel (i, j, k) at (i H, j H, "
+                         "k H): OpenVDB, Houdini) or blender (placed so that Blender, which "
+                         "puts voxel centres half a voxel up, shows them there)",
+                         val);
+                return BT_EXIT_BAD_INPUT;
+            }
+            A->blender = !strcmp(val, "blender");
         } else if ((r = bt_option(CMD, argc, argv, &i, "--grids", &val))) {
             if (r < 0 || parse_grids(val, &A->o.flags)) return BT_EXIT_BAD_INPUT;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--threads", &val))) {
@@ -153,14 +164,15 @@ static int parse_args(int argc, char **argv, vdb_args *A) {
     return BT_EXIT_OK;
 }
 
-int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls,
+int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls, int blender,
                  const uint64_t hash[2], const bt_set *sets, size_t nsets, unsigned char **data,
                  size_t *size) {
     const bt_vdb *V = bt_vdb_get(cmd);
     if (!V) return BT_EXIT_INTERNAL;
     char hex[33], settings[160], params[4096], err[1024] = "";
     bt_hash_hex(hash, hex);
-    snprintf(settings, sizeof settings, "voxel_size %.17g band %g", ls->voxel_size, ls->band);
+    snprintf(settings, sizeof settings, "voxel_size %.17g band %g voxel_centres %s", ls->voxel_size,
+             ls->band, blender ? "blender" : "openvdb");
     size_t o = 0;
     params[0] = '\0';
     for (size_t i = 0; i < nsets && o + 1 < sizeof params; ++i) {
@@ -171,7 +183,7 @@ int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls
                               {"libblend:version", BT_VERSION},
                               {"libblend:level_set", settings},
                               {"libblend:parameters", params}};
-    if (V->write_level_set(ls, meta, 4, hex, data, size, err, sizeof err)) {
+    if (V->write_level_set(ls, blender ? -0.5 : 0.0, meta, 4, hex, data, size, err, sizeof err)) {
         bt_error(cmd, "%s: writing the level set failed: %s", scene_path, err);
         return BT_EXIT_INTERNAL;
     }
@@ -214,7 +226,8 @@ static int run(int argc, char **argv) {
         rc = bt_fail(CMD, A.scene_path, s, &e);
         goto done;
     }
-    if ((rc = bt_vdb_bytes(CMD, A.scene_path, ls, hash, A.sets, A.nsets, &bytes, &len))) goto done;
+    if ((rc = bt_vdb_bytes(CMD, A.scene_path, ls, A.blender, hash, A.sets, A.nsets, &bytes, &len)))
+        goto done;
     clock_gettime(CLOCK_MONOTONIC, &t1);
     if (fwrite(bytes, 1, len, w.f) != len) {
         bt_error(CMD, "%s: writing the level set failed (%s); nothing was written", A.out,
@@ -241,6 +254,7 @@ const bt_command bt_cmd_vdb = {
     "vdb", "the scene as an OpenVDB narrow-band level set (Blender, Houdini)",
     "usage: blendtool vdb SCENE -o OUT.vdb [--resolution N | --voxel-size H] [--band W]\n"
     "                     [--bounds x0,y0,z0,x1,y1,z1] [--grids value,gradient]\n"
+    "                     [--voxel-centres openvdb|blender]\n"
     "                     [--threads N] [--quiet] [--set PATH=VALUE]...\n\n"
     "Writes the scene's surface inside the region (the scene's bounds, or --bounds) as\n"
     "an OpenVDB level set: a float grid named \"surface\" of class level set, in scene\n"
@@ -254,6 +268,10 @@ const bt_command bt_cmd_vdb = {
     "  --resolution N  voxels along the region's longest side (default 128, at most 8192)\n"
     "  --voxel-size H  the voxel size instead of a resolution (at most 8192 voxels per axis)\n"
     "  --band W        the band's half width in voxels, 1 to 32 (default 3, OpenVDB's)\n"
+    "  --voxel-centres openvdb (default): voxel (i, j, k) at (i H, j H, k H), as OpenVDB\n"
+    "                  and Houdini read it; blender: the transform moved by -H/2 on each\n"
+    "                  axis, so that Blender (which puts voxel centres at index + 1/2)\n"
+    "                  shows the surface where it is\n"
     "  --grids LIST    extra grids on the band's voxels: value (the field f itself),\n"
     "                  gradient (grad f, a covariant vector grid)\n"
     "  --threads N     0 = one per CPU (default), 1 = single-threaded; the file is the\n"

@@ -21,8 +21,8 @@ void say(char *err, size_t errlen, const char *what) {
 }
 
 template <typename GridT, typename Fill>
-typename GridT::Ptr band_grid(const lb_level_set *ls, typename GridT::ValueType background,
-                              Fill fill) {
+typename GridT::Ptr band_grid(const lb_level_set *ls, double shift,
+                              typename GridT::ValueType background, Fill fill) {
     auto grid = GridT::create(background);
     auto &tree = grid->tree();
     for (size_t i = 0; i < ls->nleaves; ++i) {
@@ -38,7 +38,9 @@ typename GridT::Ptr band_grid(const lb_level_set *ls, typename GridT::ValueType 
                 leaf->setValueOff(n, v);
         }
     }
-    grid->setTransform(openvdb::math::Transform::createLinearTransform(ls->voxel_size));
+    auto xform = openvdb::math::Transform::createLinearTransform(ls->voxel_size);
+    if (shift != 0.0) xform->postTranslate(openvdb::Vec3d(shift * ls->voxel_size));
+    grid->setTransform(xform);
     return grid;
 }
 
@@ -84,9 +86,9 @@ extern "C" const char *lbv_version(void) {
     return openvdb::getLibraryVersionString();
 }
 
-extern "C" int lbv_write_level_set(const lb_level_set *ls, const lbv_meta *meta, size_t nmeta,
-                                   const char *uuid_seed, unsigned char **data, size_t *size,
-                                   char *err, size_t errlen) {
+extern "C" int lbv_write_level_set(const lb_level_set *ls, double shift, const lbv_meta *meta,
+                                   size_t nmeta, const char *uuid_seed, unsigned char **data,
+                                   size_t *size, char *err, size_t errlen) {
     *data = nullptr;
     *size = 0;
     try {
@@ -94,9 +96,10 @@ extern "C" int lbv_write_level_set(const lb_level_set *ls, const lbv_meta *meta,
         std::call_once(once, [] { openvdb::initialize(); });
         const float bg = ls->background;
         openvdb::GridPtrVec grids;
-        auto surface = band_grid<openvdb::FloatGrid>(ls, bg, [&](size_t i, openvdb::Index n, bool) {
-            return ls->values[i * LB_LEVEL_SET_LEAF_VOXELS + n];
-        });
+        auto surface =
+            band_grid<openvdb::FloatGrid>(ls, shift, bg, [&](size_t i, openvdb::Index n, bool) {
+                return ls->values[i * LB_LEVEL_SET_LEAF_VOXELS + n];
+            });
         surface->setName("surface");
         surface->setGridClass(openvdb::GRID_LEVEL_SET);
         // the flood fill gives the tiles outside the band their sign, and
@@ -109,8 +112,8 @@ extern "C" int lbv_write_level_set(const lb_level_set *ls, const lbv_meta *meta,
         restore_signs(*surface, ls);
         grids.push_back(surface);
         if (ls->fields) {
-            auto value =
-                band_grid<openvdb::FloatGrid>(ls, 0.0f, [&](size_t i, openvdb::Index n, bool on) {
+            auto value = band_grid<openvdb::FloatGrid>(
+                ls, shift, 0.0f, [&](size_t i, openvdb::Index n, bool on) {
                     return on ? ls->fields[i * LB_LEVEL_SET_LEAF_VOXELS + n] : 0.0f;
                 });
             value->setName("value");
@@ -119,8 +122,8 @@ extern "C" int lbv_write_level_set(const lb_level_set *ls, const lbv_meta *meta,
         }
         if (ls->gradients) {
             const openvdb::Vec3f zero(0.0f);
-            auto gradient =
-                band_grid<openvdb::Vec3SGrid>(ls, zero, [&](size_t i, openvdb::Index n, bool on) {
+            auto gradient = band_grid<openvdb::Vec3SGrid>(
+                ls, shift, zero, [&](size_t i, openvdb::Index n, bool on) {
                     const float *g = ls->gradients + (i * LB_LEVEL_SET_LEAF_VOXELS + n) * 3;
                     return on ? openvdb::Vec3f(g[0], g[1], g[2]) : zero;
                 });

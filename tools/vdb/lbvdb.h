@@ -30,8 +30,12 @@ typedef struct lbv_meta {
  * filled in from the band by OpenVDB's signed flood fill); with
  * ls->fields a float grid "value" (the field f on the band's voxels,
  * background 0) and with ls->gradients a vector grid "gradient"
- * (covariant, grad f on the band's voxels). uuid_seed: 32 hex digits. */
-int lbv_write_level_set(const lb_level_set *ls, const lbv_meta *meta, size_t nmeta,
+ * (covariant, grad f on the band's voxels). uuid_seed: 32 hex digits.
+ * shift: added to every voxel's world position, in voxels on each axis (0:
+ * voxel (i, j, k) at (i h, j h, k h), OpenVDB's and Houdini's reading;
+ * -0.5: where Blender, which puts a voxel's centre at index + 1/2, shows it
+ * at (i h, j h, k h)). */
+int lbv_write_level_set(const lb_level_set *ls, double shift, const lbv_meta *meta, size_t nmeta,
                         const char *uuid_seed, unsigned char **data, size_t *size, char *err,
                         size_t errlen);
 
