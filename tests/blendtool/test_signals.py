@@ -221,6 +221,11 @@ def main():
         checked += 1
         if not delivered or rc != 128 + sig or os.listdir(os.path.join(d, "out")):
             fail(f"eval waiting on stdin, {sig.name}: rc {rc}, delivered {delivered}: {err}")
+    # a level set: the C evaluation, then OpenVDB's C++ writer (dlopen'd)
+    case("vdb", lambda o: ["vdb", S2, "-o", o, "--resolution", "512", "--threads", "1",
+                           "--quiet"], "s2.vdb", False)
+    kill_case("vdb", lambda o: ["vdb", S2, "-o", o, "--resolution", "512", "--threads", "1",
+                                "--quiet"], "s2.vdb", False)
     for named in (False, True):
         kill_case("mesh", lambda o: ["mesh", S2, "-o", o, "--resolution", "288", "--quiet"],
                   "mesh.obj", named)
