@@ -131,10 +131,11 @@ int main(int argc, char **argv) {
         fwrite(img, 1, sizeof img, f);
         fclose(f);
         /* idiff: FAILURE when more than 1 % of the pixels differ by more than 0.5 */
-        snprintf(cmd, sizeof cmd, "idiff -v -fail 0.5 -failpercent 1 '%s' '%s' > '%s' 2>&1", png, ppm,
-                 log);
+        snprintf(cmd, sizeof cmd, "idiff -v -fail 0.5 -failpercent 1 '%s' '%s' > '%s' 2>&1", png,
+                 ppm, log);
         const int rc = system(cmd);
-        snprintf(cmd, sizeof cmd, "grep -E 'over 0.5|PASS|FAIL' '%s' | head -2 | tr '\\n' ' '", log);
+        snprintf(cmd, sizeof cmd, "grep -E 'over 0.5|PASS|FAIL' '%s' | head -2 | tr '\\n' ' '",
+                 log);
         fprintf(stderr, "  %-40s ", ent->d_name);
         fflush(stderr);
         if (system(cmd)) {
