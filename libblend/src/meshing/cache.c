@@ -35,209 +35,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../operators/registry.h"
+#include "../evaluation/records.h"
 
-#define NONE UINT32_MAX
-
-/* ---- records ---- */
-
-typedef struct buf {
-    uint8_t *p;
-    size_t n, cap;
-    int oom;
-} buf;
-
-static void put(buf *b, const void *x, size_t n) {
-    if (b->oom || !n) return;
-    if (b->n + n > b->cap) {
-        size_t c = b->cap ? b->cap : 1024;
-        while (c < b->n + n) c *= 2;
-        uint8_t *q = realloc(b->p, c);
-        if (!q) {
-            b->oom = 1;
-            return;
-        }
-        b->p = q;
-        b->cap = c;
-    }
-    memcpy(b->p + b->n, x, n);
-    b->n += n;
-}
-
-static void put_i(buf *b, long long v) {
-    put(b, &v, sizeof v);
-}
-
-static void put_d(buf *b, const double *v, size_t n) {
-    put(b, v, n * sizeof *v);
-}
-
-/* An argument: its match (map) or its own index (map NULL); 0 when it has
- * no match. */
-static int put_ref(buf *b, const uint32_t *map, uint32_t j) {
-    const uint32_t r = map ? map[j] : j;
-    put(b, &r, sizeof r);
-    return r != NONE;
-}
-
-static void put_curves(buf *b, const struct lb__curves *c) {
-    put_i(b, c != NULL);
-    if (!c) return;
-    put_i(b, (long long)c->nv);
-    put_i(b, (long long)c->ncomp);
-    put_i(b, (long long)c->nseg);
-    put_i(b, (long long)c->nnodes);
-    put_d(b, c->pts, 3 * c->nv);
-    for (size_t i = 0; i < c->ncomp; ++i) {
-        const lb__component *q = &c->comp[i];
-        put_i(b, (long long)q->first);
-        put_i(b, (long long)q->count);
-        put_i(b, q->closed);
-        const double v[] = {q->length, q->diameter, q->R, q->v1, q->v2, q->d1, q->d2, q->p, q->q};
-        put_d(b, v, sizeof v / sizeof *v);
-    }
-    put(b, c->seg, 2 * c->nseg * sizeof *c->seg);
-    put(b, c->segc, c->nseg * sizeof *c->segc);
-    for (size_t i = 0; i < c->nnodes; ++i) {
-        const bvh_node *q = &c->bvh[i];
-        put_d(b, q->lo, 3);
-        put_d(b, q->hi, 3);
-        put(b, &q->left, sizeof q->left);
-        put(b, &q->right, sizeof q->right);
-        put_i(b, q->leaf);
-    }
-    put_d(b, &c->rmax, 1);
-    put_d(b, &c->scene_size, 1);
-}
-
-/* Instruction i's record into b (from b->n on); 0 when an instruction it
- * names has no match (map) and so it has none either. Every field that
- * evaluation reads is written, field by field (no padding bytes);
- * registers, the exports' node identity, the plan offset (aoff) and the
- * messages' path are not. args: also its arguments (srci); without them
- * (a plan's own record) a plan compares its arguments by their places in
- * the plan. Bounding solids and cones (the instructions that bulge
- * elimination and local unions re-run) are always named. */
-static int record(const lb_evaluator *ev, uint32_t i, const uint32_t *map, int args, buf *b) {
-    const lb__instr *in = &ev->ins[i];
-    put_i(b, in->code);
-    put_i(b, in->identity);
-    put_i(b, in->fast);
-    put_i(b, in->mode);
-    put_d(b, &in->lip, 1);
-    put_d(b, &in->cost, 1);
-    put_d(b, in->ia, 3);
-    const lb_primitive *P = &in->prim;
-    put_i(b, P->kind);
-    put_i(b, P->kernel);
-    put_d(b, P->c, 3);
-    put_d(b, P->a, 3);
-    put_d(b, P->n, 3);
-    put_d(b, P->q, 3);
-    put_d(b, &P->s0, 1);
-    put_d(b, &P->s1, 1);
-    put_d(b, in->A.M, 9);
-    put_d(b, in->A.t, 3);
-    if (in->code != LB__I_OP) return 1;
-    const lb__op *o = in->op;
-    put_i(b, o->family);
-    put_i(b, o->op);
-    put_i(b, (long long)o->k);
-    const double *arr[3] = {o->r, o->p, o->m};
-    for (int a = 0; a < 3; ++a) {
-        put_i(b, arr[a] != NULL);
-        if (arr[a]) put_d(b, arr[a], o->k);
-    }
-    put_d(b, &o->shape, 1);
-    put_i(b, o->bulge);
-    const lb_bulge_params *bp = &o->bp;
-    put_d(b, bp->r, 2);
-    put_d(b, bp->p, 2);
-    put_d(b, &bp->conic_p, 1);
-    put_d(b, bp->m, 2);
-    put_d(b, &bp->omega, 1);
-    put_i(b, bp->flags);
-    const lb__local_params *lp = &o->lp;
-    put_i(b, lp->has_feature);
-    put_d(b, lp->feature, 2);
-    put_i(b, lp->has_limits);
-    put_d(b, lp->limits, 2);
-    put_d(b, &lp->radius, 1);
-    put_i(b, lp->feature_support);
-    const double lv[] = {lp->support, lp->exponent, lp->alpha[0], lp->alpha[1], lp->zero_scale};
-    put_d(b, lv, sizeof lv / sizeof *lv);
-    int ok = 1;
-    if (args)
-        for (size_t a = 0; a < o->k; ++a) ok &= put_ref(b, map, in->srci[a]);
-    put_i(b, in->srcb != NULL);
-    if (in->srcb)
-        for (size_t a = 0; a < o->k; ++a) ok &= put_ref(b, map, in->srcb[a]);
-    put_i(b, in->ncone[0]);
-    put_i(b, in->ncone[1]);
-    if (in->cone)
-        for (uint32_t q = 0; q < in->ncone[0] + in->ncone[1]; ++q)
-            ok &= put_ref(b, map, in->cone[q]);
-    put_curves(b, in->curves);
-    return ok;
-}
-
-/* FNV-1a over a record: for tables and quick rejection only (equality is
- * decided on the bytes) */
-static uint64_t hash(const uint8_t *p, size_t n) {
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-    return h;
-}
-
-/* A set of records, one per instruction: record i is p[off[i], off[i + 1]),
- * h[i] its hash; bad[i]: it names an instruction without a match (equal
- * to none). */
-typedef struct recs {
-    uint8_t *p;
-    size_t *off;
-    uint64_t *h;
-    uint8_t *bad;
-} recs;
-
-static void recs_free(recs *R) {
-    free(R->p);
-    free(R->off);
-    free(R->h);
-    free(R->bad);
-    memset(R, 0, sizeof *R);
-}
-
-/* ev's records (args: with arguments; map: names through it, else as
- * ev's own indices). 0 when out of memory. */
-static int recs_make(const lb_evaluator *ev, const uint32_t *map, int args, recs *R) {
-    buf b = {NULL, 0, 0, 0};
-    R->off = malloc((ev->n + 1) * sizeof *R->off);
-    R->h = malloc((ev->n ? ev->n : 1) * sizeof *R->h);
-    R->bad = calloc(ev->n ? ev->n : 1, 1);
-    if (!R->off || !R->h || !R->bad) {
-        recs_free(R);
-        return 0;
-    }
-    for (size_t i = 0; i < ev->n && !b.oom; ++i) {
-        R->off[i] = b.n;
-        R->bad[i] = !record(ev, (uint32_t)i, map, args, &b);
-        if (!b.oom) R->h[i] = hash(b.p + R->off[i], b.n - R->off[i]);
-    }
-    R->off[ev->n] = b.n;
-    R->p = b.p;
-    if (b.oom) {
-        recs_free(R);
-        return 0;
-    }
-    return 1;
-}
-
-/* Are record i of A and record j of B the same bytes? */
-static int recs_equal(const recs *A, size_t i, const recs *B, size_t j) {
-    const size_t la = A->off[i + 1] - A->off[i], lb = B->off[j + 1] - B->off[j];
-    return !A->bad[i] && !B->bad[j] && A->h[i] == B->h[j] && la == lb &&
-           !memcmp(A->p + A->off[i], B->p + B->off[j], la);
-}
+#define NONE LB__RNONE
 
 struct lb_mesh_cache {
     int valid;
@@ -248,7 +48,7 @@ struct lb_mesh_cache {
     /* the records of the evaluator last meshed (with and without
      * arguments), a table over the full ones */
     size_t nins;
-    recs full, self;
+    lb__recs full, self;
     uint32_t *tab; /* instruction + 1, 0: empty; tcap (a power of 2) slots */
     size_t tcap;
     lb__cblock *blocks; /* sorted by id */
@@ -267,7 +67,7 @@ struct lb__cmatch {
     const lb_evaluator *ev;
     int usable;
     uint32_t *deep, *same, *pos, *stamp, round;
-    recs cmp, self, full;
+    lb__recs cmp, self, full;
 };
 
 void lb__cmatch_free(lb__cmatch *M) {
@@ -276,9 +76,9 @@ void lb__cmatch_free(lb__cmatch *M) {
     free(M->same);
     free(M->pos);
     free(M->stamp);
-    recs_free(&M->cmp);
-    recs_free(&M->self);
-    recs_free(&M->full);
+    lb__recs_free(&M->cmp);
+    lb__recs_free(&M->self);
+    lb__recs_free(&M->full);
     free(M);
 }
 
@@ -295,17 +95,17 @@ lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usa
         M->same = malloc(n * sizeof *M->same);
         M->pos = malloc(n * sizeof *M->pos);
         M->stamp = calloc(n, sizeof *M->stamp);
-        ok = M->deep && M->same && M->pos && M->stamp && recs_make(ev, NULL, 1, &M->full) &&
-             recs_make(ev, NULL, 0, &M->self);
+        ok = M->deep && M->same && M->pos && M->stamp && lb__recs_make(ev, NULL, 1, 1, &M->full) &&
+             lb__recs_make(ev, NULL, 0, 1, &M->self);
     }
     if (ok && usable) {
         /* deep matches in tape order: an instruction's arguments come first */
-        buf b = {NULL, 0, 0, 0};
+        lb__rbuf b = {NULL, 0, 0, 0};
         for (size_t i = 0; i < ev->n && !b.oom; ++i) {
             M->deep[i] = M->same[i] = NONE;
             b.n = 0;
-            if (!record(ev, (uint32_t)i, M->deep, 1, &b) || b.oom) continue;
-            const uint64_t h = hash(b.p, b.n);
+            if (!lb__record(ev, (uint32_t)i, M->deep, 1, 1, &b) || b.oom) continue;
+            const uint64_t h = lb__rhash(b.p, b.n);
             for (size_t s = h & (C->tcap - 1); C->tab[s]; s = (s + 1) & (C->tcap - 1)) {
                 const uint32_t j = C->tab[s] - 1;
                 const size_t len = C->full.off[j + 1] - C->full.off[j];
@@ -318,7 +118,7 @@ lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usa
         }
         ok = !b.oom;
         free(b.p);
-        ok = ok && recs_make(ev, M->deep, 0, &M->cmp);
+        ok = ok && lb__recs_make(ev, M->deep, 0, 1, &M->cmp);
     }
     if (!ok) {
         lb__cmatch_free(M);
@@ -401,7 +201,7 @@ int lb__cache_same_plan(const lb_mesh_cache *C, lb__cmatch *M, const lb__cblock 
     for (uint32_t q = 0; q < P->nlist; ++q) {
         const uint32_t i = P->list[q], j = E->plan.list[q];
         if (M->same[i] == j) continue;
-        if (!recs_equal(&M->cmp, i, &C->self, j)) return 0;
+        if (!lb__recs_equal(&M->cmp, i, &C->self, j)) return 0;
         M->same[i] = j;
     }
     if (P->nact_total && memcmp(E->plan.act, P->act, P->nact_total * sizeof *P->act)) return 0;
@@ -527,8 +327,8 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
         lb__cmatch_free(M);
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create_cached: out of memory");
     }
-    recs_free(&C->full);
-    recs_free(&C->self);
+    lb__recs_free(&C->full);
+    lb__recs_free(&C->self);
     free(C->tab);
     C->full = M->full;
     C->self = M->self;
@@ -585,8 +385,8 @@ lb_status lb_mesh_cache_create(lb_mesh_cache **out, lb_error *err) {
 void lb_mesh_cache_free(lb_mesh_cache *C) {
     if (!C) return;
     blocks_free(C);
-    recs_free(&C->full);
-    recs_free(&C->self);
+    lb__recs_free(&C->full);
+    lb__recs_free(&C->self);
     free(C->tab);
     free(C);
 }
