@@ -314,6 +314,17 @@ static lb_status c_mesh_cached(unsigned mask, int size, lb_error *err, int *hs) 
     lb_mesh_cache_free(cache);
     return s;
 }
+/* against the evaluator itself as the previous one: every curve copied */
+static lb_status c_evaluator_reusing(unsigned mask, int size, lb_error *err, int *hs) {
+    (void)size;
+    *hs = 1;
+    lb_evaluator *ev = NULL;
+    size_t n = 0;
+    lb_status s =
+        lb_evaluator_create_reusing(P(0, C.scene), P(1, C.ev), P(2, &ev), P(3, &n), P(4, err));
+    lb_evaluator_free(ev);
+    return s;
+}
 static lb_status c_level_set(unsigned mask, int size, lb_error *err, int *hs) {
     (void)size;
     *hs = 1;
@@ -446,6 +457,7 @@ static const fn_case CASES[] = {
     {"lb_mesh_create_cached", 5, 0x0b, c_mesh_cached},
     {"lb_mesh_cache_create", 2, 0x01, c_mesh_cache_create},
     {"lb_level_set_create", 4, 0x07, c_level_set},
+    {"lb_evaluator_create_reusing", 5, 0x05, c_evaluator_reusing},
     {"lb_mesh_write / _stream", 4, 0x07, c_mesh_write},
     {"lb_mesh_edges", 5, 0x0f, c_mesh_edges},
     {"lb_mesh_velocities", 6, 0x19, c_velocities},

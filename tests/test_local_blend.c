@@ -581,8 +581,126 @@ static void test_compile_cost_linear(void **st) {
     assert_true(lat[0] > 0.0 && lat[1] / lat[0] <= pow(4.0, 1.2));
 }
 
+/* a ring of k spheres under one local union (the spread ring of
+ * ring_scene), sphere `moved` shifted by dx along x, the bounds grown by
+ * grow */
+static char *ring_edit(int k, const char *conv, int moved, double dx, double grow) {
+    const double rad = k * 0.7 / (2.0 * M_PI);
+    size_t cap = 256 + (size_t)k * 160, len = 0;
+    char *t = malloc(cap);
+    const int soft = !strcmp(conv, "soft");
+    len += (size_t)snprintf(t + len, cap - len,
+                            "{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": "
+                            "\"%s\", \"bounds\": {\"min\": [%g, %g, -1.5], \"max\": [%g, %g, 1.5]},"
+                            " \"root\": {\"type\": \"local_union\", \"args\": [",
+                            conv, -rad - 1.5 - grow, -rad - 1.5, rad + 1.5, rad + 1.5);
+    for (int i = 0; i < k; ++i)
+        len += (size_t)snprintf(
+            t + len, cap - len, "%s{\"type\": \"sphere\", \"center\": [%.6f, %.6f, %.6f], %s}",
+            i ? ", " : "", rad * cos(2.0 * M_PI * i / k) + (i == moved ? dx : 0.0),
+            rad * sin(2.0 * M_PI * i / k), 0.2 * sin(7.0 * i),
+            soft ? "\"radius\": 0.6, \"kernel\": \"wyvill\"" : "\"radius\": 0.5");
+    snprintf(t + len, cap - len, "]}}");
+    return t;
+}
+
+/* The edited scene compiled against the previous evaluator: the same
+ * evaluator as a fresh compile (curves described alike, the same compile
+ * cost, the same values, gradients and interval bounds, bit for bit), with
+ * exactly the expected local unions' curves copied. */
+static void check_reuse(const char *label, char *before, char *after, size_t want_reused,
+                        tally_t *t) {
+    lb_scene *s0 = parse(before), *s1 = parse(after);
+    free(before);
+    free(after);
+    lb_evaluator *prev = compile(s0), *fresh = compile(s1), *re = NULL;
+    size_t reused = 99;
+    lb_error e = {LB_OK, ""};
+    if (lb_evaluator_create_reusing(s1, prev, &re, &reused, &e)) fail_msg("%s", e.message);
+    lb_evaluator_free(prev); /* the copy owns its curves */
+    tally_check(t, reused == want_reused, "%s: %zu local unions reused, want %zu", label, reused,
+                want_reused);
+    static char d0[1 << 16], d1[1 << 16];
+    lb_evaluator_describe_local(fresh, d0, sizeof d0);
+    lb_evaluator_describe_local(re, d1, sizeof d1);
+    tally_check(t, !strcmp(d0, d1) && d0[0], "%s: the curves described alike", label);
+    tally_check(t, lb_evaluator_compile_cost(fresh) == lb_evaluator_compile_cost(re),
+                "%s: compile cost %.17g, fresh %.17g", label, lb_evaluator_compile_cost(re),
+                lb_evaluator_compile_cost(fresh));
+    double bmin[3], bmax[3];
+    assert_true(lb_scene_bounds(s1, bmin, bmax));
+    rng_t R = {99};
+    enum { N = 4000 };
+    static double x[N], y[N], z[N], v[2][N], gx[2][N], gy[2][N], gz[2][N];
+    for (int i = 0; i < N; ++i) {
+        x[i] = rng_range(&R, bmin[0], bmax[0]);
+        y[i] = rng_range(&R, bmin[1], bmax[1]);
+        z[i] = rng_range(&R, bmin[2], bmax[2]);
+    }
+    const lb_evaluator *E[2] = {fresh, re};
+    for (int k = 0; k < 2; ++k)
+        if (lb_evaluator_eval(E[k], N, x, y, z, v[k], gx[k], gy[k], gz[k], 2, &e))
+            fail_msg("%s", e.message);
+    tally_check(t,
+                !memcmp(v[0], v[1], sizeof v[0]) && !memcmp(gx[0], gx[1], sizeof gx[0]) &&
+                    !memcmp(gy[0], gy[1], sizeof gy[0]) && !memcmp(gz[0], gz[1], sizeof gz[0]),
+                "%s: values and gradients bit for bit", label);
+    for (int b = 0; b < 200; ++b) {
+        double lo[3], hi[3], l[2], h[2];
+        for (int d = 0; d < 3; ++d) {
+            const double c = rng_range(&R, bmin[d], bmax[d]), r = rng_log(&R, 0.01, 2.0);
+            lo[d] = c - r;
+            hi[d] = c + r;
+        }
+        for (int k = 0; k < 2; ++k)
+            if (lb_evaluator_bounds(E[k], lo, hi, &l[k], &h[k], &e)) fail_msg("%s", e.message);
+        tally_check(t, !memcmp(l, l + 1, sizeof *l) && !memcmp(h, h + 1, sizeof *h),
+                    "%s: interval bounds bit for bit", label);
+    }
+    lb_evaluator_free(fresh);
+    lb_evaluator_free(re);
+    lb_scene_free(s0);
+    lb_scene_free(s1);
+}
+
+/* lb_evaluator_create_reusing: a flat local union of k children is a fold
+ * of k - 1 binary ones, fold j joining the first j children with child j,
+ * so moving child m copies the curves of folds 1 .. m - 1 and finds the
+ * rest again; the same scene copies all; other bounds copy none (the
+ * curves are searched inside the bounds); no previous evaluator, none. */
+static void test_reuse_curves(void **st) {
+    (void)st;
+    tally_t t = {"compile reusing a previous evaluator's curves", 0, 0, 0};
+    check_reuse("zero ring, sphere 9 of 12 moved", ring_edit(12, "zero", -1, 0, 0),
+                ring_edit(12, "zero", 9, 0.05, 0), 8, &t);
+    check_reuse("zero ring, the last sphere moved", ring_edit(12, "zero", -1, 0, 0),
+                ring_edit(12, "zero", 11, -0.03, 0), 10, &t);
+    check_reuse("zero ring, sphere 0 moved", ring_edit(12, "zero", -1, 0, 0),
+                ring_edit(12, "zero", 0, 0.02, 0), 0, &t);
+    check_reuse("soft ring, sphere 5 of 10 moved", ring_edit(10, "soft", -1, 0, 0),
+                ring_edit(10, "soft", 5, 0.04, 0), 4, &t);
+    check_reuse("zero ring, the same scene", ring_edit(12, "zero", 3, 0.01, 0),
+                ring_edit(12, "zero", 3, 0.01, 0), 11, &t);
+    check_reuse("zero ring, other bounds", ring_edit(12, "zero", -1, 0, 0),
+                ring_edit(12, "zero", -1, 0, 0.5), 0, &t);
+    /* no previous evaluator: a plain compile */
+    char *text = ring_scene(8, 1, "zero");
+    lb_scene *sc = parse(text);
+    free(text);
+    lb_evaluator *ev = NULL;
+    size_t reused = 99;
+    assert_int_equal(lb_evaluator_create_reusing(sc, NULL, &ev, &reused, NULL), LB_OK);
+    tally_check(&t, reused == 0 && lb_evaluator_compile_cost(ev) > 0, "no previous: none reused");
+    lb_evaluator_free(ev);
+    assert_int_equal(lb_evaluator_create_reusing(sc, NULL, &ev, NULL, NULL), LB_OK);
+    lb_evaluator_free(ev);
+    lb_scene_free(sc);
+    tally_end(&t, 1200);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reuse_curves),
         cmocka_unit_test(test_two_sphere_circle),
         cmocka_unit_test(test_component_counts),
         cmocka_unit_test(test_no_blend_at_a_distance),

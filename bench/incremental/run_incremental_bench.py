@@ -51,15 +51,16 @@ for key in ("start", "end"):
     arm[key][0] -= 0.01 * size
 cases.append(("five-capsule figure (left arm moved)", write("figure-0.json", fig),
               write("figure-1.json", fig2)))
-print("%-38s %5s %10s %10s %7s %14s %9s %8s %5s" % (
+print("%-38s %5s %10s %10s %7s %14s %9s %8s %17s %5s" % (
     "scene", "cells", "full ms", "incr. ms", "ratio", "blocks reused", "cache MiB",
-    "compile", "same"))
+    "compile", "reusing (copied)", "same"))
 for name, before, after in cases:
     for res in (128, 256):
         out = subprocess.run([BIN, before, after, str(res), "1"], capture_output=True, text=True,
                              check=True).stdout
         r = json.loads(out)
-        print("%-38s %5d %10.1f %10.1f %7.3f %7d/%-6d %9.1f %6.1fms %5s" % (
+        print("%-38s %5d %10.1f %10.1f %7.3f %7d/%-6d %9.1f %6.1fms %9.1fms (%2d) %5s" % (
             name, res, 1000 * r["full_s"], 1000 * r["incremental_s"], r["ratio"], r["reused"],
-            r["blocks"], r["cache_mib"], 1000 * r["compile_s"], r["same"]))
+            r["blocks"], r["cache_mib"], 1000 * r["compile_s"], 1000 * r["compile_reusing_s"],
+            r["curves_copied"], r["same"]))
         print("BENCH " + json.dumps(dict(r, scene=name, cells=res)), flush=True)

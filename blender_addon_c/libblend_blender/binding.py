@@ -130,6 +130,8 @@ _SIGNATURES = {
     "lb_scene_material": (ctypes.c_int, [_P, ctypes.c_size_t, ctypes.POINTER(_Material)]),
     "lb_scene_material_index": (ctypes.c_int, [_P, _P, ctypes.c_size_t, _D, _D, _D, _U32, _ERR]),
     "lb_evaluator_create": (ctypes.c_int, [_P, ctypes.POINTER(_P), _ERR]),
+    "lb_evaluator_create_reusing": (ctypes.c_int, [_P, _P, ctypes.POINTER(_P),
+                                                   ctypes.POINTER(ctypes.c_size_t), _ERR]),
     "lb_evaluator_free": (None, [_P]),
     "lb_evaluator_size": (ctypes.c_size_t, [_P]),
     "lb_evaluator_eval": (ctypes.c_int, [_P, ctypes.c_size_t, _D, _D, _D, _D, _D, _D, _D,
@@ -381,12 +383,20 @@ class Scene(_Handle):
         self.lib._check(st, err, "material index")
         return idx
 
-    def compile(self):
-        """Compile into an Evaluator (independent of this scene afterwards)."""
-        out, err = _P(), _Error()
-        st = self.lib._c.lb_evaluator_create(self.ptr, ctypes.byref(out), ctypes.byref(err))
+    def compile(self, previous=None):
+        """Compile into an Evaluator (independent of this scene afterwards).
+        previous: the Evaluator of the scene before an edit (may be None):
+        the result is the same, but the local unions whose children did not
+        change copy their curves from it instead of finding them again
+        (lb_evaluator_create_reusing); Evaluator.reused_curves says how many."""
+        out, err, n = _P(), _Error(), ctypes.c_size_t(0)
+        st = self.lib._c.lb_evaluator_create_reusing(
+            self.ptr, previous.ptr if previous is not None else None, ctypes.byref(out),
+            ctypes.byref(n), ctypes.byref(err))
         self.lib._check(st, err, "compile")
-        return Evaluator(self.lib, out)
+        ev = Evaluator(self.lib, out)
+        ev.reused_curves = n.value
+        return ev
 
     def write_pov(self, evaluator, path, include_only=False, silhouette=False, aspect=0.0,
                   max_gradient=0.0, threads=0, mesh_resolution=0):
@@ -421,6 +431,7 @@ class Evaluator(_Handle):
     """A compiled scene: values, gradients, interval bounds and meshes.
     Read-only: any number of threads may use one evaluator at once."""
     _free = "lb_evaluator_free"
+    reused_curves = 0  # local unions whose curves Scene.compile(previous=) copied
 
     def __len__(self):
         return self.lib._c.lb_evaluator_size(self.ptr)

@@ -101,13 +101,11 @@ class _Job:
     def run(self):
         t0 = time.perf_counter()
         try:
-            with self.lib.parse_scene(self.text, self.name) as scene, scene.compile() as ev:
-                text = self._fit(ev, self.text) if self.fit else self.text
-                if text is self.text:  # the compiled scene is the one to mesh
-                    self._mesh(scene, ev)
-            if text is not self.text:  # a local union: its curves inside the fitted bounds
-                with self.lib.parse_scene(text, self.name) as scene, scene.compile() as ev:
-                    self._mesh(scene, ev)
+            if self.cache is None:
+                self._run()
+            else:  # one run of this field at a time uses its cache and kept evaluators
+                with self.cache_lock:
+                    self._run()
         except binding.Cancelled:
             self.error = None
         except binding.LibblendError as e:
@@ -117,13 +115,44 @@ class _Job:
         self.seconds = time.perf_counter() - t0
         self.done.set()
 
+    def _run(self):
+        with self.lib.parse_scene(self.text, self.name) as scene:
+            ev = self._compile(scene, "probe" if self.fit else "mesh")
+            try:
+                text = self._fit(ev, self.text) if self.fit else self.text
+                if text is self.text:  # the compiled scene is the one to mesh
+                    self._mesh(scene, ev)
+            finally:
+                self._keep("probe" if self.fit else "mesh", ev)
+        if text is not self.text:  # a local union: its curves inside the fitted bounds
+            with self.lib.parse_scene(text, self.name) as scene:
+                ev = self._compile(scene, "mesh")
+                try:
+                    self._mesh(scene, ev)
+                finally:
+                    self._keep("mesh", ev)
+
+    def _compile(self, scene, role):
+        """the scene's evaluator; with a cache, compiled against the one this
+        field's last run kept for the same role (the same result, the local
+        unions whose children did not change keep their curves)"""
+        kept = getattr(self.cache, "evaluators", {}) if self.cache is not None else {}
+        return scene.compile(previous=kept.get(role))
+
+    def _keep(self, role, ev):
+        """keep ev for the next run's compile (with a cache), else free it"""
+        if self.cache is None:
+            ev.close()
+            return
+        kept = self.cache.__dict__.setdefault("evaluators", {})
+        old = kept.get(role)
+        kept[role] = ev
+        if old is not None and old is not ev:
+            old.close()
+
     def _mesh(self, scene, ev):
         import numpy as np
-        if self.cache is None:
-            self.mesh = self._mesh_with(ev, None)
-        else:
-            with self.cache_lock:
-                self.mesh = self._mesh_with(ev, self.cache)
+        self.mesh = self._mesh_with(ev, self.cache)
         self.clipped = clipped_faces(self.mesh.positions, self.bmin, self.bmax)
         mats = scene.materials()
         if len(mats) > 1 and len(self.mesh.triangles):

@@ -12,6 +12,7 @@ the library's message.
 """
 import ctypes
 import glob
+import json
 import math
 import os
 import subprocess
@@ -186,6 +187,27 @@ with moved(-1) as evb, moved(1) as eva:
           "velocities: worst error %.2e of the speed %.2f" % (worst, np.linalg.norm(s_vel)))
     raises(lambda: ev.velocities(m.positions, dt=dt), binding.LibblendError, "lb_mesh_velocities")
     raises(lambda: ev.velocities(m.positions, after=eva, dt=0.0), binding.LibblendError, "dt")
+
+# ---- compiling against the previous evaluator (lb_evaluator_create_reusing):
+# a flat local union of 6 spheres is a fold of 5; moving the last sphere
+# copies 4 folds' curves, and the evaluator is the fresh compile's
+def ring(dx):
+    args = [{"type": "sphere", "center": [1.2 * math.cos(q * math.pi / 3) + (dx if q == 5 else 0),
+                                          1.2 * math.sin(q * math.pi / 3), 0], "radius": 0.6}
+            for q in range(6)]
+    return json.dumps({"format": "libblend-scene", "version": 1, "convention": "zero",
+                       "bounds": {"min": [-2, -2, -1], "max": [2, 2, 1]},
+                       "root": {"type": "local_union", "args": args}})
+
+
+with lib.parse_scene(ring(0)) as s0, lib.parse_scene(ring(0.03)) as s1, s0.compile() as e0, \
+        s1.compile(previous=e0) as e1, s1.compile() as ef:
+    Q = np.random.default_rng(5).uniform(-2, 2, (2000, 3)) * [1, 1, 0.5]
+    check(e0.reused_curves == 0 and e1.reused_curves == 4 and ef.reused_curves == 0,
+          "compile(previous=): 4 of 5 local unions' curves copied (%d)" % e1.reused_curves)
+    a, b = e1.eval(Q), ef.eval(Q)
+    check(np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1]),
+          "compile(previous=) evaluates as a fresh compile, bit for bit")
 
 # ---- errors
 raises(lambda: lib.parse_scene('{"format": "libblend-scene",\n "version": 1, }', "a.json"),

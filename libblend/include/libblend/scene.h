@@ -220,6 +220,19 @@ LB_API lb_status lb_scene_eval_reference(const lb_scene *scene, const double X[3
 LB_API lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_error *err);
 LB_API void lb_evaluator_free(lb_evaluator *ev);
 
+/* lb_evaluator_create for a scene edited from the one previous (may be
+ * NULL) was compiled from: the same evaluator, bit for bit (values,
+ * gradients, bounds, lb_evaluator_cost and lb_evaluator_compile_cost, the
+ * same refusals), made faster by copying the intersection curves of every
+ * local_union whose children (their whole subtrees, every parameter) and
+ * own parameters are those of one of previous's, inside the same scene
+ * bounds, instead of finding them again: an edit traces only the curves of
+ * the local unions above what it changed. *reused (may be NULL) receives
+ * how many local unions' curves were copied. previous is only read (it may
+ * be in use by other threads) and may be freed afterwards. */
+LB_API lb_status lb_evaluator_create_reusing(const lb_scene *scene, const lb_evaluator *previous,
+                                             lb_evaluator **out, size_t *reused, lb_error *err);
+
 /* The convention of the scene the evaluator was compiled from. */
 LB_API lb_convention lb_evaluator_convention(const lb_evaluator *ev);
 

@@ -428,6 +428,12 @@ size_t lb_evaluator_size(const lb_evaluator *ev) {
 }
 
 lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_error *err) {
+    return lb_evaluator_create_reusing(scene, NULL, out, NULL, err);
+}
+
+lb_status lb_evaluator_create_reusing(const lb_scene *scene, const lb_evaluator *previous,
+                                      lb_evaluator **out, size_t *reused, lb_error *err) {
+    if (reused) *reused = 0;
     if (!out) return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "lb_evaluator_create: out is NULL");
     *out = NULL;
     if (!scene || !scene->root)
@@ -450,7 +456,7 @@ lb_status lb_evaluator_create(const lb_scene *scene, lb_evaluator **out, lb_erro
     free(c.mark);
     free(c.stack);
     if (!s) s = allocate_registers(ev, root, err);
-    if (!s) s = lb__local_prepare(ev, scene, err);
+    if (!s) s = lb__local_prepare(ev, scene, previous, reused, err);
     if (s) {
         lb_evaluator_free(ev);
         return s;

@@ -33,6 +33,7 @@
  * describes them; local_bvh.c builds and queries step 6's hierarchy,
  * local_eval.c evaluates at points, local_bounds.c over boxes. */
 #include "local_internal.h"
+#include "records.h"
 #include "../common/boxtree.h"
 #include "../common/kuhn.h"
 
@@ -88,19 +89,23 @@ typedef struct child_eval {
     size_t nsubregs;
 } child_eval;
 
-/* Counts runs of the children's cones, and refuses once the compile cost
- * passes its limit (scene.h): no valid scene may make compiling explode. */
-static lb_status charge(child_eval *E, double runs) {
-    *E->work += runs;
-    if (*E->work <= LB_SCENE_MAX_COMPILE_COST) return LB_OK;
-    return lb__fail(E->err, LB_ERR_INVALID_ARGUMENT,
+/* The refusal once the compile cost passes its limit (scene.h). */
+static lb_status over_cost(const lb__instr *in, lb_error *err) {
+    return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                     "%s: finding the local unions' intersection curves takes more than %.3g "
                     "instruction runs (the compile-cost limit); allowed: fewer children within "
                     "reach of each other under one local union (each fold evaluates every "
                     "earlier child whose field reaches its curves: a smaller zero_scale, or "
                     "kernels of finite support, keep them apart), or clean_union or min where "
                     "no local blend is needed",
-                    E->in->op->path, LB_SCENE_MAX_COMPILE_COST);
+                    in->op->path, LB_SCENE_MAX_COMPILE_COST);
+}
+
+/* Counts runs of the children's cones, and refuses once the compile cost
+ * passes its limit: no valid scene may make compiling explode. */
+static lb_status charge(child_eval *E, double runs) {
+    *E->work += runs;
+    return *E->work <= LB_SCENE_MAX_COMPILE_COST ? LB_OK : over_cost(E->in, E->err);
 }
 
 /* instruction runs of one evaluation of a cone */
@@ -908,20 +913,131 @@ static lb_status prepare_one(const lb_evaluator *ev, lb__instr *in, const double
     return LB_OK;
 }
 
-lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, lb_error *err) {
-    for (size_t i = 0; i < ev->n; ++i) {
-        lb__instr *in = &ev->ins[i];
-        if (in->code != LB__I_OP || !(lb__op_flags(in->op) & LB__R_CURVES)) continue;
-        double bmin[3], bmax[3];
-        if (!lb_scene_bounds(scene, bmin, bmax))
-            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
-                            "%s: local_union finds its children's intersection curves inside the "
-                            "scene's bounds; allowed: a scene with \"bounds\"",
-                            in->op->path);
-        lb_status s = prepare_one(ev, in, bmin, bmax, &ev->compile_cost, err);
-        if (s) return s;
+static int has_curves(const lb__instr *in) {
+    return in->code == LB__I_OP && (lb__op_flags(in->op) & LB__R_CURVES);
+}
+
+static struct lb__curves *curves_copy(const struct lb__curves *c) {
+    struct lb__curves *d = malloc(sizeof *d);
+    if (!d) return NULL;
+    *d = *c;
+    d->pts = malloc((c->nv ? 3 * c->nv : 1) * sizeof *d->pts);
+    d->comp = malloc((c->ncomp ? c->ncomp : 1) * sizeof *d->comp);
+    d->seg = malloc((c->nseg ? 2 * c->nseg : 1) * sizeof *d->seg);
+    d->segc = malloc((c->nseg ? c->nseg : 1) * sizeof *d->segc);
+    d->bvh = malloc((c->nnodes ? c->nnodes : 1) * sizeof *d->bvh);
+    if (!d->pts || !d->comp || !d->seg || !d->segc || !d->bvh) {
+        lb__curves_free(d);
+        return NULL;
     }
-    return LB_OK;
+    if (c->nv) memcpy(d->pts, c->pts, 3 * c->nv * sizeof *d->pts);
+    if (c->ncomp) memcpy(d->comp, c->comp, c->ncomp * sizeof *d->comp);
+    if (c->nseg) {
+        memcpy(d->seg, c->seg, 2 * c->nseg * sizeof *d->seg);
+        memcpy(d->segc, c->segc, c->nseg * sizeof *d->segc);
+    }
+    if (c->nnodes) memcpy(d->bvh, c->bvh, c->nnodes * sizeof *d->bvh);
+    return d;
+}
+
+/* prev's records without curves and a table over them, for the matching */
+typedef struct reuse {
+    const lb_evaluator *prev;
+    lb__recs P;
+    uint32_t *tab; /* instruction + 1, 0: empty */
+    size_t tcap;
+    uint32_t *deep; /* ev's instruction -> prev's with the same record, or LB__RNONE */
+    lb__rbuf b;
+} reuse;
+
+static void reuse_free(reuse *U) {
+    lb__recs_free(&U->P);
+    free(U->tab);
+    free(U->deep);
+    free(U->b.p);
+}
+
+/* 0 when out of memory (then nothing is reused) */
+static int reuse_init(reuse *U, const lb_evaluator *ev, const lb_evaluator *prev) {
+    memset(U, 0, sizeof *U);
+    U->prev = prev;
+    size_t cap = 16;
+    while (cap < 2 * prev->n) cap *= 2;
+    U->tcap = cap;
+    U->tab = calloc(cap, sizeof *U->tab);
+    U->deep = malloc((ev->n ? ev->n : 1) * sizeof *U->deep);
+    if (!U->tab || !U->deep || !lb__recs_make(prev, NULL, 1, 0, &U->P)) {
+        reuse_free(U);
+        return 0;
+    }
+    for (size_t j = 0; j < prev->n; ++j) {
+        size_t s = U->P.h[j] & (cap - 1);
+        while (U->tab[s]) s = (s + 1) & (cap - 1);
+        U->tab[s] = (uint32_t)j + 1;
+    }
+    return 1;
+}
+
+/* prev's instruction with ev's instruction i's record (curves left out),
+ * or LB__RNONE */
+static uint32_t reuse_match(reuse *U, const lb_evaluator *ev, size_t i) {
+    U->b.n = 0;
+    if (!lb__record(ev, (uint32_t)i, U->deep, 1, 0, &U->b) || U->b.oom) return LB__RNONE;
+    const uint64_t h = lb__rhash(U->b.p, U->b.n);
+    for (size_t s = h & (U->tcap - 1); U->tab[s]; s = (s + 1) & (U->tcap - 1)) {
+        const uint32_t j = U->tab[s] - 1;
+        const size_t len = U->P.off[j + 1] - U->P.off[j];
+        if (U->P.h[j] == h && len == U->b.n && !U->P.bad[j] &&
+            !memcmp(U->P.p + U->P.off[j], U->b.p, len))
+            return j;
+    }
+    return LB__RNONE;
+}
+
+lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, const lb_evaluator *prev,
+                            size_t *reused, lb_error *err) {
+    if (reused) *reused = 0;
+    int any = 0, prev_any = 0;
+    for (size_t i = 0; i < ev->n; ++i) any |= has_curves(&ev->ins[i]);
+    for (size_t j = 0; prev && j < prev->n; ++j) prev_any |= has_curves(&prev->ins[j]);
+    if (!any) return LB_OK;
+    reuse U;
+    const int use = prev_any && reuse_init(&U, ev, prev);
+    lb_status s = LB_OK;
+    for (size_t i = 0; i < ev->n && !s; ++i) {
+        lb__instr *in = &ev->ins[i];
+        uint32_t j = use ? reuse_match(&U, ev, i) : LB__RNONE;
+        if (has_curves(in)) {
+            double bmin[3], bmax[3];
+            if (!lb_scene_bounds(scene, bmin, bmax)) {
+                s = lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                             "%s: local_union finds its children's intersection curves inside "
+                             "the scene's bounds; allowed: a scene with \"bounds\"",
+                             in->op->path);
+                break;
+            }
+            const struct lb__curves *old = j != LB__RNONE ? prev->ins[j].curves : NULL;
+            if (old && !memcmp(old->bmin, bmin, sizeof bmin) &&
+                !memcmp(old->bmax, bmax, sizeof bmax) && (in->curves = curves_copy(old))) {
+                /* the cost finding them took, counted as if found again */
+                ev->compile_cost += old->cost;
+                if (ev->compile_cost > LB_SCENE_MAX_COMPILE_COST) s = over_cost(in, err);
+                if (reused) ++*reused;
+            } else {
+                j = LB__RNONE;
+                const double before = ev->compile_cost;
+                s = prepare_one(ev, in, bmin, bmax, &ev->compile_cost, err);
+                if (!s) {
+                    in->curves->cost = ev->compile_cost - before;
+                    memcpy(in->curves->bmin, bmin, sizeof bmin);
+                    memcpy(in->curves->bmax, bmax, sizeof bmax);
+                }
+            }
+        }
+        if (use) U.deep[i] = j;
+    }
+    if (use) reuse_free(&U);
+    return s;
 }
 
 /* ---- description (blendtool info) ---- */

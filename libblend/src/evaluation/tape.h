@@ -179,6 +179,10 @@ struct lb__curves {
     bvh_node *bvh;
     double rmax; /* largest R */
     double scene_size;
+    /* what finding them took and where (lb_evaluator_create_reusing copies
+     * curves found inside the same bounds, and counts their cost again) */
+    double cost;
+    double bmin[3], bmax[3];
 };
 
 /* The n-th local_union instruction's curves, in tape order (tests). */
@@ -188,8 +192,14 @@ LB_INTERNAL const struct lb__curves *lb__local_nth(const lb_evaluator *ev, size_
  * After registers are assigned, every local_union instruction gets its
  * children's intersection curves (octree by intervals, segments exact on
  * each tetrahedron's linear pieces, chained, refined onto both surfaces),
- * the blending volumes' parameters and a bounding-volume hierarchy. */
-LB_INTERNAL lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, lb_error *err);
+ * the blending volumes' parameters and a bounding-volume hierarchy. With
+ * prev (may be NULL), a local union whose record (its content, and its
+ * arguments and cones matched deep, records.h) equals one of prev's, inside
+ * the same bounds, gets a copy of prev's curves instead: finding them is
+ * deterministic, so the copy is what finding them would give, bit for bit;
+ * *reused (may be NULL) counts them. */
+LB_INTERNAL lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene,
+                                        const lb_evaluator *prev, size_t *reused, lb_error *err);
 LB_INTERNAL void lb__curves_free(struct lb__curves *c);
 /* Values and gradients of a local_union or clean_union over a chunk. */
 LB_INTERNAL lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n,
