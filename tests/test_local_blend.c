@@ -410,8 +410,10 @@ static void test_zero_convention_surface(void **st) {
 /* A flat local_union of k spheres (a left fold): on a ring of radius
  * spacing k / 2 pi (spread: each meets its two neighbours), or crowded on a
  * ring of radius 1.5 (each within zero_scale of all), in either convention
- * (soft: Wyvill kernels of radius 2r). */
-static char *ring_scene(int k, int spread, const char *conv) {
+ * (soft: Wyvill kernels of radius 2r); sphere `moved` shifted by dx along x
+ * and the bounds grown by grow along -x (edits, for test_reuse_curves). */
+static char *ring_scene_edit(int k, int spread, const char *conv, int moved, double dx,
+                             double grow) {
     const double rad = spread ? k * 0.7 / (2.0 * M_PI) : 1.5;
     size_t cap = 256 + (size_t)k * 160, len = 0;
     char *t = malloc(cap);
@@ -420,15 +422,19 @@ static char *ring_scene(int k, int spread, const char *conv) {
                             "{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": "
                             "\"%s\", \"bounds\": {\"min\": [%g, %g, -1.5], \"max\": [%g, %g, 1.5]},"
                             " \"root\": {\"type\": \"local_union\", \"args\": [",
-                            conv, -rad - 1.5, -rad - 1.5, rad + 1.5, rad + 1.5);
+                            conv, -rad - 1.5 - grow, -rad - 1.5, rad + 1.5, rad + 1.5);
     for (int i = 0; i < k; ++i)
         len += (size_t)snprintf(
             t + len, cap - len, "%s{\"type\": \"sphere\", \"center\": [%.6f, %.6f, %.6f], %s}",
-            i ? ", " : "", rad * cos(2.0 * M_PI * i / k), rad * sin(2.0 * M_PI * i / k),
-            0.2 * sin(7.0 * i),
+            i ? ", " : "", rad * cos(2.0 * M_PI * i / k) + (i == moved ? dx : 0.0),
+            rad * sin(2.0 * M_PI * i / k), 0.2 * sin(7.0 * i),
             soft ? "\"radius\": 0.6, \"kernel\": \"wyvill\"" : "\"radius\": 0.5");
     snprintf(t + len, cap - len, "]}}");
     return t;
+}
+
+static char *ring_scene(int k, int spread, const char *conv) {
+    return ring_scene_edit(k, spread, conv, -1, 0.0, 0.0);
 }
 
 /* a flat local union of k spheres in a 12-wide lattice (rows 0.9 apart,
@@ -581,29 +587,6 @@ static void test_compile_cost_linear(void **st) {
     assert_true(lat[0] > 0.0 && lat[1] / lat[0] <= pow(4.0, 1.2));
 }
 
-/* a ring of k spheres under one local union (the spread ring of
- * ring_scene), sphere `moved` shifted by dx along x, the bounds grown by
- * grow */
-static char *ring_edit(int k, const char *conv, int moved, double dx, double grow) {
-    const double rad = k * 0.7 / (2.0 * M_PI);
-    size_t cap = 256 + (size_t)k * 160, len = 0;
-    char *t = malloc(cap);
-    const int soft = !strcmp(conv, "soft");
-    len += (size_t)snprintf(t + len, cap - len,
-                            "{\"format\": \"libblend-scene\", \"version\": 1, \"convention\": "
-                            "\"%s\", \"bounds\": {\"min\": [%g, %g, -1.5], \"max\": [%g, %g, 1.5]},"
-                            " \"root\": {\"type\": \"local_union\", \"args\": [",
-                            conv, -rad - 1.5 - grow, -rad - 1.5, rad + 1.5, rad + 1.5);
-    for (int i = 0; i < k; ++i)
-        len += (size_t)snprintf(
-            t + len, cap - len, "%s{\"type\": \"sphere\", \"center\": [%.6f, %.6f, %.6f], %s}",
-            i ? ", " : "", rad * cos(2.0 * M_PI * i / k) + (i == moved ? dx : 0.0),
-            rad * sin(2.0 * M_PI * i / k), 0.2 * sin(7.0 * i),
-            soft ? "\"radius\": 0.6, \"kernel\": \"wyvill\"" : "\"radius\": 0.5");
-    snprintf(t + len, cap - len, "]}}");
-    return t;
-}
-
 /* The edited scene compiled against the previous evaluator: the same
  * evaluator as a fresh compile (curves described alike, the same compile
  * cost, the same values, gradients and interval bounds, bit for bit), with
@@ -671,18 +654,18 @@ static void check_reuse(const char *label, char *before, char *after, size_t wan
 static void test_reuse_curves(void **st) {
     (void)st;
     tally_t t = {"compile reusing a previous evaluator's curves", 0, 0, 0};
-    check_reuse("zero ring, sphere 9 of 12 moved", ring_edit(12, "zero", -1, 0, 0),
-                ring_edit(12, "zero", 9, 0.05, 0), 8, &t);
-    check_reuse("zero ring, the last sphere moved", ring_edit(12, "zero", -1, 0, 0),
-                ring_edit(12, "zero", 11, -0.03, 0), 10, &t);
-    check_reuse("zero ring, sphere 0 moved", ring_edit(12, "zero", -1, 0, 0),
-                ring_edit(12, "zero", 0, 0.02, 0), 0, &t);
-    check_reuse("soft ring, sphere 5 of 10 moved", ring_edit(10, "soft", -1, 0, 0),
-                ring_edit(10, "soft", 5, 0.04, 0), 4, &t);
-    check_reuse("zero ring, the same scene", ring_edit(12, "zero", 3, 0.01, 0),
-                ring_edit(12, "zero", 3, 0.01, 0), 11, &t);
-    check_reuse("zero ring, other bounds", ring_edit(12, "zero", -1, 0, 0),
-                ring_edit(12, "zero", -1, 0, 0.5), 0, &t);
+    check_reuse("zero ring, sphere 9 of 12 moved", ring_scene_edit(12, 1, "zero", -1, 0, 0),
+                ring_scene_edit(12, 1, "zero", 9, 0.05, 0), 8, &t);
+    check_reuse("zero ring, the last sphere moved", ring_scene_edit(12, 1, "zero", -1, 0, 0),
+                ring_scene_edit(12, 1, "zero", 11, -0.03, 0), 10, &t);
+    check_reuse("zero ring, sphere 0 moved", ring_scene_edit(12, 1, "zero", -1, 0, 0),
+                ring_scene_edit(12, 1, "zero", 0, 0.02, 0), 0, &t);
+    check_reuse("soft ring, sphere 5 of 10 moved", ring_scene_edit(10, 1, "soft", -1, 0, 0),
+                ring_scene_edit(10, 1, "soft", 5, 0.04, 0), 4, &t);
+    check_reuse("zero ring, the same scene", ring_scene_edit(12, 1, "zero", 3, 0.01, 0),
+                ring_scene_edit(12, 1, "zero", 3, 0.01, 0), 11, &t);
+    check_reuse("zero ring, other bounds", ring_scene_edit(12, 1, "zero", -1, 0, 0),
+                ring_scene_edit(12, 1, "zero", -1, 0, 0.5), 0, &t);
     /* no previous evaluator: a plain compile */
     char *text = ring_scene(8, 1, "zero");
     lb_scene *sc = parse(text);

@@ -1174,18 +1174,26 @@ check(live.update_now(cube)[0] and len(cube.data.polygons) > 1000,
 lat_args = [{"type": "sphere", "center": [-1.2 + 1.2 * (q % 3), -1.2 + 1.2 * (q // 3 % 3),
                                           -1.2 + 1.2 * (q // 9)], "radius": 0.35}
             for q in range(27)]
-lat_path = os.path.join(WORK, "lattice.json")
-with open(lat_path, "w") as f:
-    json.dump({"format": "libblend-scene", "version": 1, "convention": "zero",
-               "bounds": {"min": [-2, -2, -2], "max": [2, 2, 2]},
-               "root": {"type": "displacement", "op": "union", "r": 0.2, "p": 2, "m": 1,
-                        "args": lat_args}}, f)
-check(bpy.ops.libblend.import_scene(filepath=lat_path, with_render=False) == {"FINISHED"},
-      "import the lattice")
-lat = active()
-lat.libblend.live = False
-lat.libblend.preview_resolution = 96
-check(live.update_now(lat)[0], "mesh the lattice")
+
+
+def imported_field(name, bounds, root, res):
+    """a scene written and imported as a field (live updates off), meshed at res"""
+    path = os.path.join(WORK, name + ".json")
+    with open(path, "w") as f:
+        json.dump({"format": "libblend-scene", "version": 1, "convention": "zero",
+                   "bounds": {"min": bounds[0], "max": bounds[1]}, "root": root}, f)
+    check(bpy.ops.libblend.import_scene(filepath=path, with_render=False) == {"FINISHED"},
+          "import " + name)
+    obj = active()
+    obj.libblend.live = False
+    obj.libblend.preview_resolution = res
+    check(live.update_now(obj)[0], "mesh " + name)
+    return obj
+
+
+lat = imported_field("lattice", ([-2, -2, -2], [2, 2, 2]),
+                     {"type": "displacement", "op": "union", "r": 0.2, "p": 2, "m": 1,
+                      "args": lat_args}, 96)
 spheres = sorted((o for o in lat.children_recursive if tree.is_node(o) and
                   o.libblend.kind == "PRIMITIVE"), key=lambda o: o.name)
 check(len(spheres) == 27, "27 sphere objects (%d)" % len(spheres))
@@ -1194,13 +1202,20 @@ mid.location.x += 0.04  # 1 % of the region
 bpy.context.view_layer.update()
 check(live.update_now(lat)[0], "mesh the lattice with one sphere moved")
 blocks, reused, _recycled, nbytes = live.state_of(lat).cache.stats
-V, F = blender_mesh(lat)
-full = live.prepare(lat, 96)
-full.cache = None  # the full remesh, without the cache
-full.run()
-same = (not full.error and V.shape == full.mesh.positions.shape and
-        np.array_equal(V.astype(np.float32), full.mesh.positions.astype(np.float32)) and
-        np.array_equal(F, full.mesh.triangles.astype(np.int64)))
+
+
+def same_as_full(obj, res):
+    """is obj's Blender mesh the one a full remesh (no cache, a fresh compile) gives?"""
+    V, F = blender_mesh(obj)
+    full = live.prepare(obj, res)
+    full.cache = None
+    full.run()
+    return (not full.error and V.shape == full.mesh.positions.shape and
+            np.array_equal(V.astype(np.float32), full.mesh.positions.astype(np.float32)) and
+            np.array_equal(F, full.mesh.triangles.astype(np.int64)))
+
+
+same = same_as_full(lat, 96)
 print("incremental remeshing in Blender: %d of %d blocks from the cache (%.1f MiB), same mesh: %s"
       % (reused, blocks, nbytes / 2.0**20, same))
 check(same, "the cached live update is the full remesh's mesh")
@@ -1217,31 +1232,18 @@ check(live.update_now(lat, force=True)[0] and
 ring_args = [{"type": "sphere", "center": [1.3 * math.cos(2 * math.pi * q / 8),
                                            1.3 * math.sin(2 * math.pi * q / 8), 0.0],
               "radius": 0.6} for q in range(8)]
-ring_path = os.path.join(WORK, "ring.json")
-with open(ring_path, "w") as f:
-    json.dump({"format": "libblend-scene", "version": 1, "convention": "zero",
-               "bounds": {"min": [-2.2, -2.2, -1], "max": [2.2, 2.2, 1]},
-               "root": {"type": "local_union", "args": ring_args}}, f)
-check(bpy.ops.libblend.import_scene(filepath=ring_path, with_render=False) == {"FINISHED"},
-      "import the ring of local unions")
-ring = active()
-ring.libblend.live = False
-ring.libblend.preview_resolution = 64
-check(live.update_now(ring)[0], "mesh the ring")
+ring = imported_field("ring", ([-2.2, -2.2, -1], [2.2, 2.2, 1]),
+                      {"type": "local_union", "args": ring_args}, 64)
+# the imported spheres sit at the origin with their centre as a setting
 last = min((o for o in ring.children_recursive if tree.is_node(o) and
             o.libblend.kind == "PRIMITIVE"),
-           key=lambda o: (o.matrix_world.translation - mathutils.Vector(ring_args[7]["center"])).length)
+           key=lambda o: (mathutils.Vector(o.libblend.center) -
+                          mathutils.Vector(ring_args[7]["center"])).length)
 last.location.x += 0.03
 bpy.context.view_layer.update()
 check(live.update_now(ring)[0], "mesh the ring with its last sphere moved")
 kept = live.state_of(ring).cache.evaluators["mesh"]
-V, F = blender_mesh(ring)
-full = live.prepare(ring, 64)
-full.cache = None
-full.run()
-same = (not full.error and V.shape == full.mesh.positions.shape and
-        np.array_equal(V.astype(np.float32), full.mesh.positions.astype(np.float32)) and
-        np.array_equal(F, full.mesh.triangles.astype(np.int64)))
+same = same_as_full(ring, 64)
 print("live update of a ring of local unions: %d of 7 curves copied, same mesh: %s" %
       (kept.reused_curves, same))
 check(kept.reused_curves == 6, "the live update copied 6 of 7 local unions' curves (%d)" %

@@ -98,6 +98,9 @@ char *bt_read_file(const char *path, size_t max, size_t *len, char *why, size_t 
 /* Parse "PATH=VALUE" (VALUE must be JSON). Returns 0, or -1 after printing
  * an error naming the argument. */
 int bt_set_parse(const char *cmd, const char *arg, bt_set *out);
+/* One more --set (arg) into sets[*nsets], at most max in all; 0, or -1 after
+ * printing why. */
+int bt_set_arg(const char *cmd, const char *arg, bt_set *sets, size_t *nsets, size_t max);
 
 /* Load a scene with overrides applied in order: a path that does not exist
  * and a scene the overrides make invalid are bad input (exit 2) with the
@@ -305,8 +308,16 @@ const bt_vdb *bt_vdb_get(const char *cmd);
 int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls, int blender,
                  const uint64_t hash[2], const bt_set *sets, size_t nsets, unsigned char **data,
                  size_t *size);
-/* "x0,y0,z0,x1,y1,z1" (commas or spaces) into bmin, bmax; 0, or -1 */
-int bt_parse_bounds(const char *text, double bmin[3], double bmax[3]);
+/* --bounds "x0,y0,z0,x1,y1,z1" (commas or spaces) into bmin, bmax: 0, or
+ * BT_EXIT_BAD_INPUT after saying what is expected */
+int bt_bounds_arg(const char *cmd, const char *text, double bmin[3], double bmax[3]);
+/* The scene with its --set values, and its region: the --bounds given
+ * (have_bounds) or the scene's own; an exit code, after printing why (a
+ * scene without bounds and no --bounds among them). hash as
+ * bt_load_scene_set. */
+int bt_load_scene_region(const char *cmd, const char *path, const bt_set *sets, size_t nsets,
+                         int have_bounds, double bmin[3], double bmax[3], lb_scene **scene,
+                         uint64_t hash[2]);
 
 extern const bt_command bt_cmd_validate, bt_cmd_info, bt_cmd_eval, bt_cmd_mesh, bt_cmd_pov,
     bt_cmd_render, bt_cmd_batch, bt_cmd_compare, bt_cmd_section, bt_cmd_vdb;

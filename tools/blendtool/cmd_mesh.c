@@ -31,26 +31,6 @@ static int progress(double f, void *user) {
     return 0;
 }
 
-int bt_parse_bounds(const char *text, double bmin[3], double bmax[3]) {
-    double v[6];
-    const char *p = text;
-    for (int i = 0; i < 6; ++i) {
-        while (*p == ' ' || *p == ',') ++p;
-        char *end = NULL;
-        errno = 0;
-        v[i] = strtod(p, &end);
-        if (errno || end == p || !isfinite(v[i])) return -1;
-        p = end;
-    }
-    while (*p == ' ' || *p == ',') ++p;
-    if (*p) return -1;
-    for (int d = 0; d < 3; ++d) {
-        bmin[d] = v[d];
-        bmax[d] = v[3 + d];
-    }
-    return 0;
-}
-
 /* blendtool mesh's command line */
 typedef struct mesh_args {
     const char *out, *scene_path;
@@ -91,11 +71,7 @@ static int parse_args(int argc, char **argv, mesh_args *A) {
                 return BT_EXIT_BAD_INPUT;
             }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--bounds", &val))) {
-            if (r < 0) return BT_EXIT_BAD_INPUT;
-            if (bt_parse_bounds(val, A->o.bmin, A->o.bmax)) {
-                bt_error(CMD, "--bounds %s: expected six numbers \"x0,y0,z0,x1,y1,z1\"", val);
-                return BT_EXIT_BAD_INPUT;
-            }
+            if (r < 0 || bt_bounds_arg(CMD, val, A->o.bmin, A->o.bmax)) return BT_EXIT_BAD_INPUT;
             A->have_bounds = 1;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--simplify", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
@@ -123,12 +99,8 @@ static int parse_args(int argc, char **argv, mesh_args *A) {
                 return BT_EXIT_BAD_INPUT;
             }
         } else if ((r = bt_option(CMD, argc, argv, &i, "--set", &val))) {
-            if (r < 0) return BT_EXIT_BAD_INPUT;
-            if (A->nsets == BT_MAX_SETS) {
-                bt_error(CMD, "more than %d --set overrides", BT_MAX_SETS);
+            if (r < 0 || bt_set_arg(CMD, val, A->sets, &A->nsets, BT_MAX_SETS))
                 return BT_EXIT_BAD_INPUT;
-            }
-            if (bt_set_parse(CMD, val, &A->sets[A->nsets++])) return BT_EXIT_BAD_INPUT;
         } else if (strcmp(argv[i], "--open") == 0) {
             A->o.flags |= LB_MESH_OPEN_BOUNDARY;
         } else if (strcmp(argv[i], "--tetrahedra") == 0) {
@@ -174,16 +146,9 @@ static int run(int argc, char **argv) {
     lb_mesh_options o = A.o;
     const int quiet = A.quiet;
     lb_scene *scene = NULL;
-    rc = bt_load_scene_set(CMD, scene_path, A.sets, A.nsets, &scene, NULL);
+    rc = bt_load_scene_region(CMD, scene_path, A.sets, A.nsets, A.have_bounds, o.bmin, o.bmax,
+                              &scene, NULL);
     if (rc) return rc;
-    if (!A.have_bounds && !lb_scene_bounds(scene, o.bmin, o.bmax)) {
-        bt_error(CMD,
-                 "%s: the scene has no bounds; allowed: add \"bounds\" to the scene or give "
-                 "--bounds x0,y0,z0,x1,y1,z1",
-                 scene_path);
-        lb_scene_free(scene);
-        return BT_EXIT_BAD_INPUT;
-    }
     lb_error e = {LB_OK, ""};
     lb_evaluator *ev = NULL;
     lb_mesh *mesh = NULL;

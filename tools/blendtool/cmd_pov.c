@@ -80,12 +80,7 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
         } else if (!render && strcmp(argv[i], "--include-only") == 0) {
             a->include_only = 1;
         } else if ((r = bt_option(cmd, argc, argv, &i, "--set", &v))) {
-            if (r < 0) return -1;
-            if (a->nsets == BT_MAX_SETS) {
-                bt_error(cmd, "more than %d --set overrides", BT_MAX_SETS);
-                return -1;
-            }
-            if (bt_set_parse(cmd, v, &a->sets[a->nsets++])) return -1;
+            if (r < 0 || bt_set_arg(cmd, v, a->sets, &a->nsets, BT_MAX_SETS)) return -1;
         } else if (strcmp(argv[i], "--silhouette") == 0) {
             a->silhouette = 1;
         } else if (bt_scene_arg(cmd, argv[i], &a->scene)) {

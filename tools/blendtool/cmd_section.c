@@ -103,12 +103,8 @@ static int parse(int argc, char **argv, secargs *a) {
             }
             a->label = v;
         } else if ((r = bt_option(cmd, argc, argv, &i, "--set", &v))) {
-            if (r < 0) return -1;
-            if (a->nsets + 1 >= BT_MAX_SETS) {
-                bt_error(cmd, "more than %d --set overrides", BT_MAX_SETS - 1);
-                return -1;
-            }
-            if (bt_set_parse(cmd, v, &a->sets[a->nsets++])) return -1;
+            /* one place stays free for the --sweep value */
+            if (r < 0 || bt_set_arg(cmd, v, a->sets, &a->nsets, BT_MAX_SETS - 1)) return -1;
         } else if (bt_scene_arg(cmd, argv[i], &a->scene)) {
             return -1;
         }

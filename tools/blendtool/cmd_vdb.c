@@ -117,11 +117,7 @@ static int parse_args(int argc, char **argv, vdb_args *A) {
             if (r < 0 || parse_real("--band", val, 1.0, LB_LEVEL_SET_MAX_BAND, what, &A->o.band))
                 return BT_EXIT_BAD_INPUT;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--bounds", &val))) {
-            if (r < 0) return BT_EXIT_BAD_INPUT;
-            if (bt_parse_bounds(val, A->o.bmin, A->o.bmax)) {
-                bt_error(CMD, "--bounds %s: expected six numbers \"x0,y0,z0,x1,y1,z1\"", val);
-                return BT_EXIT_BAD_INPUT;
-            }
+            if (r < 0 || bt_bounds_arg(CMD, val, A->o.bmin, A->o.bmax)) return BT_EXIT_BAD_INPUT;
             A->have_bounds = 1;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--voxel-centres", &val))) {
             if (r < 0) return BT_EXIT_BAD_INPUT;
@@ -139,12 +135,8 @@ static int parse_args(int argc, char **argv, vdb_args *A) {
         } else if ((r = bt_option(CMD, argc, argv, &i, "--threads", &val))) {
             if (r < 0 || bt_parse_threads(CMD, val, &A->o.threads)) return BT_EXIT_BAD_INPUT;
         } else if ((r = bt_option(CMD, argc, argv, &i, "--set", &val))) {
-            if (r < 0) return BT_EXIT_BAD_INPUT;
-            if (A->nsets == BT_MAX_SETS) {
-                bt_error(CMD, "more than %d --set overrides", BT_MAX_SETS);
+            if (r < 0 || bt_set_arg(CMD, val, A->sets, &A->nsets, BT_MAX_SETS))
                 return BT_EXIT_BAD_INPUT;
-            }
-            if (bt_set_parse(CMD, val, &A->sets[A->nsets++])) return BT_EXIT_BAD_INPUT;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
             A->quiet = 1;
         } else if (bt_scene_arg(CMD, argv[i], &A->scene_path)) {
@@ -196,16 +188,9 @@ static int run(int argc, char **argv) {
     if (rc) return rc;
     lb_scene *scene = NULL;
     uint64_t hash[2] = {0, 0};
-    rc = bt_load_scene_set(CMD, A.scene_path, A.sets, A.nsets, &scene, hash);
+    rc = bt_load_scene_region(CMD, A.scene_path, A.sets, A.nsets, A.have_bounds, A.o.bmin, A.o.bmax,
+                              &scene, hash);
     if (rc) return rc;
-    if (!A.have_bounds && !lb_scene_bounds(scene, A.o.bmin, A.o.bmax)) {
-        bt_error(CMD,
-                 "%s: the scene has no bounds; allowed: add \"bounds\" to the scene or give "
-                 "--bounds x0,y0,z0,x1,y1,z1",
-                 A.scene_path);
-        lb_scene_free(scene);
-        return BT_EXIT_BAD_INPUT;
-    }
     lb_error e = {LB_OK, ""};
     lb_evaluator *ev = NULL;
     lb_level_set *ls = NULL;

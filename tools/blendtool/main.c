@@ -3,6 +3,7 @@
 #include "blendtool.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -220,6 +221,46 @@ int bt_fail(const char *cmd, const char *scene_path, lb_status s, const lb_error
     else
         bt_error(cmd, "%s", e->message);
     return bt_exit_for(s);
+}
+
+static int parse_bounds(const char *text, double bmin[3], double bmax[3]) {
+    double v[6];
+    const char *p = text;
+    for (int i = 0; i < 6; ++i) {
+        while (*p == ' ' || *p == ',') ++p;
+        char *end = NULL;
+        errno = 0;
+        v[i] = strtod(p, &end);
+        if (errno || end == p || !isfinite(v[i])) return -1;
+        p = end;
+    }
+    while (*p == ' ' || *p == ',') ++p;
+    if (*p) return -1;
+    for (int d = 0; d < 3; ++d) {
+        bmin[d] = v[d];
+        bmax[d] = v[3 + d];
+    }
+    return 0;
+}
+
+int bt_bounds_arg(const char *cmd, const char *text, double bmin[3], double bmax[3]) {
+    if (!parse_bounds(text, bmin, bmax)) return 0;
+    bt_error(cmd, "--bounds %s: expected six numbers \"x0,y0,z0,x1,y1,z1\"", text);
+    return BT_EXIT_BAD_INPUT;
+}
+
+int bt_load_scene_region(const char *cmd, const char *path, const bt_set *sets, size_t nsets,
+                         int have_bounds, double bmin[3], double bmax[3], lb_scene **scene,
+                         uint64_t hash[2]) {
+    const int rc = bt_load_scene_set(cmd, path, sets, nsets, scene, hash);
+    if (rc || have_bounds || lb_scene_bounds(*scene, bmin, bmax)) return rc;
+    bt_error(cmd,
+             "%s: the scene has no bounds; allowed: add \"bounds\" to the scene or give "
+             "--bounds x0,y0,z0,x1,y1,z1",
+             path);
+    lb_scene_free(*scene);
+    *scene = NULL;
+    return BT_EXIT_BAD_INPUT;
 }
 
 int bt_compile(const char *cmd, const char *scene_path, const lb_scene *sc, lb_evaluator **ev) {

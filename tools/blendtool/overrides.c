@@ -63,6 +63,14 @@ static int all_finite(const cJSON *v) {
     return 1;
 }
 
+int bt_set_arg(const char *cmd, const char *arg, bt_set *sets, size_t *nsets, size_t max) {
+    if (*nsets >= max) {
+        bt_error(cmd, "more than %zu --set overrides", max);
+        return -1;
+    }
+    return bt_set_parse(cmd, arg, &sets[(*nsets)++]);
+}
+
 int bt_set_parse(const char *cmd, const char *arg, bt_set *out) {
     const char *eq = strchr(arg, '=');
     if (!eq || eq == arg) {
