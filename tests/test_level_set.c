@@ -11,7 +11,8 @@
  * - A soft sphere (Wyvill kernel): phi = 0.5 - K(rho), the sign and the
  *   estimate from the kernel's closed form.
  * - The same bits for 1, 2 and 3 threads (S2, 64 blended spheres).
- * - Options out of range, the memory cap and the cancel flag: the status,
+ * - Options out of range (a region past 32-bit voxel indices too), the
+ *   memory cap and the cancel flag: the status,
  *   a message with the allowed range, and no level set. */
 #include "testlib.h"
 
@@ -275,6 +276,12 @@ static void test_refusals(void **state) {
     refused(ev, &o, LB_ERR_INVALID_ARGUMENT, "at most 8192 voxels per axis");
     o.voxel_size = -1;
     refused(ev, &o, LB_ERR_INVALID_ARGUMENT, "a positive number");
+    /* far from the origin in voxels: indices past 32 bits */
+    o.voxel_size = 1e-6;
+    o.bmin[0] = 1e5;
+    o.bmax[0] = 1e5 + 1e-3;
+    refused(ev, &o, LB_ERR_INVALID_ARGUMENT, "voxel indices are 32-bit");
+    region(&o, -1, 1);
     o.voxel_size = 0.5;
     o.bmax[1] = -1;
     refused(ev, &o, LB_ERR_INVALID_ARGUMENT, "min < max");

@@ -33,7 +33,8 @@
  *  - The output does not depend on the thread count, bit for bit.
  *  - Threads: opt->threads (0 = one per online CPU, 1 = the calling thread
  *    only). No callbacks.
- *  - Limits: at most LB_LEVEL_SET_MAX_VOXELS_PER_AXIS voxels per axis,
+ *  - Limits: at most LB_LEVEL_SET_MAX_VOXELS_PER_AXIS voxels per axis, the
+ *    region within LB_LEVEL_SET_MAX_INDEX voxels of the origin,
  *    band 1 .. LB_LEVEL_SET_MAX_BAND voxels, the memory the leaves take
  *    capped (opt->max_memory); a run over a limit fails before the large
  *    allocations with a message naming the limit and what would fit. */
@@ -50,6 +51,9 @@ extern "C" {
 
 #define LB_LEVEL_SET_MAX_VOXELS_PER_AXIS 8192
 #define LB_LEVEL_SET_MAX_BAND 32.0
+/* |coordinate| / voxel size of the region's corners (voxel indices are
+ * 32-bit, as in OpenVDB) */
+#define LB_LEVEL_SET_MAX_INDEX (1 << 30)
 #define LB_LEVEL_SET_DEFAULT_BAND 3.0 /* OpenVDB's default half width */
 #define LB_LEVEL_SET_DEFAULT_RESOLUTION 128
 #define LB_LEVEL_SET_DEFAULT_MAX_MEMORY ((size_t)8 << 30) /* 8 GiB */

@@ -298,7 +298,16 @@ static lb_status check_options(const lb_level_set_options *o, double *h, lb_erro
         *h = longest / o->resolution;
     }
     for (int d = 0; d < 3; ++d) {
-        const double nv = floor(o->bmax[d] / *h) - ceil(o->bmin[d] / *h) + 1.0;
+        /* voxel indices are 32-bit (OpenVDB's too) */
+        const double lo = o->bmin[d] / *h, hi = o->bmax[d] / *h;
+        if (!(fabs(lo) <= LB_LEVEL_SET_MAX_INDEX && fabs(hi) <= LB_LEVEL_SET_MAX_INDEX))
+            return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                            "%s: the region [%g, %g] on axis %d is %.3g voxels of %g from the "
+                            "origin; allowed: at most %d (voxel indices are 32-bit): a larger "
+                            "voxel size or a region nearer the origin",
+                            FN, o->bmin[d], o->bmax[d], d, fmax(fabs(lo), fabs(hi)), *h,
+                            LB_LEVEL_SET_MAX_INDEX);
+        const double nv = floor(hi) - ceil(lo) + 1.0;
         if (!(nv <= LB_LEVEL_SET_MAX_VOXELS_PER_AXIS))
             return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                             "%s: %.0f voxels along axis %d (voxel size %g); allowed: at most %d "
