@@ -17,6 +17,15 @@
 typedef lb_status (*lb__box_visit)(void *ctx, const uint32_t lo[3], const uint32_t hi[3], int depth,
                                    int cell, int *split);
 
+/* Depths of a descent from depth 0 over n[0] x n[1] x n[2] cells: each
+ * level halves one side, so one per doubling of each side, plus the root. */
+static inline int lb__box_depths(const uint32_t n[3]) {
+    int d = 1;
+    for (int a = 0; a < 3; ++a)
+        for (uint32_t s = 1; s < n[a]; s *= 2) ++d;
+    return d;
+}
+
 /* The descent from [lo, hi) at depth (each level one more); depth grows by
  * one per halving, so it is at most the sum of log2 of the sides plus one. */
 static inline lb_status lb__box_descend(void *ctx, lb__box_visit visit, const uint32_t lo[3],

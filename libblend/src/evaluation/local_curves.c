@@ -961,20 +961,14 @@ static void reuse_free(reuse *U) {
 static int reuse_init(reuse *U, const lb_evaluator *ev, const lb_evaluator *prev) {
     memset(U, 0, sizeof *U);
     U->prev = prev;
-    size_t cap = 16;
-    while (cap < 2 * prev->n) cap *= 2;
-    U->tcap = cap;
-    U->tab = calloc(cap, sizeof *U->tab);
+    U->tcap = lb__recs_table_cap(prev->n);
+    U->tab = calloc(U->tcap, sizeof *U->tab);
     U->deep = malloc((ev->n ? ev->n : 1) * sizeof *U->deep);
     if (!U->tab || !U->deep || !lb__recs_make(prev, NULL, 1, 0, &U->P)) {
         reuse_free(U);
         return 0;
     }
-    for (size_t j = 0; j < prev->n; ++j) {
-        size_t s = U->P.h[j] & (cap - 1);
-        while (U->tab[s]) s = (s + 1) & (cap - 1);
-        U->tab[s] = (uint32_t)j + 1;
-    }
+    lb__recs_table_fill(&U->P, prev->n, U->tab, U->tcap);
     return 1;
 }
 
@@ -983,15 +977,7 @@ static int reuse_init(reuse *U, const lb_evaluator *ev, const lb_evaluator *prev
 static uint32_t reuse_match(reuse *U, const lb_evaluator *ev, size_t i) {
     U->b.n = 0;
     if (!lb__record(ev, (uint32_t)i, U->deep, 1, 0, &U->b) || U->b.oom) return LB__RNONE;
-    const uint64_t h = lb__rhash(U->b.p, U->b.n);
-    for (size_t s = h & (U->tcap - 1); U->tab[s]; s = (s + 1) & (U->tcap - 1)) {
-        const uint32_t j = U->tab[s] - 1;
-        const size_t len = U->P.off[j + 1] - U->P.off[j];
-        if (U->P.h[j] == h && len == U->b.n && !U->P.bad[j] &&
-            !memcmp(U->P.p + U->P.off[j], U->b.p, len))
-            return j;
-    }
-    return LB__RNONE;
+    return lb__recs_find(&U->P, U->tab, U->tcap, U->b.p, U->b.n);
 }
 
 lb_status lb__local_prepare(lb_evaluator *ev, const lb_scene *scene, const lb_evaluator *prev,

@@ -180,3 +180,29 @@ int lb__recs_equal(const lb__recs *A, size_t i, const lb__recs *B, size_t j) {
     return !A->bad[i] && !B->bad[j] && A->h[i] == B->h[j] && la == lb &&
            !memcmp(A->p + A->off[i], B->p + B->off[j], la);
 }
+
+size_t lb__recs_table_cap(size_t n) {
+    size_t cap = 16;
+    while (cap < 2 * n) cap *= 2;
+    return cap;
+}
+
+void lb__recs_table_fill(const lb__recs *R, size_t n, uint32_t *tab, size_t tcap) {
+    for (size_t i = 0; i < n; ++i) {
+        size_t s = R->h[i] & (tcap - 1);
+        while (tab[s]) s = (s + 1) & (tcap - 1);
+        tab[s] = (uint32_t)i + 1;
+    }
+}
+
+uint32_t lb__recs_find(const lb__recs *R, const uint32_t *tab, size_t tcap, const uint8_t *p,
+                       size_t len) {
+    const uint64_t h = lb__rhash(p, len);
+    for (size_t s = h & (tcap - 1); tab[s]; s = (s + 1) & (tcap - 1)) {
+        const uint32_t j = tab[s] - 1;
+        if (R->h[j] == h && !R->bad[j] && R->off[j + 1] - R->off[j] == len &&
+            !memcmp(R->p + R->off[j], p, len))
+            return j;
+    }
+    return LB__RNONE;
+}

@@ -54,4 +54,15 @@ LB_INTERNAL int lb__recs_make(const lb_evaluator *ev, const uint32_t *map, int a
  * instruction without a match)? */
 LB_INTERNAL int lb__recs_equal(const lb__recs *A, size_t i, const lb__recs *B, size_t j);
 
+/* An open-addressing table over the n records of R by their hashes, for
+ * finding an instruction by its record: tcap slots (lb__recs_table_cap(n),
+ * a power of 2, zeroed by the caller), each 0 (empty) or instruction + 1. */
+LB_INTERNAL size_t lb__recs_table_cap(size_t n);
+LB_INTERNAL void lb__recs_table_fill(const lb__recs *R, size_t n, uint32_t *tab, size_t tcap);
+/* The instruction of R whose record is the bytes p[0, len), through R's
+ * table, or LB__RNONE (never one that names an instruction without a
+ * match). */
+LB_INTERNAL uint32_t lb__recs_find(const lb__recs *R, const uint32_t *tab, size_t tcap,
+                                   const uint8_t *p, size_t len);
+
 #endif

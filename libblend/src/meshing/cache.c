@@ -105,16 +105,7 @@ lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usa
             M->deep[i] = M->same[i] = NONE;
             b.n = 0;
             if (!lb__record(ev, (uint32_t)i, M->deep, 1, 1, &b) || b.oom) continue;
-            const uint64_t h = lb__rhash(b.p, b.n);
-            for (size_t s = h & (C->tcap - 1); C->tab[s]; s = (s + 1) & (C->tcap - 1)) {
-                const uint32_t j = C->tab[s] - 1;
-                const size_t len = C->full.off[j + 1] - C->full.off[j];
-                if (C->full.h[j] == h && len == b.n &&
-                    !memcmp(C->full.p + C->full.off[j], b.p, len)) {
-                    M->deep[i] = j;
-                    break;
-                }
-            }
+            M->deep[i] = lb__recs_find(&C->full, C->tab, C->tcap, b.p, b.n);
         }
         ok = !b.oom;
         free(b.p);
@@ -313,8 +304,7 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     const lb_evaluator *ev = M->ev;
     blocks_free(C);
     C->valid = 0;
-    size_t cap = 16;
-    while (cap < 2 * ev->n) cap *= 2;
+    const size_t cap = lb__recs_table_cap(ev->n);
     uint32_t *tab = calloc(cap, sizeof *tab);
     uint32_t *scratch = malloc(lb__cmatch_scratch(M) * sizeof *scratch);
     int ok = tab && scratch;
@@ -335,11 +325,7 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     memset(&M->full, 0, sizeof M->full);
     memset(&M->self, 0, sizeof M->self);
     lb__cmatch_free(M);
-    for (size_t i = 0; i < ev->n; ++i) {
-        size_t h = C->full.h[i] & (cap - 1);
-        while (tab[h]) h = (h + 1) & (cap - 1);
-        tab[h] = (uint32_t)i + 1;
-    }
+    lb__recs_table_fill(&C->full, ev->n, tab, cap);
     C->tab = tab;
     C->tcap = cap;
     C->nins = ev->n;

@@ -156,14 +156,6 @@ typedef struct sel {
     lb_error *err;
 } sel;
 
-/* Depths of the octree over nb blocks: each level halves one side. */
-static int sel_depth(const uint32_t nb[3]) {
-    int d = 1;
-    for (int a = 0; a < 3; ++a)
-        for (uint32_t s = 1; s < nb[a]; s *= 2) ++d;
-    return d;
-}
-
 /* One box of blocks [r0, r1) (a visit of lb__box_descend): kept when the
  * surface may cross it, a kept single block into the list with its plan. */
 static lb_status select_visit(void *ctx, const uint32_t r0[3], const uint32_t r1[3], int depth,
@@ -230,7 +222,7 @@ static void blist_free(blist *L) {
  * (with their plans when keep). */
 static lb_status select_all(const lb_evaluator *ev, const lb__grid *g, const uint32_t nb[3],
                             blist *L, size_t max_blocks, int keep, lb_error *err) {
-    const int depth = sel_depth(nb);
+    const int depth = lb__box_depths(nb);
     sel S = {ev,
              g,
              nb,

@@ -357,9 +357,7 @@ lb_status lb_level_set_create(const lb_evaluator *ev, const lb_level_set_options
     }
     const size_t cap = opt->max_memory ? opt->max_memory : LB_LEVEL_SET_DEFAULT_MAX_MEMORY;
     S.max = cap / leaf_bytes(opt->flags);
-    int depth = 1;
-    for (int a = 0; a < 3; ++a)
-        for (uint32_t q = 1; q < S.nb[a]; q *= 2) ++depth;
+    const int depth = lb__box_depths(S.nb);
     S.pool = calloc((size_t)depth, sizeof *S.pool);
     S.R = malloc(lb__ivs_len(ev) * sizeof *S.R);
     if (!S.pool || !S.R) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
@@ -438,14 +436,15 @@ lb_status lb_level_set_create(const lb_evaluator *ev, const lb_level_set_options
     }
     if (!s) { /* voxels evaluated: those of the candidates inside the region */
         for (size_t i = 0; i < S.n; ++i) {
-            size_t c = 1;
+            uint32_t r0[3], r1[3];
             for (int d = 0; d < 3; ++d) {
-                int64_t a = S.c[i].org[d], b = a + LEAF - 1;
-                if (a < S.imin[d]) a = S.imin[d];
-                if (b > S.imax[d]) b = S.imax[d];
-                c *= (size_t)(b - a + 1);
+                r0[d] = (uint32_t)(S.c[i].org[d] / LEAF - S.L0[d]);
+                r1[d] = r0[d] + 1;
             }
-            L->nevaluated += c;
+            int64_t v0[3], v1[3];
+            if (leaf_voxels(&S, r0, r1, v0, v1))
+                L->nevaluated +=
+                    (size_t)((v1[0] - v0[0] + 1) * (v1[1] - v0[1] + 1) * (v1[2] - v0[2] + 1));
         }
     }
     for (size_t i = 0; i < S.n; ++i) lb__cplan_free(&S.c[i].plan);
