@@ -296,7 +296,6 @@ typedef struct bt_vdb {
     int (*write_level_set)(const lb_level_set *ls, double shift, const lbv_meta *meta, size_t nmeta,
                            const char *uuid_seed, unsigned char **data, size_t *size, char *err,
                            size_t errlen);
-    const char *(*version)(void);
 } bt_vdb;
 /* The OpenVDB functions, or NULL after printing why they cannot be loaded. */
 const bt_vdb *bt_vdb_get(const char *cmd);

@@ -24,8 +24,7 @@ const bt_vdb *bt_vdb_get(const char *cmd) {
         api.write_level_set =
             (int (*)(const lb_level_set *, double, const lbv_meta *, size_t, const char *,
                      unsigned char **, size_t *, char *, size_t))dlsym(h, "lbv_write_level_set");
-        api.version = (const char *(*)(void))dlsym(h, "lbv_version");
-        if (!api.write_level_set || !api.version) {
+        if (!api.write_level_set) {
             snprintf(why, sizeof why,
                      "the OpenVDB module liblbvdb.so lacks its functions (not the one built "
                      "with this blendtool)");
@@ -248,8 +247,8 @@ const bt_command bt_cmd_vdb = {
     "the right sign everywhere else. Blender imports it as a Volume object (Volume to\n"
     "Mesh turns it back into a surface), Houdini as a VDB primitive. Only the leaves\n"
     "(8^3 voxels) the field's interval bounds cannot rule out are computed. The\n"
-    "grids carry the scene's hash, libblend's version, the voxel size and band, and\n"
-    "the --set paths as string metadata.\n"
+    "grids carry the scene's hash, libblend's version, the voxel size, band and voxel\n"
+    "centres, and the --set values as string metadata.\n"
     "  --resolution N  voxels along the region's longest side (default 128, at most 8192)\n"
     "  --voxel-size H  the voxel size instead of a resolution (at most 8192 voxels per axis)\n"
     "  --band W        the band's half width in voxels, 1 to 32 (default 3, OpenVDB's)\n"

@@ -82,10 +82,6 @@ bool set_uuid(std::string &bytes, const char *seed) {
 
 } // namespace
 
-extern "C" const char *lbv_version(void) {
-    return openvdb::getLibraryVersionString();
-}
-
 extern "C" int lbv_write_level_set(const lb_level_set *ls, double shift, const lbv_meta *meta,
                                    size_t nmeta, const char *uuid_seed, unsigned char **data,
                                    size_t *size, char *err, size_t errlen) {

@@ -39,9 +39,6 @@ int lbv_write_level_set(const lb_level_set *ls, double shift, const lbv_meta *me
                         const char *uuid_seed, unsigned char **data, size_t *size, char *err,
                         size_t errlen);
 
-/* OpenVDB's library version, "10.0.1" */
-const char *lbv_version(void);
-
 #ifdef __cplusplus
 }
 #endif
