@@ -307,7 +307,7 @@ static lb_status c_mesh_cached(unsigned mask, int size, lb_error *err, int *hs) 
     for (int round = 0; round < 2; ++round) {
         lb_mesh *m = NULL;
         s = lb_mesh_create_cached(P(0, C.ev), P(1, &o), P(2, cache), P(3, &m), P(4, err));
-        lb_mesh_free(m);
+        lb_mesh_cache_recycle(P(2, cache), m); /* NULL cache: freed */
     }
     lb_mesh_cache_stats st;
     lb_mesh_cache_stats_get(P(2, cache), P(1, &st));

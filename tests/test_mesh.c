@@ -1437,7 +1437,11 @@ static void test_bad_options(void **state) {
  * moves step by step (and then another), each mesh byte-identical to a
  * full lb_mesh_create of the same evaluator (positions, normals, triangles,
  * corner normals), with and without sharp features, on 1, 2 and 3 threads;
- * most blocks come from the cache, all of them for the same scene again. */
+ * most blocks come from the cache, all of them for the same scene again.
+ * Between steps a mesh is given back to the cache (lb_mesh_cache_recycle)
+ * in turn: none, the cache's own output, or the full mesh with every byte
+ * of its arrays overwritten (the next output must not depend on what they
+ * held), and once an empty mesh of another region. */
 static char *lattice_text(int moved, double dx) {
     const size_t cap = 16384;
     char *t = malloc(cap);
@@ -1517,6 +1521,33 @@ static void test_mesh_cache(void **state) {
                     reused_total += st.reused;
                     blocks_total += st.blocks;
                 }
+                if (step % 3 == 1) {
+                    lb_mesh_cache_recycle(cache, mc);
+                    mc = NULL;
+                } else if (step % 3 == 2) {
+                    memset(mf->positions, 0xA5, 3 * mf->nvertices * sizeof(double));
+                    memset(mf->normals, 0x5A, 3 * mf->nnormals * sizeof(double));
+                    memset(mf->triangles, 0xFF, 3 * mf->ntriangles * sizeof(uint32_t));
+                    const size_t before = st.bytes;
+                    const size_t arrays =
+                        6 * mf->nvertices * sizeof(double) + 3 * mf->ntriangles * sizeof(uint32_t);
+                    lb_mesh_cache_recycle(cache, mf);
+                    mf = NULL;
+                    lb_mesh_cache_stats_get(cache, &st);
+                    if (st.bytes != before + arrays)
+                        fail_msg("a mesh given back: the cache holds %zu bytes, expected %zu + %zu",
+                                 st.bytes, before, arrays);
+                } else if (step == 3) { /* an empty mesh, of a region the surface misses */
+                    lb_mesh_options q = o;
+                    for (int d = 0; d < 3; ++d) {
+                        q.bmin[d] = 1.9;
+                        q.bmax[d] = 1.95;
+                    }
+                    lb_mesh *me = NULL;
+                    if (lb_mesh_create(ev, &q, &me, &e)) fail_msg("empty region: %s", e.message);
+                    assert_int_equal(me->ntriangles, 0);
+                    lb_mesh_cache_recycle(cache, me);
+                }
                 lb_mesh_free(mc);
                 lb_mesh_free(mf);
                 lb_evaluator_free(ev);
@@ -1530,6 +1561,7 @@ static void test_mesh_cache(void **state) {
     lb_mesh_cache_stats st;
     lb_mesh_cache_stats_get(NULL, &st);
     assert_int_equal(st.blocks, 0);
+    lb_mesh_cache_recycle(NULL, NULL); /* both NULL: nothing */
 }
 
 /* With no argument every case runs; with names (e.g. "test_threads_identical"),

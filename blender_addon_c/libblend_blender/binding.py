@@ -148,6 +148,7 @@ _SIGNATURES = {
     "lb_mesh_create_cached": (ctypes.c_int, [_P, ctypes.POINTER(_MeshOptions), _P,
                                              ctypes.POINTER(ctypes.POINTER(_Mesh)), _ERR]),
     "lb_mesh_cache_stats_get": (None, [_P, ctypes.POINTER(_CacheStats)]),
+    "lb_mesh_cache_recycle": (None, [_P, ctypes.POINTER(_Mesh)]),
     "lb_mesh_edges": (ctypes.c_int, [ctypes.POINTER(_Mesh), _U32, _U32,
                                      ctypes.POINTER(ctypes.c_size_t), _ERR]),
     "lb_mesh_write": (ctypes.c_int, [ctypes.POINTER(_Mesh), ctypes.c_char_p, ctypes.c_int, _ERR]),
@@ -522,7 +523,9 @@ class Evaluator(_Handle):
         simplify > 0 (cells, at most 1) merges triangles wherever the surface
         stays within that tolerance of the field (lb_mesh_options.simplify);
         cache (a MeshCache) remeshes only the blocks that changed since the
-        last mesh made through it (lb_mesh_create_cached), byte-identical."""
+        last mesh made through it (lb_mesh_create_cached), byte-identical;
+        once copied, the C mesh's arrays go back to the cache
+        (lb_mesh_cache_recycle) to take the next output."""
         _need_numpy()
         o = _MeshOptions()
         self.lib._c.lb_mesh_options_init(ctypes.byref(o))
@@ -573,7 +576,10 @@ class Evaluator(_Handle):
                 mesh.edges, mesh.corner_edges = ed[:ne.value].copy(), ce
             return mesh
         finally:
-            self.lib._c.lb_mesh_free(out)
+            if cache is not None:
+                self.lib._c.lb_mesh_cache_recycle(cache.ptr, out)
+            else:
+                self.lib._c.lb_mesh_free(out)
 
 
 class Mesh:

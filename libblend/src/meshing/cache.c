@@ -55,6 +55,11 @@ struct lb_mesh_cache {
     size_t nblocks;
     size_t counts[2]; /* the merged mesh's vertices and triangles */
     lb_mesh_cache_stats stats;
+    /* a mesh given back (lb_mesh_cache_recycle): its arrays, with room for
+     * nv vertices (positions and normals) and nt triangles; NULL: none */
+    double *spare_pos, *spare_nrm;
+    uint32_t *spare_tri;
+    size_t spare_nv, spare_nt;
 };
 
 /* The matching of an evaluator against the cache (mesher.c's rule):
@@ -141,6 +146,19 @@ static void blocks_free(lb_mesh_cache *C) {
     free(C->blocks);
     C->blocks = NULL;
     C->nblocks = 0;
+}
+
+static void spare_free(lb_mesh_cache *C) {
+    free(C->spare_pos);
+    free(C->spare_nrm);
+    free(C->spare_tri);
+    C->spare_pos = C->spare_nrm = NULL;
+    C->spare_tri = NULL;
+    C->spare_nv = C->spare_nt = 0;
+}
+
+static size_t spare_bytes(const lb_mesh_cache *C) {
+    return C->spare_pos ? 6 * C->spare_nv * sizeof(double) + 3 * C->spare_nt * sizeof(uint32_t) : 0;
 }
 
 const lb__cblock *lb__cache_blocks(const lb_mesh_cache *C, size_t *n) {
@@ -351,11 +369,25 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
                    2 * C->nins * (sizeof(size_t) + sizeof(uint64_t) + 1) +
                    C->tcap * sizeof(uint32_t);
     for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
+    bytes += spare_bytes(C);
     C->stats.blocks = n;
     C->stats.reused = reused;
     C->stats.recycled += reused > 0;
     C->stats.bytes = bytes;
     return LB_OK;
+}
+
+void lb__cache_take_spare(lb_mesh_cache *C, lb_mesh *M, size_t *vcap, size_t *tcap) {
+    if (!C->spare_pos) return;
+    C->stats.bytes -= spare_bytes(C);
+    M->positions = C->spare_pos;
+    M->normals = C->spare_nrm;
+    M->triangles = C->spare_tri;
+    *vcap = C->spare_nv;
+    *tcap = C->spare_nt;
+    C->spare_pos = C->spare_nrm = NULL;
+    C->spare_tri = NULL;
+    C->spare_nv = C->spare_nt = 0;
 }
 
 /* ---- the public side ---- */
@@ -368,8 +400,28 @@ lb_status lb_mesh_cache_create(lb_mesh_cache **out, lb_error *err) {
     return LB_OK;
 }
 
+void lb_mesh_cache_recycle(lb_mesh_cache *C, lb_mesh *mesh) {
+    if (!C || !mesh || !mesh->positions || !mesh->normals || !mesh->triangles) {
+        lb_mesh_free(mesh);
+        return;
+    }
+    C->stats.bytes -= spare_bytes(C);
+    spare_free(C);
+    /* room as allocated: the arrays were shrunk to the mesh's counts (at
+     * least one entry each), normals to nnormals >= nvertices */
+    C->spare_pos = mesh->positions;
+    C->spare_nrm = mesh->normals;
+    C->spare_tri = mesh->triangles;
+    C->spare_nv = mesh->nvertices;
+    C->spare_nt = mesh->ntriangles;
+    C->stats.bytes += spare_bytes(C);
+    free(mesh->corner_normals);
+    free(mesh);
+}
+
 void lb_mesh_cache_free(lb_mesh_cache *C) {
     if (!C) return;
+    spare_free(C);
     blocks_free(C);
     lb__recs_free(&C->full);
     lb__recs_free(&C->self);

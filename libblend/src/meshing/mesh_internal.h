@@ -176,6 +176,9 @@ LB_INTERNAL lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb
 /* The vertices and triangles of the cached mesh once merged (before the
  * passes after it). */
 LB_INTERNAL void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt);
+/* The arrays of a mesh given back (lb_mesh_cache_recycle), if any, moved
+ * into M (empty) with their room (vertices, triangles) in vcap and tcap. */
+LB_INTERNAL void lb__cache_take_spare(lb_mesh_cache *C, lb_mesh *M, size_t *vcap, size_t *tcap);
 
 /* The facing of triangle (a, b, c): (b - a) x (c - a), not normalised
  * (features.c's flips and folds, corners.c). */
