@@ -812,12 +812,15 @@ lb_status lb__cplan_make(const lb_evaluator *ev, const lb__plan *P, lb__cplan *C
     cplan_sizes(ev, P, &nl, &na);
     C->nlist = (uint32_t)nl;
     C->nact_total = (uint32_t)na;
-    C->list = malloc((nl ? nl : 1) * sizeof *C->list);
-    C->act = malloc((na ? na : 1) * sizeof *C->act);
-    if (!C->list || !C->act) {
-        lb__cplan_free(C);
+    /* one allocation, the arguments after the list (a mesh keeps one plan
+     * per block: tens of thousands of allocations per run) */
+    C->list = malloc((nl ? nl : 1) * sizeof *C->list + (na ? na : 1) * sizeof *C->act);
+    if (!C->list) {
+        C->act = NULL;
+        C->nlist = C->nact_total = 0;
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
     }
+    C->act = (uint16_t *)(void *)(C->list + (nl ? nl : 1));
     cplan_fill(ev, P, C->list, C->act);
     return LB_OK;
 }
@@ -849,8 +852,7 @@ void *lb__cplan_pack(const lb_evaluator *ev, const lb__plan *P, size_t n, lb__cp
 }
 
 void lb__cplan_free(lb__cplan *C) {
-    free(C->list);
-    free(C->act);
+    free(C->list); /* act lies in the same allocation */
     C->list = NULL;
     C->act = NULL;
     C->nlist = C->nact_total = 0;

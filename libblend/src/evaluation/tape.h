@@ -88,7 +88,9 @@ typedef struct lb__plan {
 LB_INTERNAL lb_status lb__plan_alloc(const lb_evaluator *ev, lb__plan *P, lb_error *err);
 
 /* A plan kept small, for many boxes at once (the mesher's blocks): the
- * listed instructions, then each listed operator's argument list. */
+ * listed instructions, then each listed operator's argument list.
+ * lb__cplan_make allocates both in one block (act right after list), which
+ * lb__cplan_free frees. */
 typedef struct lb__cplan {
     uint32_t nlist, nact_total;
     uint32_t *list;
