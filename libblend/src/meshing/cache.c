@@ -24,6 +24,20 @@
  * mesher.c takes a block from the cache only when all of those are the
  * same in both meshes.
  *
+ * The selection's boxes. The block selection (mesher.c) descends an
+ * octree of boxes of blocks, each box's interval pass under its parent's
+ * plan. Which blocks under a box are kept, and their plans, are a function
+ * of the box and of its own plan alone (the passes below read nothing
+ * else), by the same argument as a block's output. So the cache keeps the
+ * boxes at one depth (about 4 x 4 x 4 blocks) with their plans, and a box
+ * whose plan is the cached box's, content for content (lb__cache_same_plan,
+ * as for blocks), takes the cached blocks under it instead of descending:
+ * their plans written in the new evaluator's indices through the two
+ * boxes' lists, which match place for place (a block's list is a subset of
+ * its box's). Those blocks then go through the block rule like any other.
+ * On the 512-sphere lattice with one sphere moved this skips most of the
+ * selection's interval passes.
+ *
  * The records. For each instruction of the evaluator last meshed, its
  * content with arguments as instruction indices of that evaluator (a
  * record), in one buffer, with a hash table over the records for the
@@ -53,6 +67,12 @@ struct lb_mesh_cache {
     size_t tcap;
     lb__cblock *blocks; /* sorted by id */
     size_t nblocks;
+    /* the block selection's boxes at depth node_depth (-1: none) that the
+     * surface may cross: id is the box's first block's, plan its plan
+     * (with argpos), sorted by id */
+    lb__cblock *nodes;
+    size_t nnodes;
+    int node_depth;
     size_t counts[2]; /* the merged mesh's vertices and triangles */
     lb_mesh_cache_stats stats;
     /* a mesh given back (lb_mesh_cache_recycle): its arrays, with room for
@@ -146,6 +166,68 @@ static void blocks_free(lb_mesh_cache *C) {
     free(C->blocks);
     C->blocks = NULL;
     C->nblocks = 0;
+    lb__cnodes_free(C->nodes, C->nnodes);
+    C->nodes = NULL;
+    C->nnodes = 0;
+    C->node_depth = -1;
+}
+
+void lb__cnodes_free(lb__cblock *nodes, size_t n) {
+    for (size_t i = 0; i < n; ++i) lb__cblock_free(&nodes[i]);
+    free(nodes);
+}
+
+static int cmp_id(const void *a, const void *b) {
+    const uint64_t x = ((const lb__cblock *)a)->id, y = ((const lb__cblock *)b)->id;
+    return x < y ? -1 : x > y;
+}
+
+/* The first of the n entries of E (sorted by id) with id >= key. */
+static size_t lower_id(const lb__cblock *E, size_t n, uint64_t key) {
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        const size_t m = lo + (hi - lo) / 2;
+        if (E[m].id < key)
+            lo = m + 1;
+        else
+            hi = m;
+    }
+    return lo;
+}
+
+const lb__cblock *lb__cache_node(const lb_mesh_cache *C, int depth, uint64_t id) {
+    if (!C->valid || depth != C->node_depth) return NULL;
+    const size_t q = lower_id(C->nodes, C->nnodes, id);
+    return q < C->nnodes && C->nodes[q].id == id ? &C->nodes[q] : NULL;
+}
+
+size_t lb__cache_block_from(const lb_mesh_cache *C, uint64_t id) {
+    return lower_id(C->blocks, C->nblocks, id);
+}
+
+int lb__cache_carry(const lb__cblock *node, const lb__cplan *now, const lb__cplan *leaf,
+                    lb__cplan *out) {
+    const uint32_t nl = leaf->nlist, na = leaf->nact_total;
+    memset(out, 0, sizeof *out);
+    uint32_t *list = malloc((nl ? nl : 1) * sizeof *list + (na ? na : 1) * sizeof *out->act);
+    if (!list) return 0;
+    /* both lists ascend, and the leaf's is a subset of the box's */
+    uint32_t q = 0;
+    for (uint32_t t = 0; t < nl; ++t) {
+        const uint32_t j = leaf->list[t];
+        while (q < node->plan.nlist && node->plan.list[q] < j) ++q;
+        if (q == node->plan.nlist || node->plan.list[q] != j) {
+            free(list);
+            return 0;
+        }
+        list[t] = now->list[q];
+    }
+    out->list = list;
+    out->act = (uint16_t *)(void *)(list + (nl ? nl : 1));
+    if (na) memcpy(out->act, leaf->act, na * sizeof *out->act);
+    out->nlist = nl;
+    out->nact_total = na;
+    return 1;
 }
 
 static void spare_free(lb_mesh_cache *C) {
@@ -318,7 +400,8 @@ void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt) {
 }
 
 lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, lb__cblock *blocks,
-                           size_t n, size_t reused, const size_t counts[2], lb_error *err) {
+                           size_t n, size_t reused, const size_t counts[2], lb__cblock *nodes,
+                           size_t nnodes, int node_depth, lb_error *err) {
     const lb_evaluator *ev = M->ev;
     blocks_free(C);
     C->valid = 0;
@@ -327,11 +410,13 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     uint32_t *scratch = malloc(lb__cmatch_scratch(M) * sizeof *scratch);
     int ok = tab && scratch;
     for (size_t i = 0; i < n && ok; ++i) ok = set_places(M, &blocks[i], scratch);
+    for (size_t i = 0; i < nnodes && ok; ++i) ok = set_places(M, &nodes[i], scratch);
     free(scratch);
     if (!ok) {
         free(tab);
         for (size_t i = 0; i < n; ++i) lb__cblock_free(&blocks[i]);
         free(blocks);
+        lb__cnodes_free(nodes, nnodes);
         lb__cmatch_free(M);
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create_cached: out of memory");
     }
@@ -351,6 +436,10 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     C->counts[1] = counts[1];
     C->blocks = blocks;
     C->nblocks = n;
+    if (nnodes) qsort(nodes, nnodes, sizeof *nodes, cmp_id); /* made in descent order */
+    C->nodes = nodes;
+    C->nnodes = nnodes;
+    C->node_depth = node_depth;
     C->valid = 1;
     for (int d = 0; d < 3; ++d) {
         C->origin[d] = g->origin[d];
@@ -369,6 +458,7 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
                    2 * C->nins * (sizeof(size_t) + sizeof(uint64_t) + 1) +
                    C->tcap * sizeof(uint32_t);
     for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
+    for (size_t i = 0; i < nnodes; ++i) bytes += cblock_bytes(&nodes[i]);
     bytes += spare_bytes(C);
     C->stats.blocks = n;
     C->stats.reused = reused;
@@ -397,6 +487,7 @@ lb_status lb_mesh_cache_create(lb_mesh_cache **out, lb_error *err) {
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT, "lb_mesh_cache_create: out must be non-NULL");
     *out = calloc(1, sizeof **out);
     if (!*out) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_cache_create: out of memory");
+    (*out)->node_depth = -1;
     return LB_OK;
 }
 

@@ -172,7 +172,23 @@ LB_INTERNAL void lb__cache_import(const lb__cblock *E, lb__block *B);
  * vertices and triangles. On failure the cache is emptied. */
 LB_INTERNAL lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g,
                                        lb__cblock *blocks, size_t n, size_t reused,
-                                       const size_t counts[2], lb_error *err);
+                                       const size_t counts[2], lb__cblock *nodes, size_t nnodes,
+                                       int node_depth, lb_error *err);
+/* The incremental block selection (mesher.c's select_visit; cache.c states
+ * the rule): the selection's boxes at one depth are kept with their plans
+ * (nodes, moved into the cache by the commit, with n of them; freed by
+ * lb__cnodes_free otherwise). A box whose plan is the cached box's, content
+ * for content, has the cached box's blocks under it with the same plans:
+ * lb__cache_node finds the cached box (NULL: none, or another depth),
+ * lb__cache_block_from the first cached block with id >= a given one, and
+ * lb__cache_carry writes a cached block's plan in the new evaluator's
+ * indices (through the two boxes' lists, equal place for place); 0 when an
+ * instruction is missing from the box's list or memory is short. */
+LB_INTERNAL void lb__cnodes_free(lb__cblock *nodes, size_t n);
+LB_INTERNAL const lb__cblock *lb__cache_node(const lb_mesh_cache *C, int depth, uint64_t id);
+LB_INTERNAL size_t lb__cache_block_from(const lb_mesh_cache *C, uint64_t id);
+LB_INTERNAL int lb__cache_carry(const lb__cblock *node, const lb__cplan *now, const lb__cplan *leaf,
+                                lb__cplan *out);
 /* The vertices and triangles of the cached mesh once merged (before the
  * passes after it). */
 LB_INTERNAL void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt);

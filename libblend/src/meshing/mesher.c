@@ -144,6 +144,24 @@ typedef struct blist {
     size_t n, cap;
 } blist;
 
+/* The incremental selection (cache.c states the rule): the boxes at depth
+ * `depth` that the surface may cross, with their plans, for the next
+ * cache (nodes); with a usable match M, a box whose plan is the cached
+ * box's takes the cached blocks under it instead of its descent. */
+typedef struct incsel {
+    lb_mesh_cache *cache;
+    lb__cmatch *M; /* NULL: record the boxes only */
+    uint32_t *scratch;
+    int depth; /* -1: none */
+    lb__cblock *nodes;
+    size_t n, cap;
+    size_t carried; /* blocks carried over */
+} incsel;
+
+/* Halvings above the blocks for the boxes the incremental selection keeps:
+ * boxes of about 4 x 4 x 4 blocks. */
+#define INC_LEVELS 6
+
 typedef struct sel {
     const lb_evaluator *ev;
     const lb__grid *g;
@@ -152,9 +170,89 @@ typedef struct sel {
     size_t max_blocks;
     lb__plan *pool; /* one plan per depth */
     lb__iv *R;
-    int keep; /* store each block's plan */
+    int keep;    /* store each block's plan */
+    incsel *inc; /* NULL: a plain selection */
     lb_error *err;
 } sel;
+
+/* Room for one more block in L (over max_blocks: LB_ERR_NO_MEMORY too). */
+static lb_status blist_room(sel *S) {
+    blist *L = S->L;
+    if (L->n >= S->max_blocks)
+        return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: more than %zu blocks", FN, S->max_blocks);
+    if (L->n == L->cap) {
+        const size_t nc = L->cap ? 2 * L->cap : 256;
+        lb__block *q = realloc(L->b, nc * sizeof *q);
+        if (!q) return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        L->b = q;
+        L->cap = nc;
+    }
+    return LB_OK;
+}
+
+/* A block of the list at block coordinates b (its cells clipped to the
+ * grid), with plan. */
+static void block_at(sel *S, const uint32_t b[3], const lb__cplan *plan) {
+    lb__block *B = &S->L->b[S->L->n++];
+    memset(B, 0, sizeof *B);
+    if (plan) B->plan = *plan;
+    for (int d = 0; d < 3; ++d) {
+        const uint64_t n0 = (uint64_t)b[d] * LB__MB;
+        uint64_t n1 = n0 + LB__MB;
+        if (n1 > S->g->cells[d]) n1 = S->g->cells[d];
+        B->b[d] = b[d];
+        B->nc[d] = (uint32_t)(n1 - n0);
+    }
+    B->id = ((uint64_t)b[2] * S->nb[1] + b[1]) * S->nb[0] + b[0];
+}
+
+/* Box [r0, r1) at the incremental depth, its plan own: recorded for the
+ * next cache; *taken when the cached blocks under it were taken instead of
+ * its descent. */
+static lb_status inc_box(sel *S, const uint32_t r0[3], const uint32_t r1[3], const lb__plan *own,
+                         int *taken) {
+    incsel *I = S->inc;
+    *taken = 0;
+    if (I->n == I->cap) {
+        const size_t nc = I->cap ? 2 * I->cap : 64;
+        lb__cblock *q = realloc(I->nodes, nc * sizeof *q);
+        if (!q) return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        I->nodes = q;
+        I->cap = nc;
+    }
+    lb__cblock *N = &I->nodes[I->n];
+    memset(N, 0, sizeof *N);
+    lb_status s = lb__cplan_make(S->ev, own, &N->plan, S->err);
+    if (s) return s;
+    N->id = ((uint64_t)r0[2] * S->nb[1] + r0[1]) * S->nb[0] + r0[0];
+    ++I->n;
+    const lb__cblock *E = I->M ? lb__cache_node(I->cache, I->depth, N->id) : NULL;
+    if (!E || !lb__cache_same_plan(I->cache, I->M, E, &N->plan, I->scratch)) return LB_OK;
+    size_t nold = 0;
+    const lb__cblock *old = lb__cache_blocks(I->cache, &nold);
+    const size_t first = S->L->n;
+    for (uint32_t z = r0[2]; z < r1[2]; ++z)
+        for (uint32_t y = r0[1]; y < r1[1]; ++y) {
+            const uint64_t row = ((uint64_t)z * S->nb[1] + y) * S->nb[0];
+            for (size_t j = lb__cache_block_from(I->cache, row + r0[0]);
+                 j < nold && old[j].id < row + r1[0]; ++j) {
+                lb__cplan p;
+                if ((s = blist_room(S))) return s;
+                if (!lb__cache_carry(E, &N->plan, &old[j].plan, &p)) {
+                    /* not carried: the blocks taken so far go, and the box
+                     * is descended */
+                    for (size_t k = first; k < S->L->n; ++k) lb__cplan_free(&S->L->b[k].plan);
+                    S->L->n = first;
+                    return LB_OK;
+                }
+                const uint32_t b[3] = {(uint32_t)(old[j].id % S->nb[0]), y, z};
+                block_at(S, b, &p);
+            }
+        }
+    I->carried += S->L->n - first;
+    *taken = 1;
+    return LB_OK;
+}
 
 /* One box of blocks [r0, r1) (a visit of lb__box_descend): kept when the
  * surface may cross it, a kept single block into the list with its plan. */
@@ -182,30 +280,18 @@ static lb_status select_visit(void *ctx, const uint32_t r0[3], const uint32_t r1
     double lo, hi;
     phi_interval(g, bl, bh, S->R[S->ev->out].lo, S->R[S->ev->out].hi, &lo, &hi);
     if (lo >= 0.0 || hi < 0.0) return LB_OK; /* all outside, or all inside */
-    blist *L = S->L;
     if (cell) {
-        if (L->n >= S->max_blocks)
-            return lb__fail(err, LB_ERR_NO_MEMORY, "%s: more than %zu blocks", FN, S->max_blocks);
-        if (L->n == L->cap) {
-            const size_t nc = L->cap ? 2 * L->cap : 256;
-            lb__block *q = realloc(L->b, nc * sizeof *q);
-            if (!q) return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-            L->b = q;
-            L->cap = nc;
-        }
-        lb__block *B = &L->b[L->n];
-        memset(B, 0, sizeof *B);
-        if (S->keep) {
-            lb_status s = lb__cplan_make(S->ev, own, &B->plan, err);
-            if (s) return s;
-        }
-        ++L->n;
-        for (int d = 0; d < 3; ++d) {
-            B->b[d] = r0[d];
-            B->nc[d] = (uint32_t)(n1[d] - n0[d]);
-        }
-        B->id = ((uint64_t)r0[2] * S->nb[1] + r0[1]) * S->nb[0] + r0[0];
+        lb_status s = blist_room(S);
+        lb__cplan p;
+        if (!s && S->keep) s = lb__cplan_make(S->ev, own, &p, err);
+        if (s) return s;
+        block_at(S, r0, S->keep ? &p : NULL);
         return LB_OK;
+    }
+    if (S->inc && depth == S->inc->depth) {
+        int taken;
+        const lb_status s = inc_box(S, r0, r1, own, &taken);
+        if (s || taken) return s;
     }
     *split = 1;
     return LB_OK;
@@ -219,9 +305,9 @@ static void blist_free(blist *L) {
 }
 
 /* The blocks of grid g (nb per axis) that the surface may cross, into L
- * (with their plans when keep). */
+ * (with their plans when keep; through inc, when not NULL, incrementally). */
 static lb_status select_all(const lb_evaluator *ev, const lb__grid *g, const uint32_t nb[3],
-                            blist *L, size_t max_blocks, int keep, lb_error *err) {
+                            blist *L, size_t max_blocks, int keep, incsel *inc, lb_error *err) {
     const int depth = lb__box_depths(nb);
     sel S = {ev,
              g,
@@ -231,6 +317,7 @@ static lb_status select_all(const lb_evaluator *ev, const lb__grid *g, const uin
              calloc((size_t)depth, sizeof(lb__plan)),
              malloc(lb__ivs_len(ev) * sizeof(lb__iv)),
              keep,
+             inc,
              err};
     lb_status s = S.pool && S.R ? LB_OK : lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     for (int d = 0; d < depth && !s && S.pool; ++d) s = lb__plan_alloc(ev, &S.pool[d], err);
@@ -1212,7 +1299,7 @@ static int fits(const lb_evaluator *ev, const lb_mesh_options *opt, unsigned res
     uint32_t nb[3];
     for (int d = 0; d < 3; ++d) nb[d] = (g.cells[d] + LB__MB - 1) / LB__MB;
     blist L = {NULL, 0, 0};
-    const lb_status s = select_all(ev, &g, nb, &L, max_blocks, 0, NULL);
+    const lb_status s = select_all(ev, &g, nb, &L, max_blocks, 0, NULL, NULL);
     blist_free(&L);
     return s == LB_OK;
 }
@@ -1275,7 +1362,24 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     for (int d = 0; d < 3; ++d) R.nb[d] = (g.cells[d] + LB__MB - 1) / LB__MB;
     progress P = {opt->progress, opt->user, 0.0, 0.05, 0};
     blist L = {NULL, 0, 0};
-    s = select_all(ev, &g, R.nb, &L, max_blocks, 1, err);
+    /* with a cache: the matching of ev against it (cache.c), which the
+     * selection uses for its boxes and the blocks for theirs */
+    lb__cmatch *match = NULL;
+    incsel inc = {cache, NULL, NULL, -1, NULL, 0, 0, 0};
+    const int usable = cache && lb__cache_usable(cache, ev, &g);
+    if (cache) {
+        s = lb__cmatch_new(cache, ev, usable, &match, err);
+        if (s) return s;
+        inc.M = usable ? match : NULL;
+        inc.depth = lb__box_depths(R.nb) - 1 - INC_LEVELS;
+        if (inc.depth < 1) inc.depth = -1;
+        inc.scratch = malloc(lb__cmatch_scratch(match) * sizeof *inc.scratch);
+        if (!inc.scratch) {
+            lb__cmatch_free(match);
+            return lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+        }
+    }
+    s = select_all(ev, &g, R.nb, &L, max_blocks, 1, cache ? &inc : NULL, err);
     if (s == LB_ERR_NO_MEMORY && L.n >= max_blocks) {
         const unsigned fit = largest_fit(ev, opt, max_blocks);
         if (fit)
@@ -1294,32 +1398,28 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
                          max_memory >> 20);
     }
     if (!s && !sort_blocks(&L)) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    if (s) {
-        blist_free(&L);
-        return s;
-    }
-    R.blocks = L.b;
-    R.nblocks = L.n;
-    lb__cmatch *match = NULL;
     size_t merged[2] = {0, 0}; /* the merged mesh's vertices and triangles, for the cache */
-    if (cache) {               /* each block's entry for the cache; the matches for its rule */
+    if (!s && cache) {         /* each block's entry for the cache */
         R.cache = cache;
-        R.ms.keep = calloc(R.nblocks ? R.nblocks : 1, sizeof *R.ms.keep);
+        R.ms.keep = calloc(L.n ? L.n : 1, sizeof *R.ms.keep);
         if (!R.ms.keep) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-        const int usable = lb__cache_usable(cache, ev, &g);
         if (usable) {
             lb__cache_counts(cache, &R.ms.vhint, &R.ms.thint);
             R.ms.vhint += R.ms.vhint / 16;
             R.ms.thint += R.ms.thint / 16;
-        }
-        if (!s) s = lb__cmatch_new(cache, ev, usable, &match, err);
-        if (usable) R.match = match;
-        if (s) {
-            free(R.ms.keep);
-            blist_free(&L);
-            return s;
+            R.match = match;
         }
     }
+    if (s) {
+        free(R.ms.keep);
+        blist_free(&L);
+        lb__cmatch_free(match);
+        lb__cnodes_free(inc.nodes, inc.n);
+        free(inc.scratch);
+        return s;
+    }
+    R.blocks = L.b;
+    R.nblocks = L.n;
     pthread_mutex_init(&R.lock, NULL);
     pthread_mutex_init(&R.mlock, NULL);
     size_t nt = opt->threads == 0 ? lb__cpu_count() : (size_t)opt->threads;
@@ -1405,9 +1505,11 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
             E->id = R.blocks[i].id;
         }
         lb_error ce;
-        const lb_status cs =
-            lb__cache_commit(cache, match, &g, R.ms.keep, R.nblocks, R.nreused, merged, &ce);
+        const lb_status cs = lb__cache_commit(cache, match, &g, R.ms.keep, R.nblocks, R.nreused,
+                                              merged, inc.nodes, inc.n, inc.depth, &ce);
         match = NULL;
+        inc.nodes = NULL;
+        inc.n = 0;
         if (cs) {
             /* out of memory for the records: the cache is emptied (the next
              * run meshes everything), the mesh is still good */
@@ -1421,6 +1523,8 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         for (size_t i = 0; i < R.nblocks; ++i) lb__cblock_free(&R.ms.keep[i]);
     free(R.ms.keep);
     lb__cmatch_free(match);
+    lb__cnodes_free(inc.nodes, inc.n);
+    free(inc.scratch);
     free(R.from);
     free(R.want);
     for (size_t i = 0; i < R.nblocks; ++i) {
