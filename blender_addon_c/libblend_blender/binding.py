@@ -513,7 +513,7 @@ class Evaluator(_Handle):
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
              max_memory=0, cancel=None, edges=False, features=False, corner_normals=True,
-             simplify=0.0, cache=None):
+             simplify=0.0, cache=None, recycle=False):
         """Mesh the field over the box [bmin, bmax] (docs/meshing.md). Returns a
         Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called.
         edges=True also fills Mesh.edges and Mesh.corner_edges (lb_mesh_edges);
@@ -524,8 +524,9 @@ class Evaluator(_Handle):
         stays within that tolerance of the field (lb_mesh_options.simplify);
         cache (a MeshCache) remeshes only the blocks that changed since the
         last mesh made through it (lb_mesh_create_cached), byte-identical;
-        once copied, the C mesh's arrays go back to the cache
-        (lb_mesh_cache_recycle) to take the next output."""
+        recycle=True (with a cache) gives the C mesh's arrays back to the
+        cache once copied (lb_mesh_cache_recycle), to take the next output:
+        faster in most runs, slower in some (docs/meshing.md)."""
         _need_numpy()
         o = _MeshOptions()
         self.lib._c.lb_mesh_options_init(ctypes.byref(o))
@@ -576,7 +577,7 @@ class Evaluator(_Handle):
                 mesh.edges, mesh.corner_edges = ed[:ne.value].copy(), ce
             return mesh
         finally:
-            if cache is not None:
+            if cache is not None and recycle:
                 self.lib._c.lb_mesh_cache_recycle(cache.ptr, out)
             else:
                 self.lib._c.lb_mesh_free(out)
