@@ -7,6 +7,7 @@
 #include <stdlib.h>
 
 #ifdef _WIN32
+#include <malloc.h>
 #include <windows.h>
 
 wchar_t *lb__wide(const char *s) {
@@ -22,6 +23,19 @@ wchar_t *lb__wide(const char *s) {
     }
     MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, s, -1, w, n);
     return w;
+}
+
+size_t lb__usable_size(void *p) {
+    return p ? _msize(p) : 0;
+}
+
+void *lb__huge_alloc(size_t bytes) {
+    return malloc(bytes ? bytes : 1);
+}
+
+void lb__huge_free(void *p, size_t bytes) {
+    (void)bytes;
+    free(p);
 }
 
 size_t lb__cpu_count(void) {
@@ -55,6 +69,9 @@ void lb__huge_pages(void *p, size_t bytes) {
 #include "glibc_compat.h"
 
 #include <stdint.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -71,6 +88,41 @@ size_t lb__cpu_count(void) {
 
 FILE *lb__fopen(const char *path, const char *mode) {
     return fopen(path, mode);
+}
+
+size_t lb__usable_size(void *p) {
+#ifdef __GLIBC__
+    return p ? malloc_usable_size(p) : 0;
+#else
+    (void)p;
+    return 0;
+#endif
+}
+
+#define HUGE ((size_t)2 << 20)
+
+void *lb__huge_alloc(size_t bytes) {
+    if (bytes < HUGE) return malloc(bytes ? bytes : 1); /* too small for a huge page */
+    bytes = (bytes + HUGE - 1) & ~(HUGE - 1);
+    /* a mapping one huge page longer, its unaligned head and tail given back */
+    unsigned char *m =
+        mmap(NULL, bytes + HUGE, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (m == MAP_FAILED) return NULL;
+    unsigned char *p = m + ((HUGE - ((uintptr_t)m & (HUGE - 1))) & (HUGE - 1));
+    if (p > m) munmap(m, (size_t)(p - m));
+    if (m + HUGE > p) munmap(p + bytes, (size_t)(m + HUGE - p));
+#ifdef MADV_HUGEPAGE
+    (void)madvise(p, bytes, MADV_HUGEPAGE);
+#endif
+    return p;
+}
+
+void lb__huge_free(void *p, size_t bytes) {
+    if (bytes < HUGE) {
+        free(p);
+        return;
+    }
+    if (p) munmap(p, (bytes + HUGE - 1) & ~(HUGE - 1));
 }
 
 void lb__huge_pages(void *p, size_t bytes) {

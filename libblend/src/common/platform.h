@@ -25,6 +25,19 @@ LB_INTERNAL FILE *lb__fopen(const char *path, const char *mode);
  * writing (docs/meshing.md, Incremental remeshing). Nothing elsewhere. */
 LB_INTERNAL void lb__huge_pages(void *p, size_t bytes);
 
+/* bytes of memory on huge pages where the system offers them (on Linux,
+ * from 2 MiB on, an anonymous mapping aligned to 2 MiB and advised so, its
+ * pages then faulted 2 MiB at a time; else malloc), for large long-lived buffers read
+ * over and over (the mesh cache's slabs). NULL when out of memory. Free it
+ * with lb__huge_free and the same bytes. */
+LB_INTERNAL void *lb__huge_alloc(size_t bytes);
+LB_INTERNAL void lb__huge_free(void *p, size_t bytes);
+
+/* The bytes usable at p, a block from malloc, calloc or realloc (at least
+ * the size asked for), or 0 where the C runtime does not say (then the
+ * caller assumes the size it asked for). */
+LB_INTERNAL size_t lb__usable_size(void *p);
+
 /* Whether a UTF-8 path names a folder. */
 LB_INTERNAL int lb__is_directory(const char *path);
 

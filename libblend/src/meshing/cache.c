@@ -49,9 +49,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../common/platform.h"
 #include "../evaluation/records.h"
 
 #define NONE LB__RNONE
+
+typedef struct lb__slab lb__slab;
 
 struct lb_mesh_cache {
     int valid;
@@ -75,6 +78,10 @@ struct lb_mesh_cache {
     int node_depth;
     size_t counts[2]; /* the merged mesh's vertices and triangles */
     lb_mesh_cache_stats stats;
+    /* the slabs the blocks' output lies in (the last one filled next), and
+     * their bytes */
+    lb__slab **slabs;
+    size_t nslabs, slabcap, slab_bytes;
     /* a mesh given back (lb_mesh_cache_recycle): its arrays, with room for
      * nv vertices (positions and normals) and nt triangles; NULL: none */
     double *spare_pos, *spare_nrm;
@@ -144,19 +151,178 @@ lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usa
     return LB_OK;
 }
 
+/* ---- slabs ----
+ * A block's output (the merge's source: vertices, triangles, references,
+ * near-face tables) is copied, when the cache takes it, into a slab: one
+ * large allocation, advised onto huge pages, holding many blocks' arrays
+ * back to back. An incremental run reads all of it (about 200 MB for a
+ * 3-million-triangle mesh); as some 150,000 small blocks of the C
+ * runtime's heap it spans 50,000 pages, and on a machine whose hypervisor
+ * keeps shadow page tables (measured on this project's build machine, a
+ * PVM guest) every page touched after any unmapping in the process
+ * costs a fault in the host, which tripled some runs (docs/meshing.md).
+ * A slab counts its entries; a slab with none is freed at the next commit,
+ * and when the slabs hold more than twice the live bytes (many edits
+ * leave holes) the live entries are moved into new ones. */
+struct lb__slab {
+    size_t live, liveb; /* entries and their bytes */
+    size_t used, cap;   /* bytes of data */
+    double *data;       /* the bytes (aligned for every array type) */
+};
+
+/* A new slab's bytes: an eighth of the blocks' output, from 64 KiB to
+ * 8 MiB (a small cache in small slabs, so that its holes are moved out
+ * too; a large one on huge pages). */
+static size_t slab_size(size_t live) {
+    const size_t s = live / 8;
+    return s < ((size_t)64 << 10) ? (size_t)64 << 10 : s > ((size_t)8 << 20) ? (size_t)8 << 20 : s;
+}
+#define SLAB_ALIGN(n) (((n) + 15) & ~(size_t)15)
+
+/* The arrays of an entry: pointer places and byte sizes. */
+static size_t entry_arrays(lb__cblock *E, void ***ptr, size_t *bytes) {
+    void **p[9] = {(void **)&E->okey,  (void **)&E->rref, (void **)&E->vpos,
+                   (void **)&E->vnrm,  (void **)&E->tri,  (void **)&E->node,
+                   (void **)&E->ndata, (void **)&E->fe,   (void **)&E->fent};
+    const size_t b[9] = {(E->nv - E->np) * sizeof(uint64_t),
+                         2 * E->nref * sizeof(uint32_t),
+                         3 * (E->nv + E->nref) * sizeof(double),
+                         3 * E->nv * sizeof(double),
+                         3 * E->nt * sizeof(uint32_t),
+                         E->nnode * sizeof(uint16_t),
+                         4 * (size_t)E->nnode * sizeof(double),
+                         E->nface * sizeof(uint16_t),
+                         E->nface * sizeof(lb__fent)};
+    for (int i = 0; i < 9; ++i) {
+        ptr[i] = p[i];
+        bytes[i] = b[i];
+    }
+    return 9;
+}
+
+static void slab_release(lb__cblock *E) {
+    E->slab->live--;
+    E->slab->liveb -= E->sbytes;
+    E->slab = NULL;
+}
+
+/* E's arrays copied into the cache's last slab (a new one when it is
+ * full), their old memory freed (or released, from another slab). 0: out
+ * of memory, E as it was. */
+static size_t entry_bytes(lb__cblock *E) {
+    void **ptr[9];
+    size_t bytes[9], total = 0;
+    const size_t na = entry_arrays(E, ptr, bytes);
+    for (size_t i = 0; i < na; ++i)
+        if (*ptr[i]) total += SLAB_ALIGN(bytes[i] ? bytes[i] : 1);
+    return total;
+}
+
+static int slab_put(lb_mesh_cache *C, lb__cblock *E, size_t slab) {
+    void **ptr[9];
+    size_t bytes[9];
+    const size_t na = entry_arrays(E, ptr, bytes), total = entry_bytes(E);
+    lb__slab *S = C->nslabs ? C->slabs[C->nslabs - 1] : NULL;
+    if (!S || S->cap - S->used < total) {
+        if (C->nslabs == C->slabcap) {
+            const size_t nc = C->slabcap ? 2 * C->slabcap : 16;
+            lb__slab **q = realloc(C->slabs, nc * sizeof *q);
+            if (!q) return 0;
+            C->slabs = q;
+            C->slabcap = nc;
+        }
+        S = malloc(sizeof *S);
+        const size_t cap = total > slab ? total : slab;
+        if (S) S->data = lb__huge_alloc(cap);
+        if (!S || !S->data) {
+            free(S);
+            return 0;
+        }
+        S->live = S->liveb = S->used = 0;
+        S->cap = cap;
+        C->slabs[C->nslabs++] = S;
+        C->slab_bytes += cap;
+    }
+    unsigned char *at = (unsigned char *)S->data + S->used;
+    for (size_t i = 0; i < na; ++i) {
+        if (!*ptr[i]) continue;
+        memcpy(at, *ptr[i], bytes[i]);
+        if (!E->slab) free(*ptr[i]);
+        *ptr[i] = at;
+        at += SLAB_ALIGN(bytes[i] ? bytes[i] : 1);
+    }
+    if (E->slab) slab_release(E);
+    S->used += total;
+    S->live++;
+    S->liveb += total;
+    E->slab = S;
+    E->sbytes = total;
+    return 1;
+}
+
+/* The slabs with no entry freed (the last one kept while it has room). */
+static void slab_sweep(lb_mesh_cache *C) {
+    size_t w = 0;
+    for (size_t i = 0; i < C->nslabs; ++i) {
+        lb__slab *S = C->slabs[i];
+        if (S->live || (i + 1 == C->nslabs && S->used < S->cap)) {
+            C->slabs[w++] = S;
+            continue;
+        }
+        C->slab_bytes -= S->cap;
+        lb__huge_free(S->data, S->cap);
+        free(S);
+    }
+    C->nslabs = w;
+}
+
+/* Every block's output into slabs: the new ones, then, when the slabs hold
+ * more than twice the live bytes, all of them into new slabs (the old
+ * ones freed). Out of memory leaves blocks as they are (still correct). */
+static void slab_settle(lb_mesh_cache *C) {
+    size_t live = 0;
+    for (size_t i = 0; i < C->nblocks; ++i)
+        live += C->blocks[i].slab ? C->blocks[i].sbytes : entry_bytes(&C->blocks[i]);
+    const size_t slab = slab_size(live);
+    for (size_t i = 0; i < C->nblocks; ++i)
+        if (!C->blocks[i].slab && !slab_put(C, &C->blocks[i], slab)) break;
+    slab_sweep(C);
+    if (C->slab_bytes <= 2 * live + 2 * slab) return;
+    const size_t old = C->nslabs;
+    /* a new slab first, so that nothing is copied into an old one */
+    if (old) C->slabs[old - 1]->used = C->slabs[old - 1]->cap;
+    for (size_t i = 0; i < C->nblocks; ++i)
+        if (C->blocks[i].slab && !slab_put(C, &C->blocks[i], slab)) break;
+    slab_sweep(C);
+}
+
+static void slabs_free(lb_mesh_cache *C) {
+    for (size_t i = 0; i < C->nslabs; ++i) {
+        lb__huge_free(C->slabs[i]->data, C->slabs[i]->cap);
+        free(C->slabs[i]);
+    }
+    free(C->slabs);
+    C->slabs = NULL;
+    C->nslabs = C->slabcap = C->slab_bytes = 0;
+}
+
 /* ---- blocks ---- */
 
 void lb__cblock_free(lb__cblock *E) {
     lb__cplan_free(&E->plan);
-    free(E->okey);
-    free(E->rref);
-    free(E->vpos);
-    free(E->vnrm);
-    free(E->tri);
-    free(E->node);
-    free(E->ndata);
-    free(E->fe);
-    free(E->fent);
+    if (E->slab) {
+        slab_release(E);
+    } else {
+        free(E->okey);
+        free(E->rref);
+        free(E->vpos);
+        free(E->vnrm);
+        free(E->tri);
+        free(E->node);
+        free(E->ndata);
+        free(E->fe);
+        free(E->fent);
+    }
     free(E->argpos);
     memset(E, 0, sizeof *E);
 }
@@ -387,11 +553,13 @@ void lb__cache_import(const lb__cblock *E, lb__block *B) {
 }
 
 static size_t cblock_bytes(const lb__cblock *E) {
-    return sizeof *E + E->plan.nlist * sizeof(uint32_t) + E->plan.nact_total * sizeof(uint16_t) +
-           (E->nv - E->np) * sizeof(uint64_t) + 2 * E->nref * sizeof(uint32_t) +
+    const size_t own = sizeof *E + E->plan.nlist * sizeof(uint32_t) +
+                       E->plan.nact_total * sizeof(uint16_t) + E->nargpos * sizeof(uint32_t);
+    if (E->slab) return own; /* the slabs count on their own */
+    return own + (E->nv - E->np) * sizeof(uint64_t) + 2 * E->nref * sizeof(uint32_t) +
            3 * (E->nv + E->nref) * sizeof(double) + 3 * E->nv * sizeof(double) +
            3 * E->nt * sizeof(uint32_t) + E->nnode * (sizeof(uint16_t) + 4 * sizeof(double)) +
-           E->nface * (sizeof(uint16_t) + sizeof(lb__fent)) + E->nargpos * sizeof(uint32_t);
+           E->nface * (sizeof(uint16_t) + sizeof(lb__fent));
 }
 
 void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt) {
@@ -457,9 +625,11 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     size_t bytes = sizeof *C + C->full.off[C->nins] + C->self.off[C->nins] +
                    2 * C->nins * (sizeof(size_t) + sizeof(uint64_t) + 1) +
                    C->tcap * sizeof(uint32_t);
+    slab_settle(C);
     for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
     for (size_t i = 0; i < nnodes; ++i) bytes += cblock_bytes(&nodes[i]);
-    bytes += spare_bytes(C);
+    bytes += spare_bytes(C) + C->slab_bytes + C->slabcap * sizeof(lb__slab *) +
+             C->nslabs * sizeof(lb__slab);
     C->stats.blocks = n;
     C->stats.reused = reused;
     C->stats.recycled += reused > 0;
@@ -498,13 +668,19 @@ void lb_mesh_cache_recycle(lb_mesh_cache *C, lb_mesh *mesh) {
     }
     C->stats.bytes -= spare_bytes(C);
     spare_free(C);
-    /* room as allocated: the arrays were shrunk to the mesh's counts (at
-     * least one entry each), normals to nnormals >= nvertices */
+    /* room as allocated where the C runtime says (a mesh made through a
+     * cache keeps a sixteenth more, mesher.c), else the mesh's counts:
+     * every library mesh's arrays hold at least those (normals nnormals
+     * >= nvertices) */
     C->spare_pos = mesh->positions;
     C->spare_nrm = mesh->normals;
     C->spare_tri = mesh->triangles;
-    C->spare_nv = mesh->nvertices;
-    C->spare_nt = mesh->ntriangles;
+    const size_t vp = lb__usable_size(mesh->positions) / (3 * sizeof(double)),
+                 vn = lb__usable_size(mesh->normals) / (3 * sizeof(double)),
+                 vt = lb__usable_size(mesh->triangles) / (3 * sizeof(uint32_t));
+    const size_t room = vp < vn ? vp : vn;
+    C->spare_nv = room > mesh->nvertices ? room : mesh->nvertices;
+    C->spare_nt = vt > mesh->ntriangles ? vt : mesh->ntriangles;
     C->stats.bytes += spare_bytes(C);
     free(mesh->corner_normals);
     free(mesh);
@@ -514,6 +690,7 @@ void lb_mesh_cache_free(lb_mesh_cache *C) {
     if (!C) return;
     spare_free(C);
     blocks_free(C);
+    slabs_free(C);
     lb__recs_free(&C->full);
     lb__recs_free(&C->self);
     free(C->tab);

@@ -139,6 +139,10 @@ typedef struct lb__cblock {
     double *ndata; /* 4 per node */
     uint16_t *fe;
     lb__fent *fent;
+    /* the arrays above from okey on lie in this slab of the cache (cache.c;
+     * sbytes of it), or (NULL) are blocks of their own */
+    struct lb__slab *slab;
+    size_t sbytes;
 } lb__cblock;
 
 /* Frees what E holds (not E). */

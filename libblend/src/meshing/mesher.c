@@ -738,21 +738,35 @@ static void wake(run *R) {
  * merges what is ready (try_merge, never waiting for the lock); the calling
  * thread merges the rest after the workers are joined. */
 
-/* *p (cap elements of size sz) reallocated to c elements when c > cap. */
-static int grow(void **p, size_t cap, size_t c, size_t sz) {
+/* *p (room for cap elements of size sz, the first used of them in use)
+ * given room for c elements when c > cap. */
+static int grow(void **p, size_t cap, size_t c, size_t used, size_t sz) {
     if (c <= cap) return 1;
-    void *q = realloc(*p, c * sz);
+    if (!*p) { /* the first array: advised onto huge pages before any write */
+        *p = malloc(c * sz);
+        if (*p) lb__huge_pages(*p, c * sz);
+        return *p != NULL;
+    }
+    /* a new array, advised before the used part is copied in: realloc
+     * would move the pages (mremap) to an address whose 2 MiB alignment
+     * differs, which splits the huge pages into small ones for good, and
+     * on this project's build machine (a PVM guest) a small page costs a
+     * fault in the host each time it is touched after any unmapping
+     * (docs/meshing.md, Incremental remeshing) */
+    void *q = malloc(c * sz);
     if (!q) return 0;
+    lb__huge_pages(q, c * sz);
+    memcpy(q, *p, used * sz);
+    free(*p);
     *p = q;
     return 1;
 }
 
 /* The mesh arrays' first capacity, in bytes: glibc serves an allocation
  * this large by mmap whatever its dynamic threshold (at most 32 MiB on
- * 64-bit systems), so the pages not written cost no memory, growing moves
- * pages (mremap) instead of copying them, and the final shrink is in place.
- * Growing from small sizes copied (and faulted in) the arrays about twice:
- * 4.5 % of S2's time at 256 cells. */
+ * 64-bit systems), so the pages not written cost no memory and the final
+ * shrink is in place. Growing from small sizes copied (and faulted in) the
+ * arrays about twice: 4.5 % of S2's time at 256 cells. */
 #define FIRST_BYTES ((size_t)32 << 20)
 
 /* A capacity (elements of sz bytes) of at least need, doubling cap; the
@@ -812,14 +826,10 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     }
     const size_t vc = doubled(S->vcap, M->nvertices + B->nv, 3 * sizeof(double), S->vhint),
                  tc = doubled(S->tcap, M->ntriangles + B->nt, 3 * sizeof(uint32_t), S->thint);
-    const int ok = grow((void **)&M->positions, S->vcap, vc, 3 * sizeof(double)) &&
-                   grow((void **)&M->normals, S->vcap, vc, 3 * sizeof(double)) &&
-                   grow((void **)&M->triangles, S->tcap, tc, 3 * sizeof(uint32_t));
-    if (ok && vc != S->vcap) { /* written page by page once: huge pages fault far less */
-        lb__huge_pages(M->positions, vc * 3 * sizeof(double));
-        lb__huge_pages(M->normals, vc * 3 * sizeof(double));
-    }
-    if (ok && tc != S->tcap) lb__huge_pages(M->triangles, tc * 3 * sizeof(uint32_t));
+    /* written page by page once: huge pages fault far less (grow) */
+    const int ok = grow((void **)&M->positions, S->vcap, vc, M->nvertices, 3 * sizeof(double)) &&
+                   grow((void **)&M->normals, S->vcap, vc, M->nvertices, 3 * sizeof(double)) &&
+                   grow((void **)&M->triangles, S->tcap, tc, M->ntriangles, 3 * sizeof(uint32_t));
     if (M->positions && M->normals) S->vcap = vc; /* both grown (or neither needed to) */
     if (ok) S->tcap = tc;
     if (!ok || (no && !tab_fit(S, S->used + no))) {
@@ -1476,15 +1486,28 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         if (!M->positions || !M->normals || !M->triangles)
             s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     }
-    if (!s) { /* the arrays' spare capacity goes (a mesh given back's too) */
+    if (!s) { /* the arrays' spare capacity goes, but through a cache a
+               * sixteenth more stays: given back (lb_mesh_cache_recycle)
+               * they then take the next run's output without growing,
+               * and growing may move them, which on Linux splits their
+               * huge pages and makes every later write fault in the
+               * hypervisor on this kind of machine (docs/meshing.md) */
         /* never to 0 bytes: realloc(p, 0) may free p and return NULL */
-        const size_t nv = M->nvertices ? M->nvertices : 1, nt = M->ntriangles ? M->ntriangles : 1;
-        double *p = realloc(M->positions, 3 * nv * sizeof *p);
-        if (p) M->positions = p;
-        double *q = realloc(M->normals, 3 * nv * sizeof *q);
-        if (q) M->normals = q;
-        uint32_t *r = realloc(M->triangles, 3 * nt * sizeof *r);
-        if (r) M->triangles = r;
+        size_t nv = M->nvertices ? M->nvertices : 1, nt = M->ntriangles ? M->ntriangles : 1;
+        if (cache) {
+            nv += nv / 16;
+            nt += nt / 16;
+        }
+        if (!cache || nv < R.ms.vcap) { /* only ever shrunk here */
+            double *p = realloc(M->positions, 3 * nv * sizeof *p);
+            if (p) M->positions = p;
+            double *q = realloc(M->normals, 3 * nv * sizeof *q);
+            if (q) M->normals = q;
+        }
+        if (!cache || nt < R.ms.tcap) {
+            uint32_t *r = realloc(M->triangles, 3 * nt * sizeof *r);
+            if (r) M->triangles = r;
+        }
     }
     M->nnormals = M->nvertices;
     if (!s && !P.cancelled && feat && (opt->flags & LB_MESH_CORNER_NORMALS))
