@@ -82,6 +82,11 @@ struct lb_mesh_cache {
      * their bytes */
     lb__slab **slabs;
     size_t nslabs, slabcap, slab_bytes;
+    /* slabs emptied, kept for the next blocks (up to one slab's bytes
+     * after a commit): an edit that recomputes every block then writes
+     * into memory mapped already, and nothing is unmapped */
+    lb__slab **idle;
+    size_t nidle, idlecap;
     /* a mesh given back (lb_mesh_cache_recycle): its arrays, with room for
      * nv vertices (positions and normals) and nt triangles; NULL: none */
     double *spare_pos, *spare_nrm;
@@ -161,9 +166,10 @@ lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usa
  * keeps shadow page tables (measured on this project's build machine, a
  * PVM guest) every page touched after any unmapping in the process
  * costs a fault in the host, which tripled some runs (docs/meshing.md).
- * A slab counts its entries; a slab with none is freed at the next commit,
- * and when the slabs hold more than twice the live bytes (many edits
- * leave holes) the live entries are moved into new ones. */
+ * A slab counts its entries; a slab with none goes idle at the next
+ * commit and takes that commit's new blocks (the rest freed, down to one
+ * slab's bytes), and when the slabs hold more than twice the live bytes
+ * (many edits leave holes) the live entries are moved into new ones. */
 struct lb__slab {
     size_t live, liveb; /* entries and their bytes */
     size_t used, cap;   /* bytes of data */
@@ -231,6 +237,16 @@ static int slab_put(lb_mesh_cache *C, lb__cblock *E, size_t slab) {
             C->slabs = q;
             C->slabcap = nc;
         }
+        for (size_t i = C->nidle; i-- > 0;) /* an idle slab large enough */
+            if (C->idle[i]->cap >= total) {
+                S = C->idle[i];
+                C->idle[i] = C->idle[--C->nidle];
+                S->live = S->liveb = S->used = 0;
+                C->slabs[C->nslabs++] = S;
+                break;
+            }
+    }
+    if (!S || S->cap - S->used < total) {
         S = malloc(sizeof *S);
         const size_t cap = total > slab ? total : slab;
         if (S) S->data = lb__huge_alloc(cap);
@@ -260,20 +276,41 @@ static int slab_put(lb_mesh_cache *C, lb__cblock *E, size_t slab) {
     return 1;
 }
 
-/* The slabs with no entry freed (the last one kept while it has room). */
-static void slab_sweep(lb_mesh_cache *C) {
-    size_t w = 0;
+static void slab_drop(lb_mesh_cache *C, lb__slab *S) {
+    C->slab_bytes -= S->cap;
+    lb__huge_free(S->data, S->cap);
+    free(S);
+}
+
+/* The slabs with no entry made idle (the last one stays while it has
+ * room), then idle ones freed down to keep bytes. */
+static void slab_sweep(lb_mesh_cache *C, size_t keep) {
+    size_t w = 0, idle = 0;
     for (size_t i = 0; i < C->nslabs; ++i) {
         lb__slab *S = C->slabs[i];
         if (S->live || (i + 1 == C->nslabs && S->used < S->cap)) {
             C->slabs[w++] = S;
             continue;
         }
-        C->slab_bytes -= S->cap;
-        lb__huge_free(S->data, S->cap);
-        free(S);
+        if (C->nidle == C->idlecap) {
+            const size_t nc = C->idlecap ? 2 * C->idlecap : 16;
+            lb__slab **q = realloc(C->idle, nc * sizeof *q);
+            if (!q) {
+                slab_drop(C, S);
+                continue;
+            }
+            C->idle = q;
+            C->idlecap = nc;
+        }
+        C->idle[C->nidle++] = S;
     }
     C->nslabs = w;
+    for (size_t i = 0; i < C->nidle; ++i) idle += C->idle[i]->cap;
+    while (C->nidle && idle > keep) {
+        lb__slab *S = C->idle[--C->nidle];
+        idle -= S->cap;
+        slab_drop(C, S);
+    }
 }
 
 /* Every block's output into slabs: the new ones, then, when the slabs hold
@@ -284,26 +321,26 @@ static void slab_settle(lb_mesh_cache *C) {
     for (size_t i = 0; i < C->nblocks; ++i)
         live += C->blocks[i].slab ? C->blocks[i].sbytes : entry_bytes(&C->blocks[i]);
     const size_t slab = slab_size(live);
+    slab_sweep(C, SIZE_MAX); /* the slabs the last commit emptied, for the new blocks */
     for (size_t i = 0; i < C->nblocks; ++i)
         if (!C->blocks[i].slab && !slab_put(C, &C->blocks[i], slab)) break;
-    slab_sweep(C);
+    slab_sweep(C, slab);
     if (C->slab_bytes <= 2 * live + 2 * slab) return;
     const size_t old = C->nslabs;
     /* a new slab first, so that nothing is copied into an old one */
     if (old) C->slabs[old - 1]->used = C->slabs[old - 1]->cap;
     for (size_t i = 0; i < C->nblocks; ++i)
         if (C->blocks[i].slab && !slab_put(C, &C->blocks[i], slab)) break;
-    slab_sweep(C);
+    slab_sweep(C, slab);
 }
 
 static void slabs_free(lb_mesh_cache *C) {
-    for (size_t i = 0; i < C->nslabs; ++i) {
-        lb__huge_free(C->slabs[i]->data, C->slabs[i]->cap);
-        free(C->slabs[i]);
-    }
+    for (size_t i = 0; i < C->nslabs; ++i) slab_drop(C, C->slabs[i]);
+    for (size_t i = 0; i < C->nidle; ++i) slab_drop(C, C->idle[i]);
     free(C->slabs);
-    C->slabs = NULL;
-    C->nslabs = C->slabcap = C->slab_bytes = 0;
+    free(C->idle);
+    C->slabs = C->idle = NULL;
+    C->nslabs = C->slabcap = C->nidle = C->idlecap = 0;
 }
 
 /* ---- blocks ---- */
