@@ -164,8 +164,8 @@ lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usa
  * 3-million-triangle mesh); as some 150,000 small blocks of the C
  * runtime's heap it spans 50,000 pages, and on a machine whose hypervisor
  * keeps shadow page tables (measured on this project's build machine, a
- * PVM guest) every page touched after any unmapping in the process
- * costs a fault in the host, which tripled some runs (docs/meshing.md).
+ * PVM guest) a page touched after any unmapping in the process can cost
+ * a fault in the host, which tripled some runs (docs/meshing.md).
  * A slab counts its entries; a slab with none goes idle at the next
  * commit and takes that commit's new blocks (the rest freed, down to one
  * slab's bytes), and when the slabs hold more than twice the live bytes

@@ -750,8 +750,8 @@ static int grow(void **p, size_t cap, size_t c, size_t used, size_t sz) {
     /* a new array, advised before the used part is copied in: realloc
      * would move the pages (mremap) to an address whose 2 MiB alignment
      * differs, which splits the huge pages into small ones for good, and
-     * on this project's build machine (a PVM guest) a small page costs a
-     * fault in the host each time it is touched after any unmapping
+     * on this project's build machine (a PVM guest) a small page can cost
+     * a fault in the host each time it is touched after any unmapping
      * (docs/meshing.md, Incremental remeshing) */
     void *q = malloc(c * sz);
     if (!q) return 0;
