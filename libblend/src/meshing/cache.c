@@ -387,15 +387,7 @@ static int cmp_id(const void *a, const void *b) {
 
 /* The first of the n entries of E (sorted by id) with id >= key. */
 static size_t lower_id(const lb__cblock *E, size_t n, uint64_t key) {
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        const size_t m = lo + (hi - lo) / 2;
-        if (E[m].id < key)
-            lo = m + 1;
-        else
-            hi = m;
-    }
-    return lo;
+    return lb__lower_id(E, n, sizeof *E, offsetof(lb__cblock, id), key);
 }
 
 const lb__cblock *lb__cache_node(const lb_mesh_cache *C, int depth, uint64_t id) {

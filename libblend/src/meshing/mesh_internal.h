@@ -15,7 +15,9 @@
 
 #include <libblend/mesh.h>
 
+#include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #define LB__MB 8      /* cells per block side */
 #define LB__MAXPOLY 7 /* most vertices of one cell polygon (cubes: 7, tetrahedra: 4) */
@@ -209,6 +211,31 @@ static inline void lb__facing(const double a[3], const double b[3], const double
     n[0] = u[1] * v[2] - u[2] * v[1];
     n[1] = u[2] * v[0] - u[0] * v[2];
     n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+/* A block's id: its place in x-fastest order on a grid of nb blocks per
+ * axis (blocks, the cache's entries and the selection's boxes, which take
+ * their first block's, are sorted by it). */
+static inline uint64_t lb__block_id(const uint32_t nb[3], uint32_t x, uint32_t y, uint32_t z) {
+    return ((uint64_t)z * nb[1] + y) * nb[0] + x;
+}
+
+/* The first of n records stride bytes apart, sorted by the uint64_t id at
+ * byte off of each, whose id is >= key (n: none). */
+static inline size_t lb__lower_id(const void *base, size_t n, size_t stride, size_t off,
+                                  uint64_t key) {
+    const unsigned char *p = (const unsigned char *)base + off;
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        const size_t m = lo + (hi - lo) / 2;
+        uint64_t id;
+        memcpy(&id, p + m * stride, sizeof id);
+        if (id < key)
+            lo = m + 1;
+        else
+            hi = m;
+    }
+    return lo;
 }
 
 static inline uint64_t lb__node_index(const lb__grid *g, uint64_t x, uint64_t y, uint64_t z) {

@@ -203,7 +203,7 @@ static void block_at(sel *S, const uint32_t b[3], const lb__cplan *plan) {
         B->b[d] = b[d];
         B->nc[d] = (uint32_t)(n1 - n0);
     }
-    B->id = ((uint64_t)b[2] * S->nb[1] + b[1]) * S->nb[0] + b[0];
+    B->id = lb__block_id(S->nb, b[0], b[1], b[2]);
 }
 
 /* Box [r0, r1) at the incremental depth, its plan own: recorded for the
@@ -224,7 +224,7 @@ static lb_status inc_box(sel *S, const uint32_t r0[3], const uint32_t r1[3], con
     memset(N, 0, sizeof *N);
     lb_status s = lb__cplan_make(S->ev, own, &N->plan, S->err);
     if (s) return s;
-    N->id = ((uint64_t)r0[2] * S->nb[1] + r0[1]) * S->nb[0] + r0[0];
+    N->id = lb__block_id(S->nb, r0[0], r0[1], r0[2]);
     ++I->n;
     const lb__cblock *E = I->M ? lb__cache_node(I->cache, I->depth, N->id) : NULL;
     if (!E || !lb__cache_same_plan(I->cache, I->M, E, &N->plan, I->scratch)) return LB_OK;
@@ -233,7 +233,7 @@ static lb_status inc_box(sel *S, const uint32_t r0[3], const uint32_t r1[3], con
     const size_t first = S->L->n;
     for (uint32_t z = r0[2]; z < r1[2]; ++z)
         for (uint32_t y = r0[1]; y < r1[1]; ++y) {
-            const uint64_t row = ((uint64_t)z * S->nb[1] + y) * S->nb[0];
+            const uint64_t row = lb__block_id(S->nb, 0, y, z);
             for (size_t j = lb__cache_block_from(I->cache, row + r0[0]);
                  j < nold && old[j].id < row + r1[0]; ++j) {
                 lb__cplan p;
@@ -446,15 +446,9 @@ typedef struct run {
 } run;
 
 static lb__block *find_block(run *R, const uint32_t b[3]) {
-    const uint64_t id = ((uint64_t)b[2] * R->nb[1] + b[1]) * R->nb[0] + b[0];
-    size_t lo = 0, hi = R->nblocks;
-    while (lo < hi) {
-        const size_t m = lo + (hi - lo) / 2;
-        if (R->blocks[m].id < id)
-            lo = m + 1;
-        else
-            hi = m;
-    }
+    const uint64_t id = lb__block_id(R->nb, b[0], b[1], b[2]);
+    const size_t lo =
+        lb__lower_id(R->blocks, R->nblocks, sizeof *R->blocks, offsetof(lb__block, id), id);
     return lo < R->nblocks && R->blocks[lo].id == id ? &R->blocks[lo] : NULL;
 }
 
@@ -1259,9 +1253,8 @@ static lb_status blocks_run(run *R, size_t nt, progress *P) {
             int ok = 1;
             for (int d = 0; d < 3; ++d) ok &= R->blocks[i].b[d] + ((c >> d) & 1) < R->nb[d];
             if (!ok) continue;
-            const uint64_t id = R->blocks[i].id + (uint64_t)(c & 1) +
-                                (uint64_t)((c >> 1) & 1) * R->nb[0] +
-                                (uint64_t)((c >> 2) & 1) * R->nb[0] * R->nb[1];
+            /* ids are linear in the coordinates: the offset's id added */
+            const uint64_t id = R->blocks[i].id + lb__block_id(R->nb, c & 1, (c >> 1) & 1, c >> 2);
             size_t j = cur[c];
             while (j < nbk && R->blocks[j].id < id) ++j;
             cur[c] = j;
