@@ -1467,6 +1467,19 @@ static char *lattice_text(int moved, double dx, double dr, double r) {
     return t;
 }
 
+/* Options for lattice_text's region at res cells on threads threads. */
+static lb_mesh_options lattice_options(unsigned res, int threads) {
+    lb_mesh_options o;
+    lb_mesh_options_init(&o);
+    for (int d = 0; d < 3; ++d) {
+        o.bmin[d] = -2.0;
+        o.bmax[d] = 2.0;
+    }
+    o.resolution = res;
+    o.threads = threads;
+    return o;
+}
+
 static int same_mesh(const lb_mesh *a, const lb_mesh *b) {
     if (a->nvertices != b->nvertices || a->ntriangles != b->ntriangles ||
         a->nnormals != b->nnormals || !a->corner_normals != !b->corner_normals)
@@ -1497,14 +1510,7 @@ static void test_mesh_cache(void **state) {
             lb_error e = {LB_OK, ""};
             lb_mesh_cache *cache = NULL;
             assert_int_equal(lb_mesh_cache_create(&cache, &e), LB_OK);
-            lb_mesh_options o;
-            lb_mesh_options_init(&o);
-            for (int d = 0; d < 3; ++d) {
-                o.bmin[d] = -2.0;
-                o.bmax[d] = 2.0;
-            }
-            o.resolution = 64;
-            o.threads = threads;
+            lb_mesh_options o = lattice_options(64, threads);
             o.flags = variant ? LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS : 0u;
             for (int step = 0; step < NSTEP; ++step) {
                 char *text = lattice_text(moved[step], dx[step], dr[step], br[step]);
@@ -1581,14 +1587,7 @@ static void test_mesh_cache_memory(void **state) {
     lb_error e = {LB_OK, ""};
     lb_mesh_cache *cache = NULL;
     assert_int_equal(lb_mesh_cache_create(&cache, &e), LB_OK);
-    lb_mesh_options o;
-    lb_mesh_options_init(&o);
-    for (int d = 0; d < 3; ++d) {
-        o.bmin[d] = -2.0;
-        o.bmax[d] = 2.0;
-    }
-    o.resolution = 96;
-    o.threads = 2;
+    const lb_mesh_options o = lattice_options(96, 2);
     size_t first = 0, most = 0;
     enum { NEDIT = 60 };
     for (int k = 0; k < NEDIT; ++k) {
