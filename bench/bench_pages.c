@@ -24,7 +24,7 @@
 #include <time.h>
 
 #define ROUNDS 4
-#define HUGE ((size_t)2 << 20)
+#define HUGE_BYTES ((size_t)2 << 20)
 
 static double now(void) {
     struct timespec t;
@@ -45,12 +45,12 @@ static long huge_kib(void) {
 /* bytes at a 2 MiB boundary, advised to huge pages or not */
 static unsigned char *map(size_t bytes, int huge) {
     unsigned char *m =
-        mmap(NULL, bytes + HUGE, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        mmap(NULL, bytes + HUGE_BYTES, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (m == MAP_FAILED) {
         perror("bench_pages: mmap");
         exit(1);
     }
-    unsigned char *p = m + ((HUGE - ((uintptr_t)m & (HUGE - 1))) & (HUGE - 1));
+    unsigned char *p = m + ((HUGE_BYTES - ((uintptr_t)m & (HUGE_BYTES - 1))) & (HUGE_BYTES - 1));
     (void)madvise(p, bytes, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
     return p;
 }

@@ -99,18 +99,18 @@ size_t lb__usable_size(void *p) {
 #endif
 }
 
-#define HUGE ((size_t)2 << 20)
+#define HUGE_BYTES ((size_t)2 << 20)
 
 void *lb__huge_alloc(size_t bytes) {
-    if (bytes < HUGE) return malloc(bytes ? bytes : 1); /* too small for a huge page */
-    bytes = (bytes + HUGE - 1) & ~(HUGE - 1);
+    if (bytes < HUGE_BYTES) return malloc(bytes ? bytes : 1); /* too small for a huge page */
+    bytes = (bytes + HUGE_BYTES - 1) & ~(HUGE_BYTES - 1);
     /* a mapping one huge page longer, its unaligned head and tail given back */
     unsigned char *m =
-        mmap(NULL, bytes + HUGE, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        mmap(NULL, bytes + HUGE_BYTES, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (m == MAP_FAILED) return NULL;
-    unsigned char *p = m + ((HUGE - ((uintptr_t)m & (HUGE - 1))) & (HUGE - 1));
+    unsigned char *p = m + ((HUGE_BYTES - ((uintptr_t)m & (HUGE_BYTES - 1))) & (HUGE_BYTES - 1));
     if (p > m) munmap(m, (size_t)(p - m));
-    if (m + HUGE > p) munmap(p + bytes, (size_t)(m + HUGE - p));
+    if (m + HUGE_BYTES > p) munmap(p + bytes, (size_t)(m + HUGE_BYTES - p));
 #ifdef MADV_HUGEPAGE
     (void)madvise(p, bytes, MADV_HUGEPAGE);
 #endif
@@ -118,11 +118,11 @@ void *lb__huge_alloc(size_t bytes) {
 }
 
 void lb__huge_free(void *p, size_t bytes) {
-    if (bytes < HUGE) {
+    if (bytes < HUGE_BYTES) {
         free(p);
         return;
     }
-    if (p) munmap(p, (bytes + HUGE - 1) & ~(HUGE - 1));
+    if (p) munmap(p, (bytes + HUGE_BYTES - 1) & ~(HUGE_BYTES - 1));
 }
 
 void lb__huge_pages(void *p, size_t bytes) {

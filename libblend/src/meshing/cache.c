@@ -212,9 +212,7 @@ static void slab_release(lb__cblock *E) {
     E->slab = NULL;
 }
 
-/* E's arrays copied into the cache's last slab (a new one when it is
- * full), their old memory freed (or released, from another slab). 0: out
- * of memory, E as it was. */
+/* The bytes E's arrays take in a slab. */
 static size_t entry_bytes(lb__cblock *E) {
     void **ptr[9];
     size_t bytes[9], total = 0;
@@ -224,6 +222,9 @@ static size_t entry_bytes(lb__cblock *E) {
     return total;
 }
 
+/* E's arrays copied into the cache's last slab (an idle one or a new one
+ * of at least slab bytes when it is full), their old memory freed (or
+ * released, from another slab). 0: out of memory, E as it was. */
 static int slab_put(lb_mesh_cache *C, lb__cblock *E, size_t slab) {
     void **ptr[9];
     size_t bytes[9];
@@ -657,8 +658,8 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     slab_settle(C);
     for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
     for (size_t i = 0; i < nnodes; ++i) bytes += cblock_bytes(&nodes[i]);
-    bytes += spare_bytes(C) + C->slab_bytes + C->slabcap * sizeof(lb__slab *) +
-             C->nslabs * sizeof(lb__slab);
+    bytes += spare_bytes(C) + C->slab_bytes + (C->slabcap + C->idlecap) * sizeof(lb__slab *) +
+             (C->nslabs + C->nidle) * sizeof(lb__slab);
     C->stats.blocks = n;
     C->stats.reused = reused;
     C->stats.recycled += reused > 0;
