@@ -185,25 +185,29 @@ static size_t slab_size(size_t live) {
 }
 #define SLAB_ALIGN(n) (((n) + 15) & ~(size_t)15)
 
+/* The byte sizes of an entry's output arrays, in the order of
+ * entry_arrays (okey, rref, vpos, vnrm, tri, node, ndata, fe, fent). */
+#define NARRAYS 9
+static void entry_sizes(const lb__cblock *E, size_t bytes[NARRAYS]) {
+    const size_t b[NARRAYS] = {(E->nv - E->np) * sizeof(uint64_t),
+                               2 * E->nref * sizeof(uint32_t),
+                               3 * (E->nv + E->nref) * sizeof(double),
+                               3 * E->nv * sizeof(double),
+                               3 * E->nt * sizeof(uint32_t),
+                               E->nnode * sizeof(uint16_t),
+                               4 * (size_t)E->nnode * sizeof(double),
+                               E->nface * sizeof(uint16_t),
+                               E->nface * sizeof(lb__fent)};
+    memcpy(bytes, b, sizeof b);
+}
+
 /* The arrays of an entry: pointer places and byte sizes. */
-static size_t entry_arrays(lb__cblock *E, void ***ptr, size_t *bytes) {
-    void **p[9] = {(void **)&E->okey,  (void **)&E->rref, (void **)&E->vpos,
-                   (void **)&E->vnrm,  (void **)&E->tri,  (void **)&E->node,
-                   (void **)&E->ndata, (void **)&E->fe,   (void **)&E->fent};
-    const size_t b[9] = {(E->nv - E->np) * sizeof(uint64_t),
-                         2 * E->nref * sizeof(uint32_t),
-                         3 * (E->nv + E->nref) * sizeof(double),
-                         3 * E->nv * sizeof(double),
-                         3 * E->nt * sizeof(uint32_t),
-                         E->nnode * sizeof(uint16_t),
-                         4 * (size_t)E->nnode * sizeof(double),
-                         E->nface * sizeof(uint16_t),
-                         E->nface * sizeof(lb__fent)};
-    for (int i = 0; i < 9; ++i) {
-        ptr[i] = p[i];
-        bytes[i] = b[i];
-    }
-    return 9;
+static void entry_arrays(lb__cblock *E, void **ptr[NARRAYS], size_t bytes[NARRAYS]) {
+    void **p[NARRAYS] = {(void **)&E->okey,  (void **)&E->rref, (void **)&E->vpos,
+                         (void **)&E->vnrm,  (void **)&E->tri,  (void **)&E->node,
+                         (void **)&E->ndata, (void **)&E->fe,   (void **)&E->fent};
+    memcpy(ptr, p, sizeof p);
+    entry_sizes(E, bytes);
 }
 
 static void slab_release(lb__cblock *E) {
@@ -214,10 +218,10 @@ static void slab_release(lb__cblock *E) {
 
 /* The bytes E's arrays take in a slab. */
 static size_t entry_bytes(lb__cblock *E) {
-    void **ptr[9];
-    size_t bytes[9], total = 0;
-    const size_t na = entry_arrays(E, ptr, bytes);
-    for (size_t i = 0; i < na; ++i)
+    void **ptr[NARRAYS];
+    size_t bytes[NARRAYS], total = 0;
+    entry_arrays(E, ptr, bytes);
+    for (size_t i = 0; i < NARRAYS; ++i)
         if (*ptr[i]) total += SLAB_ALIGN(bytes[i] ? bytes[i] : 1);
     return total;
 }
@@ -226,9 +230,10 @@ static size_t entry_bytes(lb__cblock *E) {
  * of at least slab bytes when it is full), their old memory freed (or
  * released, from another slab). 0: out of memory, E as it was. */
 static int slab_put(lb_mesh_cache *C, lb__cblock *E, size_t slab) {
-    void **ptr[9];
-    size_t bytes[9];
-    const size_t na = entry_arrays(E, ptr, bytes), total = entry_bytes(E);
+    void **ptr[NARRAYS];
+    size_t bytes[NARRAYS];
+    entry_arrays(E, ptr, bytes);
+    const size_t total = entry_bytes(E);
     lb__slab *S = C->nslabs ? C->slabs[C->nslabs - 1] : NULL;
     if (!S || S->cap - S->used < total) {
         if (C->nslabs == C->slabcap) {
@@ -261,7 +266,7 @@ static int slab_put(lb_mesh_cache *C, lb__cblock *E, size_t slab) {
         C->slab_bytes += cap;
     }
     unsigned char *at = (unsigned char *)S->data + S->used;
-    for (size_t i = 0; i < na; ++i) {
+    for (size_t i = 0; i < NARRAYS; ++i) {
         if (!*ptr[i]) continue;
         memcpy(at, *ptr[i], bytes[i]);
         if (!E->slab) free(*ptr[i]);
@@ -586,10 +591,10 @@ static size_t cblock_bytes(const lb__cblock *E) {
     const size_t own = sizeof *E + E->plan.nlist * sizeof(uint32_t) +
                        E->plan.nact_total * sizeof(uint16_t) + E->nargpos * sizeof(uint32_t);
     if (E->slab) return own; /* the slabs count on their own */
-    return own + (E->nv - E->np) * sizeof(uint64_t) + 2 * E->nref * sizeof(uint32_t) +
-           3 * (E->nv + E->nref) * sizeof(double) + 3 * E->nv * sizeof(double) +
-           3 * E->nt * sizeof(uint32_t) + E->nnode * (sizeof(uint16_t) + 4 * sizeof(double)) +
-           E->nface * (sizeof(uint16_t) + sizeof(lb__fent));
+    size_t bytes[NARRAYS], arrays = 0;
+    entry_sizes(E, bytes);
+    for (size_t i = 0; i < NARRAYS; ++i) arrays += bytes[i];
+    return own + arrays;
 }
 
 void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt) {
