@@ -525,8 +525,9 @@ class Evaluator(_Handle):
         cache (a MeshCache) remeshes only the blocks that changed since the
         last mesh made through it (lb_mesh_create_cached), byte-identical;
         recycle=True (with a cache) gives the C mesh's arrays back to the
-        cache once copied (lb_mesh_cache_recycle), to take the next output:
-        faster in most runs, slower in some (docs/meshing.md)."""
+        cache once copied (lb_mesh_cache_recycle), to take the next output
+        (faster in C; in Blender slower at 128 cells in one measurement, so
+        the add-on leaves it off: docs/meshing.md)."""
         _need_numpy()
         o = _MeshOptions()
         self.lib._c.lb_mesh_options_init(ctypes.byref(o))

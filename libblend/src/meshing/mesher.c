@@ -736,11 +736,6 @@ static void wake(run *R) {
  * given room for c elements when c > cap. */
 static int grow(void **p, size_t cap, size_t c, size_t used, size_t sz) {
     if (c <= cap) return 1;
-    if (!*p) { /* the first array: advised onto huge pages before any write */
-        *p = malloc(c * sz);
-        if (*p) lb__huge_pages(*p, c * sz);
-        return *p != NULL;
-    }
     /* a new array, advised before the used part is copied in: realloc
      * would move the pages (mremap) to an address whose 2 MiB alignment
      * differs, which splits the huge pages into small ones for good, and
@@ -750,10 +745,17 @@ static int grow(void **p, size_t cap, size_t c, size_t used, size_t sz) {
     void *q = malloc(c * sz);
     if (!q) return 0;
     lb__huge_pages(q, c * sz);
-    memcpy(q, *p, used * sz);
+    if (*p) memcpy(q, *p, used * sz);
     free(*p);
     *p = q;
     return 1;
+}
+
+/* n and a sixteenth more: the room a mesh made through a cache starts with
+ * (the cached mesh's counts) and keeps (lb_mesh_cache_recycle gives it
+ * back), so that the next run's output mostly fits without growing. */
+static size_t with_room(size_t n) {
+    return n + n / 16;
 }
 
 /* The mesh arrays' first capacity, in bytes: glibc serves an allocation
@@ -1408,8 +1410,8 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         if (!R.ms.keep) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
         if (usable) {
             lb__cache_counts(cache, &R.ms.vhint, &R.ms.thint);
-            R.ms.vhint += R.ms.vhint / 16;
-            R.ms.thint += R.ms.thint / 16;
+            R.ms.vhint = with_room(R.ms.vhint);
+            R.ms.thint = with_room(R.ms.thint);
             R.match = match;
         }
     }
@@ -1479,17 +1481,14 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         if (!M->positions || !M->normals || !M->triangles)
             s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     }
-    if (!s) { /* the arrays' spare capacity goes, but through a cache a
-               * sixteenth more stays: given back (lb_mesh_cache_recycle)
-               * they then take the next run's output without growing,
-               * and growing may move them, which on Linux splits their
-               * huge pages and makes every later write fault in the
-               * hypervisor on this kind of machine (docs/meshing.md) */
+    if (!s) { /* the arrays' spare capacity goes, but through a cache
+               * with_room's stays: given back (lb_mesh_cache_recycle) they
+               * then take the next run's output without growing (grow) */
         /* never to 0 bytes: realloc(p, 0) may free p and return NULL */
         size_t nv = M->nvertices ? M->nvertices : 1, nt = M->ntriangles ? M->ntriangles : 1;
         if (cache) {
-            nv += nv / 16;
-            nt += nt / 16;
+            nv = with_room(nv);
+            nt = with_room(nt);
         }
         if (!cache || nv < R.ms.vcap) { /* only ever shrunk here */
             double *p = realloc(M->positions, 3 * nv * sizeof *p);
