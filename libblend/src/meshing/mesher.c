@@ -375,8 +375,9 @@ static int sort_blocks(blist *L) {
  * (refs), and the slot is reused. */
 
 /* The mesh being merged (merge_block): its arrays' capacities, the table of
- * orphan vertices (grid edge key, mesh vertex), a block's orphan-to-mesh
- * map, each merged block's first mesh vertex, and the first failure. */
+ * orphan vertices (grid edge key, mesh vertex), a block's local-to-mesh
+ * vertex map (xt, room for xcap), each merged block's first mesh vertex,
+ * and the first failure. */
 typedef struct mkv {
     uint64_t key, v;
 } mkv;
@@ -386,7 +387,8 @@ typedef struct mstate {
     size_t vcap, tcap;
     mkv *tab;
     size_t cap, used;
-    uint32_t *local;
+    uint32_t *xt;
+    size_t xcap;
     uint32_t *base;
     /* the feature points' vertex ranges (first, count), for the flips */
     size_t *fr;
@@ -828,7 +830,16 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
                    grow((void **)&M->triangles, S->tcap, tc, M->ntriangles, 3 * sizeof(uint32_t));
     if (M->positions && M->normals) S->vcap = vc; /* both grown (or neither needed to) */
     if (ok) S->tcap = tc;
-    if (!ok || (no && !tab_fit(S, S->used + no))) {
+    if (ok && B->nv + B->nref > S->xcap) {
+        const size_t c = 2 * (B->nv + B->nref);
+        uint32_t *q = malloc(c * sizeof *q);
+        if (q) {
+            free(S->xt);
+            S->xt = q;
+            S->xcap = c;
+        }
+    }
+    if (!ok || B->nv + B->nref > S->xcap || (no && !tab_fit(S, S->used + no))) {
         S->s = lb__fail(&S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
         return 0;
     }
@@ -854,8 +865,15 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
         memcpy(M->positions + 3 * base, B->vpos, 3 * B->np * sizeof(double));
         memcpy(M->normals + 3 * base, B->vnrm, 3 * B->np * sizeof(double));
     }
+    /* each local vertex u's mesh vertex (xt): own (u < np) the mesh's next
+     * ones, an orphan through the table, a reference (u >= nv) a vertex of
+     * a block merged before this one; then every triangle index through xt
+     * (one load each from a table in the core's cache: the three cases in
+     * one loop were mispredicted often) */
+    uint32_t *xt = S->xt;
+    const uint32_t np = (uint32_t)B->np, nown = (uint32_t)B->nv, b32 = (uint32_t)base;
+    for (uint32_t u = 0; u < np; ++u) xt[u] = b32 + u;
     size_t nv = base + B->np;
-    uint32_t *local = S->local; /* orphan -> mesh vertex */
     for (size_t i = 0; i < no; ++i) {
         const uint64_t key = B->okey[i];
         const size_t cap = S->cap;
@@ -869,29 +887,17 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
             memcpy(M->normals + 3 * nv, B->vnrm + 3 * (B->np + i), 3 * sizeof(double));
             ++nv;
         }
-        local[i] = (uint32_t)S->tab[h].v;
+        xt[np + i] = (uint32_t)S->tab[h].v;
     }
-    /* local vertex u: own (u < np), orphan, or a reference to a block merged
-     * before this one */
+    for (size_t r = 0; r < B->nref; ++r) {
+        const uint32_t *q = B->rref + 2 * r;
+        /* a cached block names the next block by its offset code */
+        xt[nown + r] = S->base[B->borrowed ? S->nbr[bi][q[0]] - 1 : q[0]] + q[1];
+    }
     uint32_t *T = M->triangles + 3 * M->ntriangles;
-    const uint32_t np = (uint32_t)B->np, nown = (uint32_t)B->nv, b32 = (uint32_t)base;
+    const uint32_t *src = B->tri;
     const size_t ni = 3 * B->nt;
-    /* every index as the block's own (a loop the compiler vectorises), then
-     * the orphans and references put right while the block's triangles are
-     * in the core's cache (one loop with both cases mispredicted often) */
-    for (size_t t = 0; t < ni; ++t) T[t] = b32 + B->tri[t];
-    if (np != nown || B->nref)
-        for (size_t t = 0; t < ni; ++t) {
-            const uint32_t u = B->tri[t];
-            if (u < np) continue;
-            if (u < nown) {
-                T[t] = local[u - np];
-            } else {
-                const uint32_t *r = B->rref + 2 * (u - nown);
-                /* a cached block names the next block by its offset code */
-                T[t] = S->base[B->borrowed ? S->nbr[bi][r[0]] - 1 : r[0]] + r[1];
-            }
-        }
+    for (size_t t = 0; t < ni; ++t) T[t] = xt[src[t]];
     M->ntriangles += B->nt;
     M->nvertices = nv;
     if (S->keep && !B->borrowed) { /* the cache takes the output */
@@ -1436,14 +1442,12 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     R.ms.M = M;
     if (M && cache) /* a mesh given back: its mapped arrays take the output */
         lb__cache_take_spare(cache, M, &R.ms.vcap, &R.ms.tcap);
-    R.ms.local = malloc(LB__EMAP_SIZE * sizeof *R.ms.local);
     if (nt > 256) nt = 256;
     R.ctx = calloc(nt, sizeof *R.ctx);
     if (R.ctx)
         for (R.nctx = 0; R.nctx < nt; ++R.nctx)
             if (!(R.ctx[R.nctx] = lb__bctx_new(ev))) break;
-    if (!M || !R.ms.local || !R.ctx || R.nctx < nt)
-        s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    if (!M || !R.ctx || R.nctx < nt) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     /* with simplification, the blocks take the first half of the bar and
      * the simplification (often several times the meshing) the second */
     P.weight = opt->simplify > 0.0 ? 0.45 : 0.90;
@@ -1561,7 +1565,7 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     free(R.ms.tab);
     free(R.ms.fr);
     free(R.ms.base);
-    free(R.ms.local);
+    free(R.ms.xt);
     pthread_mutex_destroy(&R.lock);
     pthread_mutex_destroy(&R.mlock);
     if (s) {
