@@ -26,17 +26,19 @@
  *
  * The selection's boxes. The block selection (mesher.c) descends an
  * octree of boxes of blocks, each box's interval pass under its parent's
- * plan. Which blocks under a box are kept, and their plans, are a function
- * of the box and of its own plan alone (the passes below read nothing
- * else), by the same argument as a block's output. So the cache keeps the
- * boxes at one depth (about 4 x 4 x 4 blocks) with their plans, and a box
- * whose plan is the cached box's, content for content (lb__cache_same_plan,
- * as for blocks), takes the cached blocks under it instead of descending:
- * their plans written in the new evaluator's indices through the two
- * boxes' lists, which match place for place (a block's list is a subset of
- * its box's). Those blocks then go through the block rule like any other.
- * On the 512-sphere lattice with one sphere moved this skips most of the
- * selection's interval passes.
+ * plan. Which boxes and blocks under a box are kept, and their plans, are
+ * a function of the box and of its own plan alone (the passes below read
+ * nothing else), by the same argument as a block's output. So the cache
+ * keeps the boxes down to one depth (about 4 x 4 x 4 blocks) with their
+ * plans, and a box whose plan is the cached box's, content for content
+ * (lb__cache_same_plan, as for blocks), takes the cached boxes and blocks
+ * under it instead of descending: their plans written in the new
+ * evaluator's indices through the two boxes' lists, which match place for
+ * place (a box's or block's list is a subset of every box's above it).
+ * Those blocks then go through the block rule like any other. On the
+ * 512-sphere lattice with one sphere moved the descent stops at the
+ * largest boxes whose plans leave that sphere out: a few dozen interval
+ * passes instead of about a thousand.
  *
  * The records. For each instruction of the evaluator last meshed, its
  * content with arguments as instruction indices of that evaluator (a
@@ -70,9 +72,9 @@ struct lb_mesh_cache {
     size_t tcap;
     lb__cblock *blocks; /* sorted by id */
     size_t nblocks;
-    /* the block selection's boxes at depth node_depth (-1: none) that the
-     * surface may cross: id is the box's first block's, plan its plan
-     * (with argpos), sorted by id */
+    /* the block selection's boxes down to depth node_depth (-1: none) that
+     * the surface may cross: depth, id (the box's first block's), plan
+     * (with argpos), sorted by depth, then id */
     lb__cblock *nodes;
     size_t nnodes;
     int node_depth;
@@ -105,6 +107,11 @@ struct lb__cmatch {
     int usable;
     uint32_t *deep, *same, *pos, *stamp, round;
     lb__recs cmp, self, full;
+    /* a box taken (lb__cache_carry_from): each cached instruction of its
+     * list -> the new one at the same place (NONE elsewhere; nmap entries,
+     * the cache's instruction count) */
+    uint32_t *map;
+    size_t nmap;
 };
 
 void lb__cmatch_free(lb__cmatch *M) {
@@ -113,6 +120,7 @@ void lb__cmatch_free(lb__cmatch *M) {
     free(M->same);
     free(M->pos);
     free(M->stamp);
+    free(M->map);
     lb__recs_free(&M->cmp);
     lb__recs_free(&M->self);
     lb__recs_free(&M->full);
@@ -132,8 +140,11 @@ lb_status lb__cmatch_new(const lb_mesh_cache *C, const lb_evaluator *ev, int usa
         M->same = malloc(n * sizeof *M->same);
         M->pos = malloc(n * sizeof *M->pos);
         M->stamp = calloc(n, sizeof *M->stamp);
-        ok = M->deep && M->same && M->pos && M->stamp && lb__recs_make(ev, NULL, 1, 1, &M->full) &&
-             lb__recs_make(ev, NULL, 0, 1, &M->self);
+        M->nmap = usable ? C->nins : 0;
+        M->map = malloc((M->nmap ? M->nmap : 1) * sizeof *M->map);
+        for (size_t i = 0; M->map && i < M->nmap; ++i) M->map[i] = NONE;
+        ok = M->deep && M->same && M->pos && M->stamp && M->map &&
+             lb__recs_make(ev, NULL, 1, 1, &M->full) && lb__recs_make(ev, NULL, 0, 1, &M->self);
     }
     if (ok && usable) {
         /* deep matches in tape order: an instruction's arguments come first */
@@ -386,43 +397,60 @@ void lb__cnodes_free(lb__cblock *nodes, size_t n) {
     free(nodes);
 }
 
-static int cmp_id(const void *a, const void *b) {
-    const uint64_t x = ((const lb__cblock *)a)->id, y = ((const lb__cblock *)b)->id;
-    return x < y ? -1 : x > y;
-}
-
 /* The first of the n entries of E (sorted by id) with id >= key. */
 static size_t lower_id(const lb__cblock *E, size_t n, uint64_t key) {
     return lb__lower_id(E, n, sizeof *E, offsetof(lb__cblock, id), key);
 }
 
+/* Boxes by depth, then id. */
+static int cmp_node(const void *a, const void *b) {
+    const lb__cblock *x = a, *y = b;
+    if (x->depth != y->depth) return x->depth < y->depth ? -1 : 1;
+    return x->id < y->id ? -1 : x->id > y->id;
+}
+
 const lb__cblock *lb__cache_node(const lb_mesh_cache *C, int depth, uint64_t id) {
-    if (!C->valid || depth != C->node_depth) return NULL;
-    const size_t q = lower_id(C->nodes, C->nnodes, id);
-    return q < C->nnodes && C->nodes[q].id == id ? &C->nodes[q] : NULL;
+    const lb__cblock *F = lb__cache_node_from(C, depth, id);
+    return F && F->depth == (uint32_t)depth && F->id == id ? F : NULL;
+}
+
+const lb__cblock *lb__cache_node_from(const lb_mesh_cache *C, int depth, uint64_t id) {
+    if (!C->valid || depth < 0) return NULL;
+    size_t lo = 0, hi = C->nnodes;
+    const lb__cblock key = {.id = id, .depth = (uint32_t)depth};
+    while (lo < hi) {
+        const size_t m = lo + (hi - lo) / 2;
+        if (cmp_node(&C->nodes[m], &key) < 0)
+            lo = m + 1;
+        else
+            hi = m;
+    }
+    return lo < C->nnodes ? &C->nodes[lo] : NULL;
+}
+
+const lb__cblock *lb__cache_nodes(const lb_mesh_cache *C, size_t *n) {
+    *n = C->valid ? C->nnodes : 0;
+    return C->nodes;
 }
 
 size_t lb__cache_block_from(const lb_mesh_cache *C, uint64_t id) {
     return lower_id(C->blocks, C->nblocks, id);
 }
 
-int lb__cache_carry(const lb__cblock *node, const lb__cplan *now, const lb__cplan *leaf,
-                    lb__cplan *out) {
+void lb__cache_carry_from(lb__cmatch *M, const lb__cblock *E, const lb__cplan *now, int on) {
+    for (uint32_t q = 0; q < E->plan.nlist; ++q) M->map[E->plan.list[q]] = on ? now->list[q] : NONE;
+}
+
+int lb__cache_carry(const lb__cmatch *M, const lb__cplan *leaf, lb__cplan *out) {
     const uint32_t nl = leaf->nlist, na = leaf->nact_total;
     memset(out, 0, sizeof *out);
     uint32_t *list = malloc((nl ? nl : 1) * sizeof *list + (na ? na : 1) * sizeof *out->act);
     if (!list) return 0;
-    /* both lists ascend, and the leaf's is a subset of the box's */
-    uint32_t q = 0;
-    for (uint32_t t = 0; t < nl; ++t) {
-        const uint32_t j = leaf->list[t];
-        while (q < node->plan.nlist && node->plan.list[q] < j) ++q;
-        if (q == node->plan.nlist || node->plan.list[q] != j) {
+    for (uint32_t t = 0; t < nl; ++t) /* the leaf's list is a subset of the box's */
+        if ((list[t] = M->map[leaf->list[t]]) == NONE) {
             free(list);
             return 0;
         }
-        list[t] = now->list[q];
-    }
     out->list = list;
     out->act = (uint16_t *)(void *)(list + (nl ? nl : 1));
     if (na) memcpy(out->act, leaf->act, na * sizeof *out->act);
@@ -639,7 +667,7 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     C->counts[1] = counts[1];
     C->blocks = blocks;
     C->nblocks = n;
-    if (nnodes) qsort(nodes, nnodes, sizeof *nodes, cmp_id); /* made in descent order */
+    if (nnodes) qsort(nodes, nnodes, sizeof *nodes, cmp_node); /* made in descent order */
     C->nodes = nodes;
     C->nnodes = nnodes;
     C->node_depth = node_depth;

@@ -117,6 +117,9 @@ typedef struct lb__block {
      * (not freed by the merge; rref's blocks are offset codes, as in
      * lb__cblock) */
     int borrowed;
+    /* taken with its plan from the cache by the selection (a box of the
+     * same plan above it): its own plan is the cached block's */
+    int carried;
 } lb__block;
 
 /* ---- incremental remeshing (cache.c; lb_mesh_cache in mesh.h) ----
@@ -137,6 +140,7 @@ typedef struct lb__cblock {
     double *vpos, *vnrm;
     uint32_t *tri;
     uint32_t nnode, nface;
+    uint32_t depth; /* a selection box's depth (boxes only; cache.c) */
     uint16_t *node;
     double *ndata; /* 4 per node */
     uint16_t *fe;
@@ -181,20 +185,28 @@ LB_INTERNAL lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb
                                        const size_t counts[2], lb__cblock *nodes, size_t nnodes,
                                        int node_depth, lb_error *err);
 /* The incremental block selection (mesher.c's select_visit; cache.c states
- * the rule): the selection's boxes at one depth are kept with their plans
- * (nodes, moved into the cache by the commit, with n of them; freed by
- * lb__cnodes_free otherwise). A box whose plan is the cached box's, content
- * for content, has the cached box's blocks under it with the same plans:
- * lb__cache_node finds the cached box (NULL: none, or another depth),
+ * the rule): the selection's boxes down to one depth are kept with their
+ * plans (nodes, each with its depth and its first block's id, moved into
+ * the cache by the commit, with n of them; freed by lb__cnodes_free
+ * otherwise). A box whose plan is the cached box's, content for content,
+ * has the cached box's blocks and boxes under it with the same plans:
+ * lb__cache_node finds the cached box (NULL: none, or deeper than the
+ * cache keeps), lb__cache_node_from the first at (depth, id) or after it
+ * (NULL: none), lb__cache_nodes gives them all (sorted by depth, then id),
  * lb__cache_block_from the first cached block with id >= a given one, and
- * lb__cache_carry writes a cached block's plan in the new evaluator's
- * indices (through the two boxes' lists, equal place for place); 0 when an
- * instruction is missing from the box's list or memory is short. */
+ * lb__cache_carry writes a cached block's or box's plan in the new
+ * evaluator's indices through the taken box's list (lb__cache_carry_from,
+ * on, before, the cached box E and its plan now in the new evaluator's
+ * indices, equal place for place; off after); 0 when an instruction is
+ * missing from the box's list or memory is short. */
 LB_INTERNAL void lb__cnodes_free(lb__cblock *nodes, size_t n);
 LB_INTERNAL const lb__cblock *lb__cache_node(const lb_mesh_cache *C, int depth, uint64_t id);
+LB_INTERNAL const lb__cblock *lb__cache_node_from(const lb_mesh_cache *C, int depth, uint64_t id);
+LB_INTERNAL const lb__cblock *lb__cache_nodes(const lb_mesh_cache *C, size_t *n);
 LB_INTERNAL size_t lb__cache_block_from(const lb_mesh_cache *C, uint64_t id);
-LB_INTERNAL int lb__cache_carry(const lb__cblock *node, const lb__cplan *now, const lb__cplan *leaf,
-                                lb__cplan *out);
+LB_INTERNAL void lb__cache_carry_from(lb__cmatch *M, const lb__cblock *E, const lb__cplan *now,
+                                      int on);
+LB_INTERNAL int lb__cache_carry(const lb__cmatch *M, const lb__cplan *leaf, lb__cplan *out);
 /* The vertices and triangles of the cached mesh once merged (before the
  * passes after it). */
 LB_INTERNAL void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt);

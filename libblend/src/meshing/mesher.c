@@ -144,22 +144,23 @@ typedef struct blist {
     size_t n, cap;
 } blist;
 
-/* The incremental selection (cache.c states the rule): the boxes at depth
- * `depth` that the surface may cross, with their plans, for the next
+/* The incremental selection (cache.c states the rule): the boxes down to
+ * depth `depth` that the surface may cross, with their plans, for the next
  * cache (nodes); with a usable match M, a box whose plan is the cached
- * box's takes the cached blocks under it instead of its descent. */
+ * box's takes the cached boxes and blocks under it instead of its
+ * descent. */
 typedef struct incsel {
     lb_mesh_cache *cache;
     lb__cmatch *M; /* NULL: record the boxes only */
     uint32_t *scratch;
-    int depth; /* -1: none */
+    int depth; /* the deepest boxes kept; -1: none */
     lb__cblock *nodes;
     size_t n, cap;
     size_t carried; /* blocks carried over */
 } incsel;
 
-/* Halvings above the blocks for the boxes the incremental selection keeps:
- * boxes of about 4 x 4 x 4 blocks. */
+/* Halvings above the blocks for the deepest boxes the incremental
+ * selection keeps: boxes of about 4 x 4 x 4 blocks. */
 #define INC_LEVELS 6
 
 typedef struct sel {
@@ -206,52 +207,114 @@ static void block_at(sel *S, const uint32_t b[3], const lb__cplan *plan) {
     B->id = lb__block_id(S->nb, b[0], b[1], b[2]);
 }
 
-/* Box [r0, r1) at the incremental depth, its plan own: recorded for the
- * next cache; *taken when the cached blocks under it were taken instead of
- * its descent. */
-static lb_status inc_box(sel *S, const uint32_t r0[3], const uint32_t r1[3], const lb__plan *own,
-                         int *taken) {
+/* Room for one more box in I (out of memory: LB_ERR_NO_MEMORY). */
+static lb_status node_room(sel *S) {
     incsel *I = S->inc;
-    *taken = 0;
-    if (I->n == I->cap) {
-        const size_t nc = I->cap ? 2 * I->cap : 64;
-        lb__cblock *q = realloc(I->nodes, nc * sizeof *q);
-        if (!q) return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-        I->nodes = q;
-        I->cap = nc;
-    }
-    lb__cblock *N = &I->nodes[I->n];
-    memset(N, 0, sizeof *N);
-    lb_status s = lb__cplan_make(S->ev, own, &N->plan, S->err);
-    if (s) return s;
-    N->id = lb__block_id(S->nb, r0[0], r0[1], r0[2]);
-    ++I->n;
-    const lb__cblock *E = I->M ? lb__cache_node(I->cache, I->depth, N->id) : NULL;
-    if (!E || !lb__cache_same_plan(I->cache, I->M, E, &N->plan, I->scratch)) return LB_OK;
+    if (I->n < I->cap) return LB_OK;
+    const size_t nc = I->cap ? 2 * I->cap : 64;
+    lb__cblock *q = realloc(I->nodes, nc * sizeof *q);
+    if (!q) return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    I->nodes = q;
+    I->cap = nc;
+    return LB_OK;
+}
+
+/* Is block coordinate b (of a block or box's first block, by id) inside
+ * the box [r0, r1)? */
+static int in_box(const uint32_t nb[3], uint64_t id, const uint32_t r0[3], const uint32_t r1[3]) {
+    const uint32_t b[3] = {(uint32_t)(id % nb[0]), (uint32_t)(id / nb[0] % nb[1]),
+                           (uint32_t)(id / nb[0] / nb[1])};
+    return b[0] >= r0[0] && b[0] < r1[0] && b[1] >= r0[1] && b[1] < r1[1] && b[2] >= r0[2] &&
+           b[2] < r1[2];
+}
+
+/* The cached boxes and blocks under box [r0, r1) (the cached box E, its
+ * plan now in the new evaluator's indices) taken, their plans carried over;
+ * 0 when some plan could not be (nothing taken then). */
+static lb_status take_under(sel *S, const lb__cblock *E, const lb__cplan *now, int depth,
+                            const uint32_t r0[3], const uint32_t r1[3], int *taken) {
+    incsel *I = S->inc;
+    const size_t first = S->L->n, nfirst = I->n;
+    const uint64_t N0 = lb__block_id(S->nb, r0[0], r0[1], r0[2]);
+    lb_status s = LB_OK;
+    int ok = 1;
+    lb__cache_carry_from(I->M, E, now, 1);
+    /* the boxes below it that the cache keeps (sorted by depth, then id):
+     * at each depth those with ids from the box's first block's to its
+     * last one's, inside it */
     size_t nold = 0;
+    const lb__cblock *on = lb__cache_nodes(I->cache, &nold);
+    const uint64_t last = lb__block_id(S->nb, r1[0] - 1, r1[1] - 1, r1[2] - 1);
+    for (size_t j = 0; j < nold && ok && !s; ++j) {
+        if (on[j].depth <= (uint32_t)depth) continue;
+        if (on[j].id < N0) { /* the next depth's first one inside */
+            const lb__cblock *F = lb__cache_node_from(I->cache, on[j].depth, N0);
+            if (!F) break;
+            j = (size_t)(F - on) - 1;
+            continue;
+        }
+        if (on[j].id > last) { /* the next depth's */
+            const lb__cblock *F = lb__cache_node_from(I->cache, on[j].depth + 1, 0);
+            if (!F) break;
+            j = (size_t)(F - on) - 1;
+            continue;
+        }
+        if (!in_box(S->nb, on[j].id, r0, r1)) continue;
+        if ((s = node_room(S))) break;
+        lb__cblock *N = &I->nodes[I->n];
+        memset(N, 0, sizeof *N);
+        if (!(ok = lb__cache_carry(I->M, &on[j].plan, &N->plan))) break;
+        N->id = on[j].id;
+        N->depth = on[j].depth;
+        ++I->n;
+    }
     const lb__cblock *old = lb__cache_blocks(I->cache, &nold);
-    const size_t first = S->L->n;
-    for (uint32_t z = r0[2]; z < r1[2]; ++z)
-        for (uint32_t y = r0[1]; y < r1[1]; ++y) {
+    for (uint32_t z = r0[2]; z < r1[2] && ok && !s; ++z)
+        for (uint32_t y = r0[1]; y < r1[1] && ok && !s; ++y) {
             const uint64_t row = lb__block_id(S->nb, 0, y, z);
             for (size_t j = lb__cache_block_from(I->cache, row + r0[0]);
                  j < nold && old[j].id < row + r1[0]; ++j) {
                 lb__cplan p;
-                if ((s = blist_room(S))) return s;
-                if (!lb__cache_carry(E, &N->plan, &old[j].plan, &p)) {
-                    /* not carried: the blocks taken so far go, and the box
-                     * is descended */
-                    for (size_t k = first; k < S->L->n; ++k) lb__cplan_free(&S->L->b[k].plan);
-                    S->L->n = first;
-                    return LB_OK;
-                }
+                if ((s = blist_room(S))) break;
+                if (!(ok = lb__cache_carry(I->M, &old[j].plan, &p))) break;
                 const uint32_t b[3] = {(uint32_t)(old[j].id % S->nb[0]), y, z};
                 block_at(S, b, &p);
+                S->L->b[S->L->n - 1].carried = 1;
             }
         }
+    lb__cache_carry_from(I->M, E, now, 0);
+    if (s || !ok) { /* nothing taken: the box is descended (or the run fails) */
+        for (size_t k = first; k < S->L->n; ++k) lb__cplan_free(&S->L->b[k].plan);
+        S->L->n = first;
+        for (size_t k = nfirst; k < I->n; ++k) lb__cplan_free(&I->nodes[k].plan);
+        I->n = nfirst;
+        return s;
+    }
     I->carried += S->L->n - first;
     *taken = 1;
     return LB_OK;
+}
+
+/* Box [r0, r1) at depth (at most the incremental depth), its plan own:
+ * recorded for the next cache; *taken when the cached boxes and blocks
+ * under it were taken instead of its descent. */
+static lb_status inc_box(sel *S, const uint32_t r0[3], const uint32_t r1[3], int depth,
+                         const lb__plan *own, int *taken) {
+    incsel *I = S->inc;
+    *taken = 0;
+    lb_status s = node_room(S);
+    if (s) return s;
+    lb__cblock *N = &I->nodes[I->n];
+    memset(N, 0, sizeof *N);
+    s = lb__cplan_make(S->ev, own, &N->plan, S->err);
+    if (s) return s;
+    N->id = lb__block_id(S->nb, r0[0], r0[1], r0[2]);
+    N->depth = (uint32_t)depth;
+    ++I->n;
+    const lb__cblock *E = I->M ? lb__cache_node(I->cache, depth, N->id) : NULL;
+    if (!E || !lb__cache_same_plan(I->cache, I->M, E, &N->plan, I->scratch)) return LB_OK;
+    const lb__cplan now = N->plan; /* I->nodes may move */
+    return take_under(S, E, &now, depth, r0, r1, taken);
 }
 
 /* One box of blocks [r0, r1) (a visit of lb__box_descend): kept when the
@@ -288,9 +351,9 @@ static lb_status select_visit(void *ctx, const uint32_t r0[3], const uint32_t r1
         block_at(S, r0, S->keep ? &p : NULL);
         return LB_OK;
     }
-    if (S->inc && depth == S->inc->depth) {
+    if (S->inc && depth <= S->inc->depth) {
         int taken;
-        const lb_status s = inc_box(S, r0, r1, own, &taken);
+        const lb_status s = inc_box(S, r0, r1, depth, own, &taken);
         if (s || taken) return s;
     }
     *split = 1;
@@ -1191,8 +1254,9 @@ static int decide(run *R) {
         const uint64_t id = R->blocks[i].id;
         while (j < nold && old[j].id < id) changed[nch++] = old[j++].id; /* old only */
         if (j < nold && old[j].id == id) cand[i] = &old[j++];
-        if (cand[i] &&
-            lb__cache_same_plan(R->cache, R->match, cand[i], &R->blocks[i].plan, scratch))
+        /* a block carried by the selection has the cached plan (cache.c) */
+        if (cand[i] && (R->blocks[i].carried || lb__cache_same_plan(R->cache, R->match, cand[i],
+                                                                    &R->blocks[i].plan, scratch)))
             R->from[i] = cand[i];
         else
             changed[nch++] = id;
