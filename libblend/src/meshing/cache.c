@@ -404,7 +404,8 @@ void lb__cblock_free(lb__cblock *E) {
 }
 
 static void blocks_free(lb_mesh_cache *C) {
-    for (size_t i = 0; i < C->nblocks; ++i) lb__cblock_free(&C->blocks[i]);
+    for (size_t i = 0; i < C->nblocks; ++i)
+        if (C->blocks[i].id != LB__CBLOCK_MOVED) lb__cblock_free(&C->blocks[i]);
     free(C->blocks);
     C->blocks = NULL;
     C->nblocks = 0;

@@ -153,6 +153,9 @@ typedef struct lb__cblock {
 
 /* Frees what E holds (not E). */
 LB_INTERNAL void lb__cblock_free(lb__cblock *E);
+/* The id of a cached entry whose content a new run's entry took over
+ * (mesher.c, before lb__cache_commit): it holds nothing of its own. */
+#define LB__CBLOCK_MOVED UINT64_MAX
 /* The cache's blocks are usable for ev on grid g: made for the same grid,
  * convention and culling. */
 LB_INTERNAL int lb__cache_usable(const lb_mesh_cache *C, const lb_evaluator *ev, const lb__grid *g);

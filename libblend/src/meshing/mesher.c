@@ -1583,7 +1583,7 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
                 lb__cplan_free(&old->plan);
                 *E = *old;
                 E->plan = plan;
-                memset(old, 0, sizeof *old);
+                old->id = LB__CBLOCK_MOVED; /* what it held is E's */
             }
             E->id = R.blocks[i].id;
         }
