@@ -1624,6 +1624,74 @@ static void test_mesh_cache_memory(void **state) {
     lb_mesh_cache_free(cache);
 }
 
+/* A cached run cancelled part way (by the progress callback, at several
+ * points) fails and leaves the cache as it was: the scene meshed before it
+ * then comes all from the cache, and every mesh through the cache is the
+ * full one's bytes. */
+static void test_mesh_cache_cancel(void **state) {
+    (void)state;
+    char *ta = lattice_text(-1, 0.0, 0.0, 0.15), *tb = lattice_text(13, 0.04, 0.0, 0.15);
+    lb_error e = {LB_OK, ""};
+    lb_scene *sa = NULL, *sb = NULL;
+    lb_evaluator *ea = NULL, *eb = NULL;
+    if (lb_scene_parse(ta, strlen(ta), "a.json", &sa, &e) || lb_evaluator_create(sa, &ea, &e) ||
+        lb_scene_parse(tb, strlen(tb), "b.json", &sb, &e) || lb_evaluator_create(sb, &eb, &e))
+        fail_msg("%s", e.message);
+    for (int threads = 1; threads <= 2; ++threads) {
+        lb_mesh_options o = lattice_options(64, threads);
+        lb_mesh *fa = NULL, *fb = NULL, *m = NULL;
+        lb_mesh_cache *cache = NULL;
+        if (lb_mesh_create(ea, &o, &fa, &e) || lb_mesh_create(eb, &o, &fb, &e) ||
+            lb_mesh_cache_create(&cache, &e) || lb_mesh_create_cached(ea, &o, cache, &m, &e))
+            fail_msg("%s", e.message);
+        lb_mesh_free(m);
+        /* how many progress calls a whole incremental run makes */
+        prog count = {0, 0.0, 1, -1};
+        lb_mesh_cache *probe = NULL;
+        o.progress = on_progress;
+        o.user = &count;
+        if (lb_mesh_cache_create(&probe, &e) || lb_mesh_create_cached(ea, &o, probe, &m, &e))
+            fail_msg("%s", e.message);
+        lb_mesh_free(m);
+        count.calls = 0;
+        if (lb_mesh_create_cached(eb, &o, probe, &m, &e)) fail_msg("%s", e.message);
+        lb_mesh_free(m);
+        lb_mesh_cache_free(probe);
+        assert_true(count.calls >= 8);
+        for (int k = 0; k < 4; ++k) {
+            prog p = {0, 0.0, 1, 1 + k * (count.calls - 2) / 4};
+            o.progress = on_progress;
+            o.user = &p;
+            const lb_status s = lb_mesh_create_cached(eb, &o, cache, &m, &e);
+            if (s != LB_ERR_CANCELLED || m)
+                fail_msg("%d threads, cancelled at call %d of %d: status %d", threads, p.cancel_at,
+                         count.calls, (int)s);
+            o.progress = NULL;
+            lb_mesh_cache_stats st;
+            if (lb_mesh_create_cached(ea, &o, cache, &m, &e)) fail_msg("%s", e.message);
+            lb_mesh_cache_stats_get(cache, &st);
+            if (!same_mesh(m, fa) || st.reused != st.blocks)
+                fail_msg("%d threads, after a run cancelled at call %d: %zu of %zu blocks from "
+                         "the cache, %s",
+                         threads, p.cancel_at, st.reused, st.blocks,
+                         same_mesh(m, fa) ? "same bytes" : "other bytes");
+            lb_mesh_free(m);
+        }
+        if (lb_mesh_create_cached(eb, &o, cache, &m, &e)) fail_msg("%s", e.message);
+        if (!same_mesh(m, fb)) fail_msg("%d threads: the edit after cancelled runs", threads);
+        lb_mesh_free(m);
+        lb_mesh_free(fa);
+        lb_mesh_free(fb);
+        lb_mesh_cache_free(cache);
+    }
+    lb_evaluator_free(ea);
+    lb_evaluator_free(eb);
+    lb_scene_free(sa);
+    lb_scene_free(sb);
+    free(ta);
+    free(tb);
+}
+
 /* With no argument every case runs; with names (e.g. "test_threads_identical"),
  * only those: the ThreadSanitizer build runs the cases that start threads
  * (tests/CMakeLists.txt, test_mesh_threaded). An unknown name fails. */
@@ -1649,6 +1717,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_wide_union),
         cmocka_unit_test(test_mesh_cache),
         cmocka_unit_test(test_mesh_cache_memory),
+        cmocka_unit_test(test_mesh_cache_cancel),
     };
     enum { NALL = sizeof all / sizeof all[0] };
     if (argc < 2) return cmocka_run_group_tests(all, setup, NULL);
