@@ -118,8 +118,12 @@ typedef struct lb__block {
      * lb__cblock) */
     int borrowed;
     /* taken with its plan from the cache by the selection (a box of the
-     * same plan above it): its own plan is the cached block's */
+     * same plan above it): its own plan is the cached block's; plan_of,
+     * when the two evaluators number that plan's instructions alike: the
+     * cached entry whose plan memory plan is (not B's to free: mesher.c's
+     * commit moves it to the new entry) */
     int carried;
+    const struct lb__cblock *plan_of;
 } lb__block;
 
 /* ---- incremental remeshing (cache.c; lb_mesh_cache in mesh.h) ----

@@ -193,6 +193,14 @@ static lb_status blist_room(sel *S) {
 
 /* A block of the list at block coordinates b (its cells clipped to the
  * grid), with plan. */
+/* B's plan freed, unless it is a cached entry's (plan_of). */
+static void plan_drop(lb__block *B) {
+    if (B->plan_of)
+        memset(&B->plan, 0, sizeof B->plan);
+    else
+        lb__cplan_free(&B->plan);
+}
+
 static void block_at(sel *S, const uint32_t b[3], const lb__cplan *plan) {
     lb__block *B = &S->L->b[S->L->n++];
     memset(B, 0, sizeof *B);
@@ -268,23 +276,28 @@ static lb_status take_under(sel *S, const lb__cblock *E, const lb__cplan *now, i
         N->depth = on[j].depth;
         ++I->n;
     }
+    /* the two boxes' lists number their instructions alike (an edit of
+     * parameters only): a block's plan is the cached one's, shared */
+    const int alike = E->plan.nlist == now->nlist &&
+                      !memcmp(E->plan.list, now->list, now->nlist * sizeof *now->list);
     const lb__cblock *old = lb__cache_blocks(I->cache, &nold);
     for (uint32_t z = r0[2]; z < r1[2] && ok && !s; ++z)
         for (uint32_t y = r0[1]; y < r1[1] && ok && !s; ++y) {
             const uint64_t row = lb__block_id(S->nb, 0, y, z);
             for (size_t j = lb__cache_block_from(I->cache, row + r0[0]);
                  j < nold && old[j].id < row + r1[0]; ++j) {
-                lb__cplan p;
+                lb__cplan p = old[j].plan;
                 if ((s = blist_room(S))) break;
-                if (!(ok = lb__cache_carry(I->M, &old[j].plan, &p))) break;
+                if (!alike && !(ok = lb__cache_carry(I->M, &old[j].plan, &p))) break;
                 const uint32_t b[3] = {(uint32_t)(old[j].id % S->nb[0]), y, z};
                 block_at(S, b, &p);
                 S->L->b[S->L->n - 1].carried = 1;
+                S->L->b[S->L->n - 1].plan_of = alike ? &old[j] : NULL;
             }
         }
     lb__cache_carry_from(I->M, E, now, 0);
     if (s || !ok) { /* nothing taken: the box is descended (or the run fails) */
-        for (size_t k = first; k < S->L->n; ++k) lb__cplan_free(&S->L->b[k].plan);
+        for (size_t k = first; k < S->L->n; ++k) plan_drop(&S->L->b[k]);
         S->L->n = first;
         for (size_t k = nfirst; k < I->n; ++k) lb__cplan_free(&I->nodes[k].plan);
         I->n = nfirst;
@@ -361,7 +374,7 @@ static lb_status select_visit(void *ctx, const uint32_t r0[3], const uint32_t r1
 }
 
 static void blist_free(blist *L) {
-    for (size_t i = 0; i < L->n; ++i) lb__cplan_free(&L->b[i].plan);
+    for (size_t i = 0; i < L->n; ++i) plan_drop(&L->b[i]);
     free(L->b);
     L->b = NULL;
     L->n = L->cap = 0;
@@ -1127,7 +1140,7 @@ static void finish_block(run *R, size_t i, size_t t) {
         R->ms.keep[i].plan = B->plan;
         memset(&B->plan, 0, sizeof B->plan);
     }
-    lb__cplan_free(&B->plan);
+    plan_drop(B);
     free(B->octmem);
     B->octmem = NULL;
     atomic_fetch_add(&R->done, 1);
@@ -1577,13 +1590,16 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     if (!s && cache) { /* the cache becomes this mesh's */
         for (size_t i = 0; i < R.nblocks; ++i) {
             lb__cblock *E = &R.ms.keep[i];
+            const lb__cblock *of = R.blocks[i].plan_of; /* E's plan is its plan */
             if (R.from && R.from[i]) { /* moved over from the cached entry, with the new plan */
                 lb__cblock *old = (lb__cblock *)(uintptr_t)R.from[i];
                 const lb__cplan plan = E->plan;
-                lb__cplan_free(&old->plan);
+                if (!of) lb__cplan_free(&old->plan); /* else of is old: the same memory */
                 *E = *old;
                 E->plan = plan;
                 old->id = LB__CBLOCK_MOVED; /* what it held is E's */
+            } else if (of) {                /* the plan's memory taken from the cached entry */
+                memset(&((lb__cblock *)(uintptr_t)of)->plan, 0, sizeof of->plan);
             }
             E->id = R.blocks[i].id;
         }
@@ -1602,8 +1618,11 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     if (!s && P.fn && P.fn(1.0, P.user)) {
         /* cancelling at 100 % is too late to matter: the mesh is done */
     }
-    if (R.ms.keep) /* a failed run: the cache stays as it was */
-        for (size_t i = 0; i < R.nblocks; ++i) lb__cblock_free(&R.ms.keep[i]);
+    if (R.ms.keep) /* a failed run: the cache stays as it was (its plans too) */
+        for (size_t i = 0; i < R.nblocks; ++i) {
+            if (R.blocks[i].plan_of) memset(&R.ms.keep[i].plan, 0, sizeof R.ms.keep[i].plan);
+            lb__cblock_free(&R.ms.keep[i]);
+        }
     free(R.ms.keep);
     lb__cmatch_free(match);
     lb__cnodes_free(inc.nodes, inc.n);
@@ -1614,7 +1633,7 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         lb__block *B = &R.blocks[i];
         output_free(B);
         free(B->octmem);
-        lb__cplan_free(&B->plan);
+        plan_drop(B);
     }
     free(R.blocks);
     for (size_t t = 0; t < R.nctx; ++t) lb__bctx_free(R.ctx[t]);
