@@ -1133,9 +1133,13 @@ static void finish_block(run *R, size_t i, size_t t) {
             ok = !lb__fail(&e, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     }
     if (!ok) fail_block(R, i, &e);
-    for (int c = 1; c < 8; ++c)
-        if (R->nbr[i][c]) slot_release(R, R->nbr[i][c] - 1);
-    slot_release(R, i);
+    /* (a block from the cache that no computed block reads has no slot:
+     * its count is never needed) */
+    for (int c = 1; c < 8; ++c) {
+        const uint32_t j = R->nbr[i][c];
+        if (j && !(R->from && R->from[j - 1] && !R->want[j - 1])) slot_release(R, j - 1);
+    }
+    if (!(R->from && R->from[i] && !R->want[i])) slot_release(R, i);
     if (R->cache) { /* the cache keeps the plan */
         R->ms.keep[i].plan = B->plan;
         memset(&B->plan, 0, sizeof B->plan);
