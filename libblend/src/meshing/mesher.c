@@ -177,22 +177,27 @@ typedef struct sel {
 } sel;
 
 /* Room for one more block in L (over max_blocks: LB_ERR_NO_MEMORY too). */
+/* Room for element n (of sz bytes) in *p, which has room for *cap: doubled
+ * from first when full. 0 when out of memory (*p as it was). */
+static int room_for(void **p, size_t *cap, size_t n, size_t sz, size_t first) {
+    if (n < *cap) return 1;
+    const size_t nc = *cap ? 2 * *cap : first;
+    void *q = realloc(*p, nc * sz);
+    if (!q) return 0;
+    *p = q;
+    *cap = nc;
+    return 1;
+}
+
 static lb_status blist_room(sel *S) {
     blist *L = S->L;
     if (L->n >= S->max_blocks)
         return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: more than %zu blocks", FN, S->max_blocks);
-    if (L->n == L->cap) {
-        const size_t nc = L->cap ? 2 * L->cap : 256;
-        lb__block *q = realloc(L->b, nc * sizeof *q);
-        if (!q) return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-        L->b = q;
-        L->cap = nc;
-    }
+    if (!room_for((void **)&L->b, &L->cap, L->n, sizeof *L->b, 256))
+        return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     return LB_OK;
 }
 
-/* A block of the list at block coordinates b (its cells clipped to the
- * grid), with plan. */
 /* B's plan freed, unless it is a cached entry's (plan_of). */
 static void plan_drop(lb__block *B) {
     if (B->plan_of)
@@ -201,6 +206,8 @@ static void plan_drop(lb__block *B) {
         lb__cplan_free(&B->plan);
 }
 
+/* A block of the list at block coordinates b (its cells clipped to the
+ * grid), with plan. */
 static void block_at(sel *S, const uint32_t b[3], const lb__cplan *plan) {
     lb__block *B = &S->L->b[S->L->n++];
     memset(B, 0, sizeof *B);
@@ -218,12 +225,8 @@ static void block_at(sel *S, const uint32_t b[3], const lb__cplan *plan) {
 /* Room for one more box in I (out of memory: LB_ERR_NO_MEMORY). */
 static lb_status node_room(sel *S) {
     incsel *I = S->inc;
-    if (I->n < I->cap) return LB_OK;
-    const size_t nc = I->cap ? 2 * I->cap : 64;
-    lb__cblock *q = realloc(I->nodes, nc * sizeof *q);
-    if (!q) return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-    I->nodes = q;
-    I->cap = nc;
+    if (!room_for((void **)&I->nodes, &I->cap, I->n, sizeof *I->nodes, 64))
+        return lb__fail(S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     return LB_OK;
 }
 
