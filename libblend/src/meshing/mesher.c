@@ -176,7 +176,6 @@ typedef struct sel {
     lb_error *err;
 } sel;
 
-/* Room for one more block in L (over max_blocks: LB_ERR_NO_MEMORY too). */
 /* Room for element n (of sz bytes) in *p, which has room for *cap: doubled
  * from first when full. 0 when out of memory (*p as it was). */
 static int room_for(void **p, size_t *cap, size_t n, size_t sz, size_t first) {
@@ -189,6 +188,7 @@ static int room_for(void **p, size_t *cap, size_t n, size_t sz, size_t first) {
     return 1;
 }
 
+/* Room for one more block in L (over max_blocks: LB_ERR_NO_MEMORY too). */
 static lb_status blist_room(sel *S) {
     blist *L = S->L;
     if (L->n >= S->max_blocks)
@@ -240,8 +240,10 @@ static int in_box(const uint32_t nb[3], uint64_t id, const uint32_t r0[3], const
 }
 
 /* The cached boxes and blocks under box [r0, r1) (the cached box E, its
- * plan now in the new evaluator's indices) taken, their plans carried over;
- * 0 when some plan could not be (nothing taken then). */
+ * plan now in the new evaluator's indices) taken, their plans carried over
+ * (*taken = 1); when some plan cannot be, nothing is taken (the box is
+ * descended). A failure's status (out of memory, over max_blocks) is
+ * returned. */
 static lb_status take_under(sel *S, const lb__cblock *E, const lb__cplan *now, int depth,
                             const uint32_t r0[3], const uint32_t r1[3], int *taken) {
     incsel *I = S->inc;
@@ -945,7 +947,7 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
         memcpy(M->normals + 3 * base, B->vnrm, 3 * B->np * sizeof(double));
     }
     /* each local vertex u's mesh vertex (xt): own (u < np) the mesh's next
-     * ones, an orphan through the table, a reference (u >= nv) a vertex of
+     * ones, an orphan through the table, a reference (u >= nown) a vertex of
      * a block merged before this one; then every triangle index through xt
      * (one load each from a table in the core's cache: the three cases in
      * one loop were mispredicted often) */
