@@ -928,15 +928,9 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     const size_t base = M->nvertices;
     S->base[bi] = (uint32_t)base;
     if (B->nfeat) {
-        if (S->nfr == S->frcap) {
-            const size_t c = S->frcap ? 2 * S->frcap : 64;
-            size_t *p = realloc(S->fr, 2 * c * sizeof *p);
-            if (!p) {
-                S->s = lb__fail(&S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
-                return 0;
-            }
-            S->fr = p;
-            S->frcap = c;
+        if (!room_for((void **)&S->fr, &S->frcap, S->nfr, 2 * sizeof *S->fr, 64)) {
+            S->s = lb__fail(&S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+            return 0;
         }
         S->fr[2 * S->nfr] = base + B->np - B->nfeat;
         S->fr[2 * S->nfr + 1] = B->nfeat;
@@ -1092,6 +1086,13 @@ static int start_block(run *R, size_t i, size_t t) {
     return !s;
 }
 
+/* May block i hold a node slot? Not when it comes from the cache and no
+ * computed block reads it (start_block gives it none: its reader count is
+ * never needed). */
+static int has_slot(const run *R, size_t i) {
+    return !(R->from && R->from[i] && !R->want[i]);
+}
+
 /* Block i's output from its cached entry (the arrays borrowed; its
  * references name next blocks by offset code, which the merge reads
  * through nbr: the rule checked that those blocks are kept). */
@@ -1138,13 +1139,9 @@ static void finish_block(run *R, size_t i, size_t t) {
             ok = !lb__fail(&e, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     }
     if (!ok) fail_block(R, i, &e);
-    /* (a block from the cache that no computed block reads has no slot:
-     * its count is never needed) */
-    for (int c = 1; c < 8; ++c) {
-        const uint32_t j = R->nbr[i][c];
-        if (j && !(R->from && R->from[j - 1] && !R->want[j - 1])) slot_release(R, j - 1);
-    }
-    if (!(R->from && R->from[i] && !R->want[i])) slot_release(R, i);
+    for (int c = 1; c < 8; ++c)
+        if (R->nbr[i][c] && has_slot(R, R->nbr[i][c] - 1)) slot_release(R, R->nbr[i][c] - 1);
+    if (has_slot(R, i)) slot_release(R, i);
     if (R->cache) { /* the cache keeps the plan */
         R->ms.keep[i].plan = B->plan;
         memset(&B->plan, 0, sizeof B->plan);
