@@ -569,6 +569,12 @@ static lb_status settle_by_bisection(const lb_evaluator *ev, const lb__grid *g, 
     return LB_OK;
 }
 
+/* cos(acos(LB__FEATURE_COS) / 2) = sqrt((1 + 0.9) / 2) = 0.974679..., a
+ * little above: two normals each within this of a third (unit to an ulp or
+ * two, as the edge refinement leaves them) are within LB__FEATURE_COS of
+ * each other with room for rounding (25.838 against 25.842 degrees) */
+#define NEAR_COS 0.9747 /* to be derived again if LB__FEATURE_COS changes */
+
 static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__block *B, bctx *C,
                                 lb_error *err) {
     const size_t ne = C->ne, nref = C->nref, np0 = ne - C->norph;
@@ -578,6 +584,16 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
         if ((f > 0 && C->faces[f - 1].cell == F->cell) ||
             (f + 1 < C->nf && C->faces[f + 1].cell == F->cell))
             continue; /* two loops in one cell: their fans could cross */
+        /* most polygons bend little: all their normals within half the
+         * threshold's angle of the first (cos >= NEAR_COS) keeps every pair
+         * within it (angles add), so the pairs need no test */
+        const double *n0 = vertex_normal(B, C, F->e[0]);
+        uint32_t q0 = 1;
+        for (; q0 < F->n; ++q0) {
+            const double *nq = vertex_normal(B, C, F->e[q0]);
+            if (!(n0[0] * nq[0] + n0[1] * nq[1] + n0[2] * nq[2] >= NEAR_COS)) break;
+        }
+        if (q0 == F->n) continue;
         double P[3 * LB__MAXPOLY], N[3 * LB__MAXPOLY], ns[3] = {0, 0, 0};
         double mincos = 1.0;
         for (uint32_t q = 0; q < F->n; ++q) {
