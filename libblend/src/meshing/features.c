@@ -35,6 +35,7 @@
  * first rule) also refused the many that the flips set right, and left the
  * crease of a cylinder cut by a slab 0.03 to 0.06 cells off at 32 to 128
  * cells where it is now as close as the flat triangles' own chord error. */
+#include "../common/platform.h"
 #include "mesh_internal.h"
 
 #include <math.h>
@@ -194,29 +195,27 @@ int lb__feature_qef(const double *p, const double *n, int m, const double lo[3],
     return 1;
 }
 
-/* edge key -> the triangle whose feature corner faces it */
-typedef struct fkv {
-    uint64_t key; /* (min vertex << 32 | max vertex) + 1; 0: empty */
-    size_t t;
-} fkv;
-
-static inline size_t fslot(uint64_t key, size_t cap) {
-    key ^= key >> 33;
-    key *= 0xff51afd7ed558ccdULL;
-    key ^= key >> 33;
-    return (size_t)key & (cap - 1);
-}
-
-/* Find or insert key; returns the slot. */
-static size_t ftab_find(fkv *tab, size_t cap, uint64_t key) {
-    size_t h = fslot(key, cap);
-    while (tab[h].key && tab[h].key != key) h = (h + 1) & (cap - 1);
-    return h;
-}
-
 static void tri_normal(const double *P, const uint32_t *t, double nrm[3]) {
     lb__facing(P + 3 * (size_t)t[0], P + 3 * (size_t)t[1], P + 3 * (size_t)t[2], nrm);
 }
+
+/* The pairs found so far, chained per vertex: the segments (a, b) waiting
+ * for their second fan triangle under a = min(a, b), and the crease edges
+ * (c, d) made under min(c, d). A grid-edge vertex ends at most four cell
+ * face segments (one on each face around its grid edge) and a feature
+ * point joins at most its cell's six neighbours, so every chain is short;
+ * and the merged mesh numbers vertices block by block, so the
+ * chains a block's fans touch lie together in memory (a hash table over
+ * all segments spread its probes over megabytes: a cache miss each). */
+#define NONE UINT32_MAX
+typedef struct seg {
+    uint32_t b;    /* the other end */
+    uint32_t next; /* the next segment under the same vertex, or NONE */
+    size_t t;      /* the fan triangle waiting; SIZE_MAX: paired */
+} seg;
+typedef struct join {
+    uint32_t d, next;
+} join;
 
 lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err) {
     /* the fan triangles: exactly one feature corner */
@@ -226,41 +225,41 @@ lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err) {
         nfan += (feat[T[0]] + feat[T[1]] + feat[T[2]]) == 1;
     }
     if (!nfan) return LB_OK;
-    size_t cap = 16;
-    while (cap < 2 * nfan) cap *= 2;
-    fkv *tab = calloc(cap, sizeof *tab);
-    /* the feature-to-feature edges made so far (no edge twice) */
-    size_t ecap = 16;
-    while (ecap < nfan) ecap *= 2;
-    fkv *made = calloc(ecap, sizeof *made);
-    if (!tab || !made) {
-        free(tab);
-        free(made);
-        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
-    }
-    size_t nmade = 0;
+    /* one block: the segments, the joins (at most nfan / 2 flips), the
+     * two chain heads per vertex */
+    const size_t nv = M->nvertices, bytes = nfan * sizeof(seg) + (nfan / 2 + 1) * sizeof(join) +
+                                            2 * nv * sizeof(uint32_t);
+    unsigned char *mem = nfan < NONE ? lb__huge_alloc(bytes) : NULL;
+    if (!mem) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+    seg *segs = (seg *)(void *)mem;
+    join *joins = (join *)(void *)(mem + nfan * sizeof(seg));
+    uint32_t *head = (uint32_t *)(void *)(mem + nfan * sizeof(seg) + (nfan / 2 + 1) * sizeof(join)),
+             *jhead = head + nv;
+    memset(head, 0xff, 2 * nv * sizeof *head);
+    size_t nseg = 0, nmade = 0;
     for (size_t t = 0; t < M->ntriangles; ++t) {
         uint32_t *T = M->triangles + 3 * t;
         if ((feat[T[0]] + feat[T[1]] + feat[T[2]]) != 1) continue;
         const int k = feat[T[0]] ? 0 : feat[T[1]] ? 1 : 2;
         const uint32_t a = T[(k + 1) % 3], b = T[(k + 2) % 3];
-        const uint64_t key = ((uint64_t)(a < b ? a : b) << 32 | (a < b ? b : a)) + 1;
-        const size_t h = ftab_find(tab, cap, key);
-        if (!tab[h].key) {
-            tab[h].key = key;
-            tab[h].t = t;
+        const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
+        uint32_t i = head[lo];
+        while (i != NONE && (segs[i].b != hi || segs[i].t == SIZE_MAX)) i = segs[i].next;
+        if (i == NONE) { /* the first fan triangle on this segment: wait */
+            segs[nseg] = (seg){hi, head[lo], t};
+            head[lo] = (uint32_t)nseg++;
             continue;
         }
         /* the other fan on this segment: triangle (d, b, a) */
-        uint32_t *U = M->triangles + 3 * tab[h].t;
-        tab[h].key = UINT64_MAX; /* used: no third triangle pairs with it */
+        uint32_t *U = M->triangles + 3 * segs[i].t;
+        segs[i].t = SIZE_MAX; /* paired: no third triangle pairs with it */
         const int kk = feat[U[0]] ? 0 : feat[U[1]] ? 1 : 2;
         const uint32_t c = T[k], d = U[kk];
         if (U[(kk + 1) % 3] != b || U[(kk + 2) % 3] != a || c == d) continue;
-        const uint64_t ck = ((uint64_t)(c < d ? c : d) << 32 | (c < d ? d : c)) + 1;
-        if (2 * (nmade + 1) > ecap) continue; /* cannot happen: at most nfan / 2 flips */
-        const size_t hm = ftab_find(made, ecap, ck);
-        if (made[hm].key) continue; /* c and d already joined */
+        const uint32_t clo = c < d ? c : d, chi = c < d ? d : c;
+        uint32_t m = jhead[clo];
+        while (m != NONE && joins[m].d != chi) m = joins[m].next;
+        if (m != NONE) continue; /* c and d already joined */
         /* flipped: (c, a, d) and (d, b, c); only where both keep their
          * orientation (no fold) */
         const uint32_t T1[3] = {c, a, d}, T2[3] = {d, b, c};
@@ -274,13 +273,12 @@ lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err) {
         if (!(m1[0] * na[0] + m1[1] * na[1] + m1[2] * na[2] > 0.0) ||
             !(m2[0] * nb[0] + m2[1] * nb[1] + m2[2] * nb[2] > 0.0))
             continue;
-        made[hm].key = ck;
-        ++nmade;
+        joins[nmade] = (join){chi, jhead[clo]};
+        jhead[clo] = (uint32_t)nmade++;
         memcpy(T, T1, sizeof T1);
         memcpy(U, T2, sizeof T2);
     }
-    free(tab);
-    free(made);
+    lb__huge_free(mem, bytes);
     return LB_OK;
 }
 
