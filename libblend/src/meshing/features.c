@@ -44,7 +44,16 @@
 
 /* Eigenvalues w and eigenvectors (columns of V) of the symmetric k x k
  * matrix A (k <= 3, row-major in a 3x3 array), by cyclic Jacobi rotations:
- * a fixed sequence of operations, so the same input gives the same bits. */
+ * a fixed sequence of operations, so the same input gives the same bits.
+ * Each rotation zeroes A[p][q] with t = tan of its angle, the smaller root
+ * of t^2 + 2 theta t - 1 = 0, theta = (A[q][q] - A[p][p]) / (2 A[p][q]),
+ * computed as sign(d) 2 A[p][q] / (|d| + sqrt(d^2 + 4 A[p][q]^2)), d =
+ * A[q][q] - A[p][p] (one division fewer than through theta); the diagonal
+ * moves by t A[p][q] and only the third row and column turn. A pair already
+ * below rounding against its diagonal (|A[p][q]| <= 1e-16 (|A[p][p]| +
+ * |A[q][q]|)) is not turned: a sixth of the rotations on S2's fillets,
+ * which would change nothing but the last bits; the sweeps still end, as
+ * such pairs alone meet the convergence test. */
 static inline void sym_eigen(double A[3][3], int k, double w[3], double V[3][3]) {
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) V[i][j] = i == j;
@@ -57,20 +66,20 @@ static inline void sym_eigen(double A[3][3], int k, double w[3], double V[3][3])
         if (off <= 1e-30 * diag) break;
         for (int p = 0; p < k; ++p)
             for (int q = p + 1; q < k; ++q) {
-                if (A[p][q] == 0.0) continue;
-                const double theta = (A[q][q] - A[p][p]) / (2.0 * A[p][q]);
+                const double apq = A[p][q], app = A[p][p], aqq = A[q][q];
+                if (!(fabs(apq) > 1e-16 * (fabs(app) + fabs(aqq)))) continue;
+                const double d = aqq - app, e = 2.0 * apq;
                 const double t =
-                    (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                    d == 0.0 ? 1.0 : (d > 0.0 ? e : -e) / (fabs(d) + sqrt(d * d + e * e));
                 const double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
-                for (int r = 0; r < k; ++r) { /* A = A J */
+                A[p][p] = app - t * apq;
+                A[q][q] = aqq + t * apq;
+                A[p][q] = A[q][p] = 0.0;
+                for (int r = 0; r < k; ++r) {
+                    if (r == p || r == q) continue;
                     const double arp = A[r][p], arq = A[r][q];
-                    A[r][p] = c * arp - s * arq;
-                    A[r][q] = s * arp + c * arq;
-                }
-                for (int r = 0; r < k; ++r) { /* A = J^T A */
-                    const double apr = A[p][r], aqr = A[q][r];
-                    A[p][r] = c * apr - s * aqr;
-                    A[q][r] = s * apr + c * aqr;
+                    A[r][p] = A[p][r] = c * arp - s * arq;
+                    A[r][q] = A[q][r] = s * arp + c * arq;
                 }
                 for (int r = 0; r < k; ++r) {
                     const double vrp = V[r][p], vrq = V[r][q];
