@@ -1,12 +1,15 @@
 """Sharp features' cost and triangle counts (docs/meshing.md, Sharp features):
 
-    /usr/bin/python3 bench/mesh/run_features_bench.py BENCH_MESH SOURCE_DIR [ROUNDS]
+    /usr/bin/python3 bench/mesh/run_features_bench.py BENCH_MESH SOURCE_DIR [ROUNDS [BASE_BENCH_MESH]]
 
 For S1 and S2 at 128 and 256 cells on one thread, lb_mesh_create's time with
 LB_MESH_FEATURES (and with LB_MESH_CORNER_NORMALS too) against without, the
 runs alternating ROUNDS times (3)
 in this process's run so that the machine's load hits both alike; the ratio
-of the medians of the best-of-3 times (bench_mesh). Then the sharp shapes of
+of the medians of the best-of-3 times (bench_mesh). With BASE_BENCH_MESH (the
+mesher before features, built by bench/run_features_bench.sh) also that
+mesher's time in the same rounds, and the time with features against it. Then
+the sharp shapes of
 tests/data/features at 64 cells: triangles with and without (the errors are
 the test's). Run by bench/run_features_bench.sh; not a test."""
 import json
@@ -17,32 +20,40 @@ import sys
 
 BENCH, SRC = sys.argv[1], sys.argv[2]
 ROUNDS = int(sys.argv[3]) if len(sys.argv) > 3 else 3
+BASE = sys.argv[4] if len(sys.argv) > 4 else None
 
 
 def run(scene, res, features):
-    """features: False, True or "corners" (with corner normals)"""
-    args = [BENCH, scene, str(res), "1"] + (["--corner-normals"] if features == "corners" else
-                                            ["--features"] if features else [])
+    """features: False, True, "corners" (with corner normals) or "base" (BASE, without)"""
+    args = [BASE if features == "base" else BENCH, scene, str(res), "1"] + (
+        ["--corner-normals"] if features == "corners" else
+        ["--features"] if features is True else [])
     return json.loads(subprocess.run(args, check=True, capture_output=True,
                                      text=True).stdout.strip().splitlines()[-1])
 
 
+KINDS = (False, True, "corners") + (("base",) if BASE else ())
 print("| scene | cells | without (s) | with (s) | with / without | with corner normals (s) "
-      "| corners / without | triangles without / with |")
-print("|---|---|---|---|---|---|---|---|")
+      "| corners / without | triangles without / with |" +
+      (" before features (s) | with / before |" if BASE else ""))
+print("|---|---|---|---|---|---|---|---|" + ("---|---|" if BASE else ""))
 for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spheres.json")):
     scene = os.path.join(SRC, "scenes", f)
     for res in (128, 256):
-        t = {False: [], True: [], "corners": []}
+        t = {k: [] for k in KINDS}
         tri = {}
         for _ in range(ROUNDS):
-            for feat in (False, True, "corners"):
+            for feat in KINDS:
                 r = run(scene, res, feat)
                 t[feat].append(r["seconds"])
                 tri[feat] = r["triangles"]
         a, b, c = (statistics.median(t[k]) for k in (False, True, "corners"))
-        print("| %s | %d | %.4f | %.4f | %.3f | %.4f | %.3f | %d / %d |" %
-              (name, res, a, b, b / a, c, c / a, tri[False], tri[True]))
+        extra = ""
+        if BASE:
+            z = statistics.median(t["base"])
+            extra = " %.4f | %.3f |" % (z, b / z)
+        print("| %s | %d | %.4f | %.4f | %.3f | %.4f | %.3f | %d / %d |%s" %
+              (name, res, a, b, b / a, c, c / a, tri[False], tri[True], extra))
 print()
 print("| shape | cells | triangles without | triangles with |")
 print("|---|---|---|---|")
