@@ -26,7 +26,28 @@ import jsonschema
 blendtool, src = sys.argv[1], sys.argv[2]
 schema = json.load(open(os.path.join(src, "docs", "libblend-scene.schema.json")))
 jsonschema.Draft202012Validator.check_schema(schema)
-validator = jsonschema.Draft202012Validator(schema)
+
+
+def items_once_per_object(validator, items, instance, schema):
+    """The 2020-12 `items` keyword, validating each distinct Python object once.
+
+    The arity cases below hold up to 65,536 references to one sphere dict;
+    an array item's verdict depends only on its value and the subschema, so
+    the same object need not be walked 65,536 times (that took 70 of the
+    test's 84 s). Lists loaded from JSON hold distinct objects and are
+    validated item by item as before."""
+    if not validator.is_type(instance, "array"):
+        return
+    prefix = len(schema.get("prefixItems", []))
+    found = {}
+    for index, item in enumerate(instance[prefix:], start=prefix):
+        if id(item) not in found:
+            found[id(item)] = list(validator.descend(item, items, path=index))
+        yield from found[id(item)]
+
+
+validator = jsonschema.validators.extend(
+    jsonschema.Draft202012Validator, {"items": items_once_per_object})(schema)
 failures = []
 
 
