@@ -23,6 +23,12 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from batchlib import bt, check, digest, fail, finish, setup  # noqa: E402
 
 BT, SRC, WORK = setup()
+# render folders in a TMPDIR of this test's own: the SIGKILL trials check that
+# none is left behind, which a shared /tmp cannot show while other tests (run
+# in parallel by ctest) render
+TMP = os.path.join(WORK, "tmp")
+os.makedirs(TMP)
+os.environ["TMPDIR"] = TMP
 SCHEMA = json.load(open(os.path.join(SRC, "docs", "libblend-job.schema.json")))
 
 
@@ -348,6 +354,7 @@ r = bt("batch", write_job(os.path.join(dref, "k2.json"), dict(kjob, name="k2", o
 full_time = time.time() - t0
 rng = random.Random(13)
 redone_complete = 0
+killed = 0  # render folders the killed runs left (the next run removes them)
 for trial in range(20):
     before = {n for n in os.listdir(os.path.join(dk, "out", ".libblend-manifest"))} \
         if os.path.isdir(os.path.join(dk, "out", ".libblend-manifest")) else set()
@@ -355,6 +362,7 @@ for trial in range(20):
     time.sleep(rng.uniform(0.0, full_time * 1.1))
     p.send_signal(signal.SIGKILL)
     p.wait()
+    killed += len(glob.glob(os.path.join(TMP, "blendtool-render-*")))
     out = os.path.join(dk, "out")
     # every manifest that exists vouches for complete outputs
     for mf in glob.glob(os.path.join(out, ".libblend-manifest", "*.json")):
@@ -374,10 +382,11 @@ for trial in range(20):
           "trial %d: the rerun completes the job%s" % (trial, why(r)))
     shutil.rmtree(out) if trial % 2 else None
 check(redone_complete == 0, "a task complete before a kill was redone %d times" % redone_complete)
-left = glob.glob("/tmp/blendtool-render-*") + glob.glob(os.path.join(dk, "out", ".*.lbtmp.*"))
 r = bt("render", DROP, "-o", os.path.join(WORK, "after.png"), "--width", "32", "--height", "24")
-left = [p for p in glob.glob("/tmp/blendtool-render-*") if os.path.isdir(p)]
+left = [p for p in glob.glob(os.path.join(TMP, "blendtool-render-*")) if os.path.isdir(p)]
 check(not left, "render folders of killed runs are removed by the next render: %s" % left)
+check(not glob.glob(os.path.join(dk, "out", ".*.lbtmp.*")), "temporary outputs of killed runs are left")
+print("SIGKILL trials: %d render folders left by killed runs, all removed by the next run" % killed)
 
 # ---- GNU parallel: the task list through parallel, --joblog, --resume-failed
 dp = os.path.join(WORK, "par")
