@@ -176,17 +176,33 @@ typedef struct sel {
     lb_error *err;
 } sel;
 
+/* *p (room for cap elements of size sz, the first used of them in use)
+ * given room for c elements when c > cap. */
+static int grow(void **p, size_t cap, size_t c, size_t used, size_t sz) {
+    if (c <= cap) return 1;
+    /* a new array, advised before the used part is copied in: realloc
+     * would move the pages (mremap) to an address whose 2 MiB alignment
+     * differs, which splits the huge pages into small ones for good, and
+     * on this project's build machine (a PVM guest) a small page can cost
+     * a fault in the host each time it is touched after any unmapping
+     * (docs/meshing.md, Incremental remeshing) */
+    void *q = malloc(c * sz);
+    if (!q) return 0;
+    lb__huge_pages(q, c * sz);
+    if (*p) memcpy(q, *p, used * sz);
+    free(*p);
+    *p = q;
+    return 1;
+}
+
 /* Room for element n (of sz bytes) in *p, which has room for *cap: doubled
- * from first when full. 0 when out of memory (*p as it was). A large array
- * is advised to huge pages: under jemalloc (Blender's allocator) the block
+ * from first when full. 0 when out of memory (*p as it was). Grown as the
+ * output arrays are (grow): under jemalloc (Blender's allocator) the block
  * list's pages came fresh from the system every run, a fault per 4 KiB. */
 static int room_for(void **p, size_t *cap, size_t n, size_t sz, size_t first) {
     if (n < *cap) return 1;
     const size_t nc = *cap ? 2 * *cap : first;
-    void *q = realloc(*p, nc * sz);
-    if (!q) return 0;
-    lb__huge_pages(q, nc * sz);
-    *p = q;
+    if (!grow(p, *cap, nc, n, sz)) return 0;
     *cap = nc;
     return 1;
 }
@@ -819,25 +835,6 @@ static void wake(run *R) {
  * output is the same for every thread count. Whoever finishes a block
  * merges what is ready (try_merge, never waiting for the lock); the calling
  * thread merges the rest after the workers are joined. */
-
-/* *p (room for cap elements of size sz, the first used of them in use)
- * given room for c elements when c > cap. */
-static int grow(void **p, size_t cap, size_t c, size_t used, size_t sz) {
-    if (c <= cap) return 1;
-    /* a new array, advised before the used part is copied in: realloc
-     * would move the pages (mremap) to an address whose 2 MiB alignment
-     * differs, which splits the huge pages into small ones for good, and
-     * on this project's build machine (a PVM guest) a small page can cost
-     * a fault in the host each time it is touched after any unmapping
-     * (docs/meshing.md, Incremental remeshing) */
-    void *q = malloc(c * sz);
-    if (!q) return 0;
-    lb__huge_pages(q, c * sz);
-    if (*p) memcpy(q, *p, used * sz);
-    free(*p);
-    *p = q;
-    return 1;
-}
 
 /* n and a sixteenth more: the room a mesh made through a cache starts with
  * (the cached mesh's counts) and keeps (lb_mesh_cache_recycle gives it
