@@ -94,6 +94,13 @@ struct lb_mesh_cache {
     double *spare_pos, *spare_nrm;
     uint32_t *spare_tri;
     size_t spare_nv, spare_nt;
+    /* the arrays a run needs only while it runs, one per use (its slot),
+     * kept for the next run (lb__cache_run_take, lb__cache_run_keep) */
+    struct {
+        void *p;
+        size_t bytes;
+    } run[LB__RUN_SLOTS];
+    size_t run_bytes;
 };
 
 /* The matching of an evaluator against the cache (mesher.c's rule):
@@ -714,7 +721,8 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     slab_settle(C);
     for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
     for (size_t i = 0; i < nnodes; ++i) bytes += cblock_bytes(&nodes[i]);
-    bytes += spare_bytes(C) + C->slab_bytes + (C->slabcap + C->idlecap) * sizeof(lb__slab *) +
+    bytes += spare_bytes(C) + C->run_bytes + C->slab_bytes +
+             (C->slabcap + C->idlecap) * sizeof(lb__slab *) +
              (C->nslabs + C->nidle) * sizeof(lb__slab);
     C->stats.blocks = n;
     C->stats.reused = reused;
@@ -734,6 +742,33 @@ void lb__cache_take_spare(lb_mesh_cache *C, lb_mesh *M, size_t *vcap, size_t *tc
     C->spare_pos = C->spare_nrm = NULL;
     C->spare_tri = NULL;
     C->spare_nv = C->spare_nt = 0;
+}
+
+void *lb__cache_run_take(lb_mesh_cache *C, int slot, size_t bytes, size_t *got) {
+    void *p = C->run[slot].p;
+    const size_t have = C->run[slot].bytes;
+    C->run[slot].p = NULL;
+    C->run[slot].bytes = 0;
+    C->run_bytes -= have;
+    C->stats.bytes -= have;
+    if (p && have < bytes) { /* too small: a new one */
+        free(p);
+        p = NULL;
+    }
+    *got = have;
+    return p;
+}
+
+void lb__cache_run_keep(lb_mesh_cache *C, int slot, void *p, size_t bytes) {
+    if (C->run[slot].p) { /* cannot happen: each slot's array is out once */
+        C->run_bytes -= C->run[slot].bytes;
+        C->stats.bytes -= C->run[slot].bytes;
+        free(C->run[slot].p);
+    }
+    C->run[slot].p = p;
+    C->run[slot].bytes = p ? bytes : 0;
+    C->run_bytes += C->run[slot].bytes;
+    C->stats.bytes += C->run[slot].bytes;
 }
 
 /* ---- the public side ---- */
@@ -775,6 +810,7 @@ void lb_mesh_cache_recycle(lb_mesh_cache *C, lb_mesh *mesh) {
 void lb_mesh_cache_free(lb_mesh_cache *C) {
     if (!C) return;
     spare_free(C);
+    for (int i = 0; i < LB__RUN_SLOTS; ++i) free(C->run[i].p);
     blocks_free(C);
     slabs_free(C);
     lb__recs_free(&C->full);

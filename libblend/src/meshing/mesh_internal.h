@@ -220,6 +220,18 @@ LB_INTERNAL void lb__cache_counts(const lb_mesh_cache *C, size_t *nv, size_t *nt
 /* The arrays of a mesh given back (lb_mesh_cache_recycle), if any, moved
  * into M (empty) with their room (vertices, triangles) in vcap and tcap. */
 LB_INTERNAL void lb__cache_take_spare(lb_mesh_cache *C, lb_mesh *M, size_t *vcap, size_t *tcap);
+/* The arrays a cached run needs only while it runs (the sorted blocks,
+ * the next-block table, the readers' counts, the matching's candidates),
+ * kept by the cache from one run to the next, one per slot (mesher.c's
+ * uses): under jemalloc (Blender's allocator) the pages of arrays freed
+ * and allocated again mostly came back from the system, a fault per 4 KiB
+ * (docs/meshing.md, Incremental remeshing). lb__cache_run_take hands out
+ * the slot's array if it holds at least bytes (its size in *got), else
+ * NULL (a smaller one is freed); lb__cache_run_keep takes p (malloc'd,
+ * bytes long; NULL: none) into the slot. Counted in the cache's bytes. */
+#define LB__RUN_SLOTS 16
+LB_INTERNAL void *lb__cache_run_take(lb_mesh_cache *C, int slot, size_t bytes, size_t *got);
+LB_INTERNAL void lb__cache_run_keep(lb_mesh_cache *C, int slot, void *p, size_t bytes);
 
 /* The facing of triangle (a, b, c): (b - a) x (c - a), not normalised
  * (features.c's flips and folds, corners.c). */

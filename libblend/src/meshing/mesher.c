@@ -439,34 +439,6 @@ static int cmp_bkey(const void *a, const void *b) {
     return x < y ? -1 : x > y;
 }
 
-/* L's blocks in order of id (the descent leaves them in octree order):
- * their keys sorted, then each block moved once (qsort over the blocks
- * themselves, 392 bytes each, was 4 % of an incremental run of 28,664
- * blocks; this is 1 %). 0 when out of memory (L unchanged). */
-static int sort_blocks(blist *L) {
-    if (L->n < 2) return 1;
-    bkey *k = malloc(L->n * sizeof *k);
-    lb__block *b = malloc(L->n * sizeof *b);
-    if (!k || !b) {
-        free(k);
-        free(b);
-        return 0;
-    }
-    lb__huge_pages(k, L->n * sizeof *k);
-    lb__huge_pages(b, L->n * sizeof *b);
-    for (size_t i = 0; i < L->n; ++i) {
-        k[i].id = L->b[i].id;
-        k[i].at = i;
-    }
-    qsort(k, L->n, sizeof *k, cmp_bkey);
-    for (size_t i = 0; i < L->n; ++i) b[i] = L->b[k[i].at];
-    free(k);
-    free(L->b);
-    L->b = b;
-    L->cap = L->n;
-    return 1;
-}
-
 /* ---- the blocks' work, in parallel ----
  * Blocks are taken from the last to the first. A block's node values come
  * first; then, once the next blocks (+x, +y, +z and their combinations:
@@ -547,7 +519,96 @@ typedef struct run {
     const lb__cblock **from;
     uint8_t *want;
     size_t nreused;
+    /* the run's own arrays (run_alloc): the cache they go back to (NULL:
+     * none, plain malloc and free), and each slot's array out now */
+    lb_mesh_cache *keeper;
+    struct {
+        void *p;
+        size_t bytes;
+    } out[LB__RUN_SLOTS];
 } run;
+
+/* the uses of run_alloc's arrays, one slot each */
+enum {
+    RS_KEYS,
+    RS_SORTED,
+    RS_CAND,
+    RS_CHANGED,
+    RS_SCRATCH,
+    RS_FROM,
+    RS_WANT,
+    RS_NBR,
+    RS_READY,
+    RS_REFS,
+    RS_FIN,
+    RS_BASE,
+    RS_ALL,
+    RS_FREE,
+    RS_IDS,
+    RS_COUNT
+};
+_Static_assert(RS_COUNT <= LB__RUN_SLOTS, "a slot for each use");
+
+/* An array of bytes (zeroed when zero) for one use (slot) in this run:
+ * with a cache, the one it kept from the last run when large enough, else
+ * a new one; run_free gives it back. NULL when out of memory. */
+static void *run_alloc(run *R, int slot, size_t bytes, int zero) {
+    if (!bytes) bytes = 1;
+    if (!R->keeper) return zero ? calloc(1, bytes) : malloc(bytes);
+    size_t got = 0;
+    void *p = lb__cache_run_take(R->keeper, slot, bytes, &got);
+    if (p) {
+        if (zero) memset(p, 0, bytes);
+    } else {
+        if (!(p = zero ? calloc(1, bytes) : malloc(bytes))) return NULL;
+        lb__huge_pages(p, bytes);
+        got = bytes;
+    }
+    R->out[slot].p = p;
+    R->out[slot].bytes = got;
+    return p;
+}
+
+/* The slot's array (from run_alloc, or NULL) back to the cache, or freed. */
+static void run_free(run *R, int slot, void *p) {
+    if (!p) return;
+    if (R->keeper && R->out[slot].p == p) {
+        lb__cache_run_keep(R->keeper, slot, p, R->out[slot].bytes);
+        R->out[slot].p = NULL;
+    } else {
+        free(p);
+    }
+}
+
+/* L's blocks in order of id (the descent leaves them in octree order):
+ * their keys sorted, then each block moved once (qsort over the blocks
+ * themselves, 392 bytes each, was 4 % of an incremental run of 28,664
+ * blocks; this is 1 %). 0 when out of memory (L unchanged). */
+static int sort_blocks(run *R, blist *L) {
+    if (L->n < 2) return 1;
+    bkey *k = run_alloc(R, RS_KEYS, L->n * sizeof *k, 0);
+    lb__block *b = run_alloc(R, RS_SORTED, L->n * sizeof *b, 0);
+    if (!k || !b) {
+        run_free(R, RS_KEYS, k);
+        run_free(R, RS_SORTED, b);
+        return 0;
+    }
+    if (!R->keeper) { /* else run_alloc advised them when new */
+        lb__huge_pages(k, L->n * sizeof *k);
+        lb__huge_pages(b, L->n * sizeof *b);
+    }
+    for (size_t i = 0; i < L->n; ++i) {
+        k[i].id = L->b[i].id;
+        k[i].at = i;
+    }
+    qsort(k, L->n, sizeof *k, cmp_bkey);
+    for (size_t i = 0; i < L->n; ++i) b[i] = L->b[k[i].at];
+    run_free(R, RS_KEYS, k);
+    free(L->b);
+    L->b = b;
+    L->cap = L->n;
+    return 1;
+}
 
 static lb__block *find_block(run *R, const uint32_t b[3]) {
     const uint64_t id = lb__block_id(R->nb, b[0], b[1], b[2]);
@@ -1259,15 +1320,15 @@ static int decide(run *R) {
     const size_t n = R->nblocks;
     size_t nold = 0;
     const lb__cblock *old = lb__cache_blocks(R->cache, &nold);
-    const lb__cblock **cand = calloc(n ? n : 1, sizeof *cand);
-    uint64_t *changed = malloc((n + nold ? n + nold : 1) * sizeof *changed);
-    uint32_t *scratch = malloc(lb__cmatch_scratch(R->match) * sizeof *scratch);
-    R->from = calloc(n ? n : 1, sizeof *R->from);
-    R->want = calloc(n ? n : 1, 1);
+    const lb__cblock **cand = run_alloc(R, RS_CAND, n * sizeof *cand, 1);
+    uint64_t *changed = run_alloc(R, RS_CHANGED, (n + nold) * sizeof *changed, 0);
+    uint32_t *scratch = run_alloc(R, RS_SCRATCH, lb__cmatch_scratch(R->match) * sizeof *scratch, 0);
+    R->from = run_alloc(R, RS_FROM, n * sizeof *R->from, 1);
+    R->want = run_alloc(R, RS_WANT, n, 1);
     if (!cand || !changed || !scratch || !R->from || !R->want) {
-        free(cand);
-        free(changed);
-        free(scratch);
+        run_free(R, RS_CAND, (void *)cand);
+        run_free(R, RS_CHANGED, changed);
+        run_free(R, RS_SCRATCH, scratch);
         return 0;
     }
     size_t nch = 0, j = 0;
@@ -1283,7 +1344,7 @@ static int decide(run *R) {
             changed[nch++] = id;
     }
     while (j < nold) changed[nch++] = old[j++].id;
-    free(scratch);
+    run_free(R, RS_SCRATCH, scratch);
     for (size_t q = 0; q < nch; ++q) {
         const uint64_t id = changed[q];
         const uint32_t p[3] = {(uint32_t)(id % R->nb[0]), (uint32_t)(id / R->nb[0] % R->nb[1]),
@@ -1299,8 +1360,8 @@ static int decide(run *R) {
             if (O) R->from[O - R->blocks] = NULL;
         }
     }
-    free(changed);
-    free(cand);
+    run_free(R, RS_CHANGED, changed);
+    run_free(R, RS_CAND, (void *)cand);
     for (size_t i = 0; i < n; ++i) {
         if (R->from[i]) {
             ++R->nreused;
@@ -1319,13 +1380,13 @@ static int decide(run *R) {
 static lb_status blocks_run(run *R, size_t nt, progress *P) {
     if (nt > R->nctx) nt = R->nctx;
     const size_t nbk = R->nblocks;
-    R->nbr = calloc(nbk ? nbk : 1, sizeof *R->nbr);
-    R->ready = calloc(nbk ? nbk : 1, sizeof *R->ready);
-    R->refs = calloc(nbk ? nbk : 1, sizeof *R->refs);
-    R->fin = calloc(nbk ? nbk : 1, sizeof *R->fin);
-    R->ms.base = malloc((nbk ? nbk : 1) * sizeof *R->ms.base);
-    R->all = malloc((nbk ? nbk : 1) * sizeof *R->all);
-    R->free = malloc((nbk ? nbk : 1) * sizeof *R->free);
+    R->nbr = run_alloc(R, RS_NBR, nbk * sizeof *R->nbr, 1);
+    R->ready = run_alloc(R, RS_READY, nbk * sizeof *R->ready, 1);
+    R->refs = run_alloc(R, RS_REFS, nbk * sizeof *R->refs, 1);
+    R->fin = run_alloc(R, RS_FIN, nbk * sizeof *R->fin, 1);
+    R->ms.base = run_alloc(R, RS_BASE, nbk * sizeof *R->ms.base, 0);
+    R->all = run_alloc(R, RS_ALL, nbk * sizeof *R->all, 0);
+    R->free = run_alloc(R, RS_FREE, nbk * sizeof *R->free, 0);
     if (!R->nbr || !R->ready || !R->refs || !R->fin || !R->ms.base || !R->all || !R->free) {
         R->err_block = 0;
         return lb__fail(&R->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
@@ -1340,7 +1401,7 @@ static lb_status blocks_run(run *R, size_t nt, progress *P) {
      * blocks are sorted by id), so one cursor per offset walks the ids
      * once, copied out of the 400-byte blocks (a binary search per block
      * and offset was 9 % of an incremental run of 28,664 blocks) */
-    uint64_t *ids = malloc((nbk ? nbk : 1) * sizeof *ids);
+    uint64_t *ids = run_alloc(R, RS_IDS, nbk * sizeof *ids, 0);
     if (!ids) {
         R->err_block = 0;
         return lb__fail(&R->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
@@ -1364,7 +1425,7 @@ static lb_status blocks_run(run *R, size_t nt, progress *P) {
                                   atomic_load_explicit(&R->refs[j], memory_order_relaxed) + 1,
                                   memory_order_relaxed);
         }
-    free(ids);
+    run_free(R, RS_IDS, ids);
     R->ms.nbr = R->nbr;
     if (R->match && !decide(R)) {
         R->err_block = 0;
@@ -1503,7 +1564,8 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
                          FN, max_blocks, LB__MB, g.cells[0], g.cells[1], g.cells[2],
                          max_memory >> 20);
     }
-    if (!s && !sort_blocks(&L)) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    R.keeper = cache;
+    if (!s && !sort_blocks(&R, &L)) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     size_t merged[2] = {0, 0}; /* the merged mesh's vertices and triangles, for the cache */
     if (!s && cache) {         /* each block's entry for the cache */
         R.cache = cache;
@@ -1648,27 +1710,27 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     lb__cmatch_free(match);
     lb__cnodes_free(inc.nodes, inc.n);
     free(inc.scratch);
-    free(R.from);
-    free(R.want);
+    run_free(&R, RS_FROM, (void *)R.from);
+    run_free(&R, RS_WANT, R.want);
     for (size_t i = 0; i < R.nblocks; ++i) {
         lb__block *B = &R.blocks[i];
         output_free(B);
         free(B->octmem);
         plan_drop(B);
     }
-    free(R.blocks);
+    run_free(&R, RS_SORTED, R.blocks);
     for (size_t t = 0; t < R.nctx; ++t) lb__bctx_free(R.ctx[t]);
     free(R.ctx);
     for (size_t i = 0; i < R.nall; ++i) free(R.all[i]);
-    free(R.all);
-    free(R.free);
-    free(R.nbr);
-    free(R.ready);
-    free(R.refs);
-    free(R.fin);
+    run_free(&R, RS_ALL, R.all);
+    run_free(&R, RS_FREE, R.free);
+    run_free(&R, RS_NBR, R.nbr);
+    run_free(&R, RS_READY, (void *)R.ready);
+    run_free(&R, RS_REFS, (void *)R.refs);
+    run_free(&R, RS_FIN, (void *)R.fin);
     free(R.ms.tab);
     free(R.ms.fr);
-    free(R.ms.base);
+    run_free(&R, RS_BASE, R.ms.base);
     free(R.ms.xt);
     pthread_mutex_destroy(&R.lock);
     pthread_mutex_destroy(&R.mlock);
