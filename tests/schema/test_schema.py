@@ -149,7 +149,7 @@ for path in scenes:
     d = copy.deepcopy(doc)
     d["bounds"] = {"min": [0, 0, 0]}
     cases.append(("bounds without max", d))
-    for what, d in cases[:: max(1, len(cases) // 40)]:  # at most ~40 per scene: blendtool runs each
+    for what, d in cases[:: max(1, len(cases) // 40)]:  # at most ~40 per scene, each validated by both
         mutations += 1
 
         def broken(l_ok, msg, s_ok=schema_accepts(d), name=os.path.basename(path), what=what):
