@@ -100,7 +100,6 @@ struct lb_mesh_cache {
         void *p;
         size_t bytes;
     } run[LB__RUN_SLOTS];
-    size_t run_bytes;
 };
 
 /* The matching of an evaluator against the cache (mesher.c's rule):
@@ -502,6 +501,12 @@ static size_t spare_bytes(const lb_mesh_cache *C) {
     return C->spare_pos ? 6 * C->spare_nv * sizeof(double) + 3 * C->spare_nt * sizeof(uint32_t) : 0;
 }
 
+static size_t run_bytes(const lb_mesh_cache *C) {
+    size_t bytes = 0;
+    for (int i = 0; i < LB__RUN_SLOTS; ++i) bytes += C->run[i].bytes;
+    return bytes;
+}
+
 const lb__cblock *lb__cache_blocks(const lb_mesh_cache *C, size_t *n) {
     *n = C->nblocks;
     return C->blocks;
@@ -721,7 +726,7 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     slab_settle(C);
     for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
     for (size_t i = 0; i < nnodes; ++i) bytes += cblock_bytes(&nodes[i]);
-    bytes += spare_bytes(C) + C->run_bytes + C->slab_bytes +
+    bytes += spare_bytes(C) + run_bytes(C) + C->slab_bytes +
              (C->slabcap + C->idlecap) * sizeof(lb__slab *) +
              (C->nslabs + C->nidle) * sizeof(lb__slab);
     C->stats.blocks = n;
@@ -749,7 +754,6 @@ void *lb__cache_run_take(lb_mesh_cache *C, int slot, size_t bytes, size_t *got) 
     const size_t have = C->run[slot].bytes;
     C->run[slot].p = NULL;
     C->run[slot].bytes = 0;
-    C->run_bytes -= have;
     C->stats.bytes -= have;
     if (p && have < bytes) { /* too small: a new one */
         free(p);
@@ -761,13 +765,11 @@ void *lb__cache_run_take(lb_mesh_cache *C, int slot, size_t bytes, size_t *got) 
 
 void lb__cache_run_keep(lb_mesh_cache *C, int slot, void *p, size_t bytes) {
     if (C->run[slot].p) { /* cannot happen: each slot's array is out once */
-        C->run_bytes -= C->run[slot].bytes;
         C->stats.bytes -= C->run[slot].bytes;
         free(C->run[slot].p);
     }
     C->run[slot].p = p;
     C->run[slot].bytes = p ? bytes : 0;
-    C->run_bytes += C->run[slot].bytes;
     C->stats.bytes += C->run[slot].bytes;
 }
 
