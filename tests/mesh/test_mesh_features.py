@@ -15,19 +15,22 @@ closed, oriented and manifold, and:
   side and at most 0.15x the error without --features (measured
   2026-12-04: 0.022, 0.011, 0.0056 cells against chord errors of 0.022,
   0.013, 0.0061 and 0.48, 0.41, 0.48 without);
-- the clean union of two spheres: near the crease circle at most 0.1
-  cells, and at most 0.4x the error without --features (measured
-  2026-12-04: 0.093, 0.081, 0.064 cells against 0.26, 0.28, 0.29; points
-  whose fans fold are moved off the crease, see docs/meshing.md);
+- the clean union of two spheres: near the crease circle at most 1.1x the
+  flat triangles' own chord error away from it, and at most 0.2x the
+  error without --features (measured 2026-12-05: 0.047, 0.022, 0.013 cells
+  against chord errors of 0.048, 0.024, 0.012 and 0.26, 0.28, 0.29
+  without; 0.093, 0.081, 0.064 before the crease points were found on the
+  crease itself, see docs/meshing.md);
 - a local union of the same spheres with a blending volume of R = 0.005
   (under a fifth of a cell): near the crease outside the volume at most
-  0.15 cells and 0.65x the error without --features (measured 2026-12-04:
-  0.11, 0.054, 0.13 against 0.26, 0.28, 0.23).
+  0.15 cells and 0.65x the error without --features (measured 2026-12-05:
+  0.083, 0.054, 0.13 against 0.26, 0.28, 0.23).
 Corner normals (OBJ's f v//n, GLB's vertex copies): on the three box
 shapes every triangle corner carries its own face's normal (the vertex
 normals alone are off by up to 76 degrees at the edges); on the cylinder
 cut by a slab each split corner is within 0.5 h / r radians of its side's
-normal. Also: the same bytes with 1 and 2 threads, and S1 (smooth: no cell
+normal (a sliver along a crease, which has no side, either side's).
+Also: the same bytes with 1 and 2 threads, and S1 (smooth: no cell
 has a crease) the same bytes with and without --features."""
 import os
 import subprocess
@@ -136,7 +139,11 @@ for res in (32, 64, 128):
     # point towards its side's triangles; here the closed form is taken a
     # quarter cell towards the corner's own triangle: the two are at most
     # half a cell apart, over which the cylinder turns by 0.5 h / r
-    # (measured 2026-12-04: 2.04, 1.07, 0.49 degrees)
+    # (measured 2026-12-04: 2.04, 1.07, 0.49 degrees). A triangle lying
+    # along a crease (every vertex within 0.05 cells of one: a sliver
+    # between two crease points and a grid-edge vertex next to the crease)
+    # has no side of its own; its corners may take either side's normal
+    # (the wall's at the point, or a cap's), but still one side's
     h = cell_size(sc, res)
     V, N, F, FN = meshcheck.read_obj_corners(corner_mesh("cylinder-slab", res, "obj"))
     P = V[F]
@@ -146,6 +153,20 @@ for res in (32, 64, 128):
     split = FN >= len(V)
     ang = np.degrees(np.arccos(np.clip(np.einsum(
         "ij,ij->i", N[FN][split], cyl_slab_normal(probe[split])), -1, 1)))
+    along = (cyl_slab_distance(V)[1][F].max(axis=1) < 0.05 * h)[:, None].repeat(3, axis=1)[split]
+    if along.any():
+        cn, pt = N[FN][split][along], P[split][along]
+        best = np.full(len(cn), 180.0)
+        cyl = sc["root"]["args"][0]
+        ax = np.array(cyl["axis"], float) / np.linalg.norm(cyl["axis"])
+        rv = pt - np.array(cyl["point"], float)
+        rv -= (rv @ ax)[:, None] * ax
+        for side in (rv / np.linalg.norm(rv, axis=1)[:, None],
+                     np.array([[0.0, 0.0, 1.0]]).repeat(len(cn), 0),
+                     np.array([[0.0, 0.0, -1.0]]).repeat(len(cn), 0)):
+            best = np.minimum(best, np.degrees(np.arccos(np.clip(
+                np.einsum("ij,ij->i", cn, side), -1, 1))))
+        ang[along] = best
     bar = np.degrees(0.5 * h / r)
     check(split.sum() > 100 and ang.max() <= bar,
           "cylinder-slab at %d: %d split corners, each within %.2f degrees of its side's normal "
@@ -164,11 +185,11 @@ union_spheres_distance = union_spheres()
 
 for res in (32, 64, 128):
     tag = "clean-union-spheres at %d" % res
-    (near, _far), (plain, _pfar) = crease_errors("clean-union-spheres", res,
-                                                 union_spheres_distance)
-    check(near <= 0.1 and near <= 0.4 * plain,
-          "%s: near the crease %.3g cells with --features, %.3g without (bars: 0.1, 0.4x)" %
-          (tag, near, plain))
+    (near, far), (plain, _pfar) = crease_errors("clean-union-spheres", res,
+                                                union_spheres_distance)
+    check(near <= 1.1 * far and near <= 0.2 * plain,
+          "%s: near the crease %.3g cells with --features, %.3g without; the flat triangles "
+          "away from it %.3g (bars: 1.1x those, 0.2x without)" % (tag, near, plain, far))
 
 # ---- a local union outside its blending volume: the same crease ----
 # (R = 0.005, a fifth of a cell at 128: inside it the blend rounds the

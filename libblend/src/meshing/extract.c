@@ -78,7 +78,7 @@ struct lb__bctx {
     /* sharp features: candidates (FACE_MAX): their face, position, value
      * and gradient, the polygon's normal sums and the QEF's point */
     uint32_t *cface;
-    double *cx, *cy, *cz, *cv, *cgx, *cgy, *cgz, *cn, *cq;
+    double *cx, *cy, *cz, *cv, *cgx, *cgy, *cgz, *cn, *cq, *cw;
     uint32_t *perm; /* own edge -> vertex index, when there are orphans */
     face *faces;
     size_t nf; /* polygons so far (< FACE_MAX) */
@@ -300,6 +300,17 @@ static uint32_t *triangulate(const face *f, const double *pos, uint32_t *T) {
     return T;
 }
 
+/* A feature candidate's crease data (C->cw, CW doubles each; used by
+ * place_features): the other side's plane (W[0..2] . x + W[3]; W[3] NAN:
+ * not on a crease), the point a probe stepped from (4..6), where the
+ * plane came from (7), the point the probe is evaluated at (8..10; the
+ * polygon's vertex on that side until then). */
+#define CW 11
+#define W_POLYGON 0.0 /* the polygon's vertex's tangent plane */
+#define W_SEEN 1.0    /* evaluated on that side (or that side is flat) */
+#define W_PROBE 2.0   /* a probe is being evaluated */
+#define W_PROBED 3.0  /* from a probe: the point it left (4..6) is kept if no better */
+
 lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     lb__bctx *C = calloc(1, sizeof *C);
     if (!C) return NULL;
@@ -317,10 +328,11 @@ lb__bctx *lb__bctx_new(const lb_evaluator *ev) {
     C->rpos = malloc(3 * EMAP_SIZE * sizeof *C->rpos);
     C->rnrm = malloc(3 * EMAP_SIZE * sizeof *C->rnrm);
     C->cface = malloc(FACE_MAX * sizeof *C->cface);
-    double **cd[9] = {&C->cx, &C->cy, &C->cz, &C->cv, &C->cgx, &C->cgy, &C->cgz, &C->cn, &C->cq};
+    double **cd[10] = {&C->cx,  &C->cy,  &C->cz, &C->cv, &C->cgx,
+                       &C->cgy, &C->cgz, &C->cn, &C->cq, &C->cw};
     int cok = 1;
-    for (int q = 0; q < 9; ++q) {
-        *cd[q] = malloc((q >= 7 ? 3 : 1) * FACE_MAX * sizeof(double));
+    for (int q = 0; q < 10; ++q) {
+        *cd[q] = malloc((q == 9 ? CW : q >= 7 ? 3 : 1) * FACE_MAX * sizeof(double));
         cok = cok && *cd[q];
     }
     C->perm = malloc(EMAP_SIZE * sizeof *C->perm);
@@ -369,6 +381,7 @@ void lb__bctx_free(lb__bctx *C) {
     free(C->cgz);
     free(C->cn);
     free(C->cq);
+    free(C->cw);
     free(C->perm);
     free(C->faces);
     lb__mscratch *S = &C->S;
@@ -439,9 +452,10 @@ static void publish(lb__bctx *C) {
  * vertex normals disagree gets a candidate point (the QEF's, within the
  * cell), moved onto the surface by Newton steps along the gradient there
  * (a point on a crease or corner is on it already; on a curved crease it
- * moves by the crease's deviation from its tangent planes). A candidate
- * that reaches the surface (|phi| <= 1e-7 h |grad phi|) within FEAT_ITER
- * evaluations becomes a vertex of the block, after its own vertices alone
+ * moves by the crease's deviation from its tangent planes, onto both
+ * sides at once: crease_side, probe). A candidate that reaches the surface
+ * (|phi| <= 1e-7 h |grad phi|) within FEAT_ITER evaluations (a crease's
+ * CREASE_EVALS more) becomes a vertex of the block, after its own vertices alone
  * and before its orphans, and its polygon a fan around it. Vertex indices
  * in the faces are local (own, then references) on entry and stay so. */
 #define FEAT_ITER 6
@@ -460,6 +474,53 @@ static void publish(lb__bctx *C) {
  * reference's (from the owner's near-face table). */
 static inline const double *vertex_normal(const lb__block *B, const bctx *C, uint32_t v) {
     return v < C->ne ? B->vnrm + 3 * v : C->rnrm + 3 * (v - C->ne);
+}
+
+/* A point on a crease may lie anywhere along it; the step's own choice
+ * (the least move onto both planes) can leave it beyond a face of its
+ * cell that the crease crosses, next to the neighbour's point or past it,
+ * and then the fans of the two cannot be flipped into a crease edge (the
+ * two new triangles face opposite ways) and the point is unfolded off the
+ * crease (features.c): 6 of the 242 points of the clean union of two
+ * spheres at 128 cells. So the step also slides the point along the
+ * crease's direction t (on both planes still) into its cell, a twentieth
+ * of a cell from its faces where the crease's piece in the cell allows
+ * (else into the cell itself, else not at all). Only the faces the crease
+ * crosses steeply (|t_d| >= 0.1) count: a crease passing just outside the
+ * cell, nearly along a face, is where a point beyond the cell belongs
+ * (FEAT_REACH). */
+static void along_crease(const lb__grid *g, const lb__block *B, uint32_t cell, const double *n1,
+                         const double *n2, const double *X, double dx[3]) {
+    double t[3] = {n1[1] * n2[2] - n1[2] * n2[1], n1[2] * n2[0] - n1[0] * n2[2],
+                   n1[0] * n2[1] - n1[1] * n2[0]};
+    const double tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    if (!(tl > 0.0) || !isfinite(tl)) return;
+    for (int d = 0; d < 3; ++d) t[d] /= tl;
+    const uint64_t gx = (uint64_t)B->b[0] * LB__MB + (cell & 15),
+                   gy = (uint64_t)B->b[1] * LB__MB + ((cell >> 4) & 15),
+                   gz = (uint64_t)B->b[2] * LB__MB + ((cell >> 8) & 15);
+    double lo[3], hi[3];
+    lb__node_pos(g, gx, gy, gz, lo);
+    lb__node_pos(g, gx + 1, gy + 1, gz + 1, hi);
+    for (int pass = 0; pass < 2; ++pass) {
+        double a = -INFINITY, b = INFINITY;
+        for (int d = 0; d < 3; ++d) {
+            if (!(fabs(t[d]) >= 0.1)) continue;
+            const double m = pass ? 0.0 : 0.05 * g->h[d], y = X[d] + dx[d];
+            double l0 = (lo[d] + m - y) / t[d], l1 = (hi[d] - m - y) / t[d];
+            if (l0 > l1) {
+                const double q = l0;
+                l0 = l1;
+                l1 = q;
+            }
+            a = fmax(a, l0);
+            b = fmin(b, l1);
+        }
+        if (!(a <= b)) continue;
+        const double lam = a > 0.0 ? a : b < 0.0 ? b : 0.0;
+        for (int d = 0; d < 3; ++d) dx[d] += lam * t[d];
+        return;
+    }
 }
 
 /* The candidates Newton could not settle (state 2), where the surface near
@@ -569,6 +630,101 @@ static lb_status settle_by_bisection(const lb_evaluator *ev, const lb__grid *g, 
     return LB_OK;
 }
 
+/* A crease, as against a smooth bend sharper than the threshold: the
+ * gradient at the QEF's point matches one of the polygon's normals to
+ * within 10 degrees (one side's, turned by the side's own curvature over
+ * a cell) while another differs by more than the threshold (the other
+ * side's). Measured at the QEF's points: min, max, clean unions and the
+ * cylinder cut by a slab within 4 degrees on nearly every candidate; S2's
+ * fillets at 128 cells none within 15 degrees (a fifth within 10 at 64 and
+ * 256 cells, which the check at the next point sends back to plain steps
+ * where the gradient there matches neither side). */
+#define CREASE_COS 0.98480775301220806 /* cos(10 degrees) */
+/* and the QEF's point, on both sides' tangent planes, lies on the surface
+ * to within the sides' own curvature over a cell (at most 0.047 cells on
+ * the clean union of two spheres at 32 cells, 0.022 on the cylinder cut by
+ * a slab); a fillet far below a cell leaves it farther (0.19 cells in the
+ * median on the local union with R = 0.005 at 128 cells), and there the
+ * sides' planes do not meet on the surface */
+#define CREASE_NEAR 0.1
+
+static inline double cos_to(const double *g, double gl, const double *p) {
+    const double pl = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    return (g[0] * p[0] + g[1] * p[1] + g[2] * p[2]) / (gl * pl);
+}
+
+/* evaluations a crease candidate may take beyond FEAT_ITER: the probe and
+ * the steps from its plane (quadratic: two, and one to spare) */
+#define CREASE_EVALS 3
+/* two gradients this close (cos 5.7 degrees) are one side's */
+#define SIDES_COS 0.99498743710661997
+
+/* W: the other side's plane (unit normal, offset) at the polygon vertex
+ * whose normal differs most from the gradient g at the QEF's point, when
+ * that point is on a crease (above); NAN offset otherwise. The plane is
+ * exact (W_SEEN) when that side is flat across the polygon: every vertex
+ * whose normal is within CREASE_COS of that one has the same normal and
+ * lies on the plane. */
+static void crease_side(const lb__block *B, const bctx *C, uint32_t f, const double *g, double gl,
+                        double tol, double W[CW]) {
+    const face *F = &C->faces[f];
+    W[7] = W_POLYGON;
+    double ca = -2.0, cb = 2.0;
+    uint32_t vb = 0;
+    for (uint32_t q = 0; q < F->n; ++q) {
+        const double *n = vertex_normal(B, C, F->e[q]);
+        const double cs = (n[0] * g[0] + n[1] * g[1] + n[2] * g[2]) / gl;
+        if (cs > ca) ca = cs;
+        if (cs < cb) cb = cs, vb = F->e[q];
+    }
+    W[3] = NAN;
+    if (!(ca >= CREASE_COS && cb < LB__FEATURE_COS)) return;
+    const double *n = vertex_normal(B, C, vb), *p = B->vpos + 3 * (size_t)vb;
+    memcpy(W, n, 3 * sizeof *n);
+    W[3] = -(n[0] * p[0] + n[1] * p[1] + n[2] * p[2]);
+    memcpy(W + 8, p, 3 * sizeof *p);
+    W[7] = W_SEEN;
+    for (uint32_t q = 0; q < F->n; ++q) {
+        const double *m = vertex_normal(B, C, F->e[q]), *r = B->vpos + 3 * (size_t)F->e[q];
+        if (m[0] * n[0] + m[1] * n[1] + m[2] * n[2] < CREASE_COS) continue;
+        if (!(m[0] * n[0] + m[1] * n[1] + m[2] * n[2] >= 1.0 - 1e-12) ||
+            !(fabs(n[0] * r[0] + n[1] * r[1] + n[2] * r[2] + W[3]) <= tol))
+            W[7] = W_POLYGON;
+    }
+}
+
+/* A candidate that failed after a probe keeps the point the probe left
+ * (on the surface, on the polygon's plane of the other side): state 1;
+ * any other is rejected (2) */
+static uint8_t settle_at_probe(bctx *C, size_t c, const double *W) {
+    if (W[7] != W_PROBED) return 2;
+    C->cx[c] = W[4];
+    C->cy[c] = W[5];
+    C->cz[c] = W[6];
+    return 1;
+}
+
+/* The probe for a point X on the surface and on the other side's plane
+ * as the polygon gave it (W): the point a step d along that plane towards
+ * the polygon's vertex on that side (W[8..10]), to be evaluated in place
+ * of X (saved in W[4..6]); 0 when that vertex is no farther than rounding
+ * along the plane. The true crease lies off the polygon's plane by that
+ * side's curvature over the distance to the vertex (up to 0.06 cells on
+ * the clean union of two spheres at 32 cells); an eighth of a cell
+ * crosses it there, and the plane taken at the probe is off at X by the
+ * curvature over an eighth of a cell (1e-3 cells at 32 cells). */
+static int probe(double W[CW], const double *X, double d) {
+    double u[3] = {W[8] - X[0], W[9] - X[1], W[10] - X[2]};
+    const double un = u[0] * W[0] + u[1] * W[1] + u[2] * W[2];
+    for (int k = 0; k < 3; ++k) u[k] -= un * W[k];
+    const double ul = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    if (!(ul > 1e-9 * d)) return 0;
+    memcpy(W + 4, X, 3 * sizeof *X);
+    for (int k = 0; k < 3; ++k) W[8 + k] = X[k] + fmin(d, ul) * u[k] / ul;
+    W[7] = W_PROBE;
+    return 1;
+}
+
 /* cos(acos(LB__FEATURE_COS) / 2) = sqrt((1 + 0.9) / 2) = 0.974679..., a
  * little above: two normals each within this of a third (unit to an ulp or
  * two, as the edge refinement leaves them) are within LB__FEATURE_COS of
@@ -625,7 +781,9 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
         C->cz[nc] = X[2];
         memcpy(C->cn + 3 * nc, ns, sizeof ns);
         memcpy(C->cq + 3 * nc, X, sizeof X);
-        C->cv[nc] = NAN; /* no earlier point (the crease step, below) */
+        C->cv[nc] = NAN;          /* no earlier point (the crease step, below) */
+        C->cw[CW * nc + 3] = NAN; /* no other side yet (crease_side, below) */
+        C->cw[CW * nc + 7] = W_POLYGON;
         ++nc;
     }
     if (!nc) return LB_OK;
@@ -634,10 +792,11 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
     lb__boxeval *E = &C->S.E;
     lb__boxeval_load(ev, &B->plan, E);
     /* each candidate's state; cv, cgx..cgz hold the tangent plane of its
-     * last point (cv NAN: none yet) for the crease step */
+     * last point (cv NAN: none yet) for the crease step, cw its crease data
+     * (CW: the other side's plane, the probe) */
     uint8_t *state = (uint8_t *)C->S.eact; /* 0 moving, 1 on the surface, 2 rejected */
     memset(state, 0, nc);
-    for (int it = 0; it < FEAT_ITER; ++it) {
+    for (int it = 0; it < FEAT_ITER + CREASE_EVALS; ++it) {
         size_t na = 0;
         for (size_t c = 0; c < nc; ++c) na += state[c] == 0;
         if (!na) break;
@@ -657,32 +816,115 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
         j = 0;
         for (size_t c = 0; c < nc; ++c) {
             if (state[c]) continue;
-            const double Xc[3] = {x[j], y[j], z[j]}, gf[3] = {gxx[j], gyy[j], gzz[j]};
+            double Xc[3] = {x[j], y[j], z[j]};
+            const double gf[3] = {gxx[j], gyy[j], gzz[j]};
             double gp[3];
-            const double ph = lb__mesh_phi_in(g, boxmax, Xc, v[j], gf, gp);
+            double ph = lb__mesh_phi_in(g, boxmax, Xc, v[j], gf, gp);
             ++j;
-            const double gl2 = gp[0] * gp[0] + gp[1] * gp[1] + gp[2] * gp[2];
-            if (!isfinite(ph) || !(gl2 > 0.0) || !isfinite(gl2)) {
-                state[c] = 2;
-                continue;
-            }
-            if (fabs(ph) <= tol * sqrt(gl2)) {
-                state[c] = 1;
-                continue;
-            }
-            if (it == FEAT_ITER - 1) {
-                state[c] = 2;
-                continue;
+            double gl2 = gp[0] * gp[0] + gp[1] * gp[1] + gp[2] * gp[2];
+            const int valid = isfinite(ph) && gl2 > 0.0 && isfinite(gl2);
+            double *W = C->cw + CW * c;
+            double last[4] = {C->cgx[c], C->cgy[c], C->cgz[c], C->cv[c]};
+            const double *other = NULL;
+            int swapped = 0;
+            if (W[7] == W_PROBE) {
+                /* the probe beyond the crease: where its gradient is the
+                 * other side's (within CREASE_COS of the polygon's normal
+                 * there), its plane replaces the polygon's and the point
+                 * steps again from where it was; otherwise (a fillet
+                 * between the sides, or the same side) the point stays
+                 * where it was */
+                const double gl = sqrt(gl2);
+                memcpy(Xc, W + 4, sizeof Xc);
+                if (!valid || !(cos_to(gp, gl, W) >= CREASE_COS) ||
+                    cos_to(gp, gl, last) >= SIDES_COS) {
+                    C->cx[c] = Xc[0];
+                    C->cy[c] = Xc[1];
+                    C->cz[c] = Xc[2];
+                    state[c] = 1;
+                    continue;
+                }
+                memcpy(W, gp, sizeof gp);
+                W[3] = ph - (gp[0] * W[8] + gp[1] * W[9] + gp[2] * W[10]);
+                W[7] = W_PROBED;
+                memcpy(gp, last, sizeof gp);
+                gl2 = gp[0] * gp[0] + gp[1] * gp[1] + gp[2] * gp[2];
+                ph = gp[0] * Xc[0] + gp[1] * Xc[1] + gp[2] * Xc[2] + last[3];
+                other = W;
+            } else {
+                if (!valid) {
+                    state[c] = settle_at_probe(C, c, W);
+                    continue;
+                }
+                if (it == 0 && fabs(ph) <= CREASE_NEAR * hmin * sqrt(gl2))
+                    crease_side(B, C, C->cface[c], gp, sqrt(gl2), tol, W);
+                if (fabs(ph) <= tol * sqrt(gl2)) {
+                    if (isfinite(W[3]) && W[7] == W_POLYGON && it < FEAT_ITER &&
+                        probe(W, Xc, 0.125 * hmin)) {
+                        /* on the surface, and on the other side's plane
+                         * as the polygon gave it: that side's own plane
+                         * comes from a point just beyond the crease */
+                        C->cgx[c] = gp[0];
+                        C->cgy[c] = gp[1];
+                        C->cgz[c] = gp[2];
+                        C->cv[c] = ph - (gp[0] * Xc[0] + gp[1] * Xc[1] + gp[2] * Xc[2]);
+                        C->cx[c] = W[8];
+                        C->cy[c] = W[9];
+                        C->cz[c] = W[10];
+                        continue;
+                    }
+                    state[c] = 1;
+                    continue;
+                }
+                /* the step from the probe's plane landed off the surface by
+                 * more than a sharp crease allows (CREASE_NEAR): the sides
+                 * meet in a fillet, whose field there is not theirs */
+                if (W[7] == W_PROBED && isfinite(W[3]) &&
+                    !(fabs(ph) <= CREASE_NEAR * hmin * sqrt(gl2))) {
+                    state[c] = settle_at_probe(C, c, W);
+                    continue;
+                }
+                if (it >= FEAT_ITER - 1 + (W[7] != W_POLYGON ? CREASE_EVALS : 0)) {
+                    state[c] = settle_at_probe(C, c, W);
+                    continue;
+                }
+                if (isfinite(W[3])) {
+                    if (!isfinite(last[3])) {
+                        other = W;
+                    } else {
+                        /* which side this point is on: the one whose last
+                         * plane its gradient matches; neither (a smooth
+                         * bend after all): plain steps from here on */
+                        const double gl = sqrt(gl2), cl = cos_to(gp, gl, last),
+                                     cw = cos_to(gp, gl, W);
+                        if (!(fmax(cl, cw) >= CREASE_COS)) {
+                            if (W[7] == W_PROBED) { /* back to where the probe left */
+                                state[c] = settle_at_probe(C, c, W);
+                                continue;
+                            }
+                            W[3] = NAN;
+                            other = last;
+                        } else if (cw > cl) {
+                            other = last; /* crossed to the other side */
+                            swapped = 1;
+                        } else {
+                            other = W;
+                        }
+                    }
+                } else if (isfinite(last[3])) {
+                    other = last;
+                }
             }
             /* the step: onto the tangent plane here, and where the last
              * point saw another side of the crease, onto that side's
              * tangent plane too (the shortest step onto both: a Newton step
              * for the crease, which plain steps, alternating between its
-             * sides, approach only linearly) */
+             * sides, approach only linearly). On a crease the other side's
+             * plane is the last one seen on that side. */
             double dx[3] = {-ph * gp[0] / gl2, -ph * gp[1] / gl2, -ph * gp[2] / gl2};
-            if (isfinite(C->cv[c])) {
-                const double h2[3] = {C->cgx[c], C->cgy[c], C->cgz[c]};
-                const double r2 = h2[0] * Xc[0] + h2[1] * Xc[1] + h2[2] * Xc[2] + C->cv[c];
+            if (other) {
+                const double h2[3] = {other[0], other[1], other[2]};
+                const double r2 = h2[0] * Xc[0] + h2[1] * Xc[1] + h2[2] * Xc[2] + other[3];
                 const double a11 = gl2, a22 = h2[0] * h2[0] + h2[1] * h2[1] + h2[2] * h2[2],
                              a12 = gp[0] * h2[0] + gp[1] * h2[1] + gp[2] * h2[2];
                 const double det = a11 * a22 - a12 * a12;
@@ -690,21 +932,26 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
                     const double l1 = (-ph * a22 + r2 * a12) / det,
                                  l2 = (-r2 * a11 + ph * a12) / det;
                     for (int d = 0; d < 3; ++d) dx[d] = l1 * gp[d] + l2 * h2[d];
+                    along_crease(g, B, C->faces[C->cface[c]].cell, gp, h2, Xc, dx);
                 }
             }
             /* a step longer than a cell: not a crease this point can reach
              * (a vanishing gradient, or sides that barely differ) */
             if (!(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2] <= hmin * hmin)) {
-                state[c] = 2;
+                state[c] = settle_at_probe(C, c, W);
                 continue;
+            }
+            if (swapped) { /* the plane left behind is the other side's now */
+                memcpy(W, last, sizeof last);
+                if (W[7] == W_POLYGON) W[7] = W_SEEN;
             }
             C->cgx[c] = gp[0];
             C->cgy[c] = gp[1];
             C->cgz[c] = gp[2];
             C->cv[c] = ph - (gp[0] * Xc[0] + gp[1] * Xc[1] + gp[2] * Xc[2]);
-            C->cx[c] += dx[0];
-            C->cy[c] += dx[1];
-            C->cz[c] += dx[2];
+            C->cx[c] = Xc[0] + dx[0];
+            C->cy[c] = Xc[1] + dx[1];
+            C->cz[c] = Xc[2] + dx[2];
         }
     }
     lb_status s = settle_by_bisection(ev, g, C, nc, state, tol, hmin, boxmax, err);
