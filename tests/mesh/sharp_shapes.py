@@ -1,7 +1,8 @@
 """Closed forms of the sharp test shapes in tests/data/features (the cube,
 the rotated cube, two boxes, a tilted cylinder cut by a slab, the clean
-union of two spheres), computed here with numpy, not by libblend; shared
-by test_mesh_features.py and test_mesh_simplify.py."""
+union of two spheres) and of the stool's arguments, computed here with
+numpy, not by libblend; shared by test_mesh_features.py and
+test_mesh_simplify.py."""
 import json
 import os
 
@@ -233,3 +234,56 @@ def union_spheres(name="clean-union-spheres"):
 
 
     return union_spheres_distance
+
+
+def ellipsoid_distance(p, center, semi_axes):
+    """unsigned distance from p to the ellipsoid's surface: the nearest
+    point is a_i^2 q_i / (t + a_i^2) (q = |p - center|) for the root t >
+    -min a_i^2 of sum (a_i q_i / (t + a_i^2))^2 = 1, decreasing in t;
+    bisected 80 times (the bracket, a few units wide, to below 1e-20)"""
+    q = np.abs(np.asarray(p, float) - center)
+    a = np.asarray(semi_axes, float)
+    lo = np.full(len(q), -a.min() ** 2)
+    hi = np.full(len(q), a.max() * np.linalg.norm(q, axis=1) + 1.0)
+    for _ in range(80):
+        t = 0.5 * (lo + hi)
+        above = np.sum((a * q / (t[:, None] + a * a)) ** 2, axis=1) > 1.0
+        lo, hi = np.where(above, t, lo), np.where(above, hi, t)
+    t = 0.5 * (lo + hi)
+    return np.linalg.norm(q - a * a * q / (t[:, None] + a * a), axis=1)
+
+
+def capsule_value(p, start, end, radius):
+    """signed distance to a capsule (negative inside)"""
+    s, e = np.asarray(start, float), np.asarray(end, float)
+    v = e - s
+    t = np.clip(((p - s) @ v) / (v @ v), 0.0, 1.0)
+    return np.linalg.norm(p - (s + t[:, None] * v), axis=1) - radius
+
+
+def stool(path):
+    """(distance, lone) for hsu-bounded Fig. 7, the stool (a bounded union
+    of an ellipsoid plate and four capsule legs): lone(p) says p is inside
+    at most one bounding solid, where the bounded union is the plain union
+    of the arguments (tests/figures checks that); near such points only one
+    argument is near, so distance(p) is the distance to the nearest
+    argument's surface"""
+    with open(path) as f:
+        root = json.load(f)["root"]
+
+    def inside(node, p):
+        if node["type"] == "ellipsoid":
+            c, a = np.asarray(node["center"], float), np.asarray(node["semi_axes"], float)
+            return np.sum(((p - c) / a) ** 2, axis=1) <= 1.0
+        return capsule_value(p, node["start"], node["end"], node["radius"]) <= 0.0
+
+    def lone(p):
+        return np.sum([inside(b, p) for b in root["bounds"]], axis=0) <= 1
+
+    def distance(p):
+        return np.min([ellipsoid_distance(p, np.asarray(n["center"], float), n["semi_axes"])
+                       if n["type"] == "ellipsoid" else
+                       np.abs(capsule_value(p, n["start"], n["end"], n["radius"]))
+                       for n in root["args"]], axis=0)
+
+    return distance, lone
