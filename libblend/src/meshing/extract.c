@@ -476,6 +476,16 @@ static inline const double *vertex_normal(const lb__block *B, const bctx *C, uin
     return v < C->ne ? B->vnrm + 3 * v : C->rnrm + 3 * (v - C->ne);
 }
 
+/* The corners of B's cell (its 12-bit local index, as faces hold it). */
+static void cell_box(const lb__grid *g, const lb__block *B, uint32_t cell, double lo[3],
+                     double hi[3]) {
+    const uint64_t gx = (uint64_t)B->b[0] * LB__MB + (cell & 15),
+                   gy = (uint64_t)B->b[1] * LB__MB + ((cell >> 4) & 15),
+                   gz = (uint64_t)B->b[2] * LB__MB + ((cell >> 8) & 15);
+    lb__node_pos(g, gx, gy, gz, lo);
+    lb__node_pos(g, gx + 1, gy + 1, gz + 1, hi);
+}
+
 /* A point on a crease may lie anywhere along it; the step's own choice
  * (the least move onto both planes) can leave it beyond a face of its
  * cell that the crease crosses, next to the neighbour's point or past it,
@@ -496,12 +506,8 @@ static void along_crease(const lb__grid *g, const lb__block *B, uint32_t cell, c
     const double tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
     if (!(tl > 0.0) || !isfinite(tl)) return;
     for (int d = 0; d < 3; ++d) t[d] /= tl;
-    const uint64_t gx = (uint64_t)B->b[0] * LB__MB + (cell & 15),
-                   gy = (uint64_t)B->b[1] * LB__MB + ((cell >> 4) & 15),
-                   gz = (uint64_t)B->b[2] * LB__MB + ((cell >> 8) & 15);
     double lo[3], hi[3];
-    lb__node_pos(g, gx, gy, gz, lo);
-    lb__node_pos(g, gx + 1, gy + 1, gz + 1, hi);
+    cell_box(g, B, cell, lo, hi);
     for (int pass = 0; pass < 2; ++pass) {
         double a = -INFINITY, b = INFINITY;
         for (int d = 0; d < 3; ++d) {
@@ -686,9 +692,9 @@ static void crease_side(const lb__block *B, const bctx *C, uint32_t f, const dou
     W[7] = W_SEEN;
     for (uint32_t q = 0; q < F->n; ++q) {
         const double *m = vertex_normal(B, C, F->e[q]), *r = B->vpos + 3 * (size_t)F->e[q];
-        if (m[0] * n[0] + m[1] * n[1] + m[2] * n[2] < CREASE_COS) continue;
-        if (!(m[0] * n[0] + m[1] * n[1] + m[2] * n[2] >= 1.0 - 1e-12) ||
-            !(fabs(n[0] * r[0] + n[1] * r[1] + n[2] * r[2] + W[3]) <= tol))
+        const double cs = m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
+        if (cs < CREASE_COS) continue;
+        if (!(cs >= 1.0 - 1e-12) || !(fabs(n[0] * r[0] + n[1] * r[1] + n[2] * r[2] + W[3]) <= tol))
             W[7] = W_POLYGON;
     }
 }
@@ -764,12 +770,8 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
             }
         }
         if (!(mincos < LB__FEATURE_COS)) continue;
-        const uint32_t ci = F->cell & 15, cj = (F->cell >> 4) & 15, ck = (F->cell >> 8) & 15;
-        const uint64_t gx = (uint64_t)B->b[0] * LB__MB + ci, gy = (uint64_t)B->b[1] * LB__MB + cj,
-                       gz = (uint64_t)B->b[2] * LB__MB + ck;
         double lo[3], hi[3], X[3];
-        lb__node_pos(g, gx, gy, gz, lo);
-        lb__node_pos(g, gx + 1, gy + 1, gz + 1, hi);
+        cell_box(g, B, F->cell, lo, hi);
         for (int d = 0; d < 3; ++d) {
             lo[d] -= FEAT_REACH * g->h[d];
             hi[d] += FEAT_REACH * g->h[d];
