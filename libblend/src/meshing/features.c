@@ -208,66 +208,73 @@ static void tri_normal(const double *P, const uint32_t *t, double nrm[3]) {
     lb__facing(P + 3 * (size_t)t[0], P + 3 * (size_t)t[1], P + 3 * (size_t)t[2], nrm);
 }
 
-/* The pairs found so far, chained per vertex: the segments (a, b) waiting
- * for their second fan triangle under a = min(a, b), and the crease edges
- * (c, d) made under min(c, d). A grid-edge vertex ends at most four cell
- * face segments (one on each face around its grid edge) and a feature
- * point joins at most its cell's six neighbours, so every chain is short;
- * and the merged mesh numbers vertices block by block, so the
- * chains a block's fans touch lie together in memory (a hash table over
- * all segments spread its probes over megabytes: a cache miss each). */
+/* The pairs found so far, chained by a hash of their first end: the
+ * segments (a, b) waiting for their second fan triangle under a = min(a,
+ * b), and the crease edges (c, d) made under c = min(c, d); as many chains
+ * as the power of 2 at or above the fan count, so chains are short. A
+ * chain per vertex (two heads for every vertex of the mesh, set before
+ * the pass) cost more than the pass on S2 (a sixth of the features' time
+ * with the scan of every triangle), and a table of all segments with
+ * probing spread its probes over megabytes (a cache miss each); the fans
+ * come block by block, so the chains one block's fans touch are few. */
 #define NONE UINT32_MAX
 typedef struct seg {
-    uint32_t b;    /* the other end */
-    uint32_t next; /* the next segment under the same vertex, or NONE */
-    size_t t;      /* the fan triangle waiting; SIZE_MAX: paired */
+    uint32_t a, b; /* its ends, a < b */
+    uint32_t next; /* the next segment in the chain, or NONE */
+    uint32_t f;    /* the fan triangle waiting (its index in fan); NONE: paired */
 } seg;
 typedef struct join {
-    uint32_t d, next;
+    uint32_t c, d, next;
 } join;
 
-lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err) {
-    /* the fan triangles: exactly one feature corner */
-    size_t nfan = 0;
-    for (size_t t = 0; t < M->ntriangles; ++t) {
-        const uint32_t *T = M->triangles + 3 * t;
-        nfan += (feat[T[0]] + feat[T[1]] + feat[T[2]]) == 1;
-    }
+static inline uint32_t chain_of(uint32_t v, int shift) {
+    return (uint32_t)((v * 0x9E3779B97F4A7C15ull) >> shift);
+}
+
+lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, const size_t *fan, size_t nfan,
+                            lb_error *err) {
     if (!nfan) return LB_OK;
+    int bits = 6;
+    while (((size_t)1 << bits) < nfan) ++bits;
+    const size_t nh = (size_t)1 << bits;
+    const int shift = 64 - bits;
     /* one block: the segments, the joins (at most nfan / 2 flips), the
-     * two chain heads per vertex */
-    const size_t nv = M->nvertices, bytes = nfan * sizeof(seg) + (nfan / 2 + 1) * sizeof(join) +
-                                            2 * nv * sizeof(uint32_t);
+     * two chain heads per hash */
+    const size_t bytes =
+        nfan * sizeof(seg) + (nfan / 2 + 1) * sizeof(join) + 2 * nh * sizeof(uint32_t);
     unsigned char *mem = nfan < NONE ? lb__huge_alloc(bytes) : NULL;
     if (!mem) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
     seg *segs = (seg *)(void *)mem;
     join *joins = (join *)(void *)(mem + nfan * sizeof(seg));
     uint32_t *head = (uint32_t *)(void *)(mem + nfan * sizeof(seg) + (nfan / 2 + 1) * sizeof(join)),
-             *jhead = head + nv;
-    memset(head, 0xff, 2 * nv * sizeof *head);
+             *jhead = head + nh;
+    memset(head, 0xff, 2 * nh * sizeof *head);
     size_t nseg = 0, nmade = 0;
-    for (size_t t = 0; t < M->ntriangles; ++t) {
-        uint32_t *T = M->triangles + 3 * t;
-        if ((feat[T[0]] + feat[T[1]] + feat[T[2]]) != 1) continue;
+    /* in the mesh's order: a triangle is changed only when its pair comes,
+     * after both were looked at */
+    for (size_t f = 0; f < nfan; ++f) {
+        uint32_t *T = M->triangles + 3 * fan[f];
         const int k = feat[T[0]] ? 0 : feat[T[1]] ? 1 : 2;
         const uint32_t a = T[(k + 1) % 3], b = T[(k + 2) % 3];
         const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
-        uint32_t i = head[lo];
-        while (i != NONE && (segs[i].b != hi || segs[i].t == SIZE_MAX)) i = segs[i].next;
+        const uint32_t h = chain_of(lo, shift);
+        uint32_t i = head[h];
+        while (i != NONE && (segs[i].a != lo || segs[i].b != hi || segs[i].f == NONE))
+            i = segs[i].next;
         if (i == NONE) { /* the first fan triangle on this segment: wait */
-            segs[nseg] = (seg){hi, head[lo], t};
-            head[lo] = (uint32_t)nseg++;
+            segs[nseg] = (seg){lo, hi, head[h], (uint32_t)f};
+            head[h] = (uint32_t)nseg++;
             continue;
         }
         /* the other fan on this segment: triangle (d, b, a) */
-        uint32_t *U = M->triangles + 3 * segs[i].t;
-        segs[i].t = SIZE_MAX; /* paired: no third triangle pairs with it */
+        uint32_t *U = M->triangles + 3 * fan[segs[i].f];
+        segs[i].f = NONE; /* paired: no third triangle pairs with it */
         const int kk = feat[U[0]] ? 0 : feat[U[1]] ? 1 : 2;
         const uint32_t c = T[k], d = U[kk];
         if (U[(kk + 1) % 3] != b || U[(kk + 2) % 3] != a || c == d) continue;
-        const uint32_t clo = c < d ? c : d, chi = c < d ? d : c;
-        uint32_t m = jhead[clo];
-        while (m != NONE && joins[m].d != chi) m = joins[m].next;
+        const uint32_t clo = c < d ? c : d, chi = c < d ? d : c, ch = chain_of(clo, shift);
+        uint32_t m = jhead[ch];
+        while (m != NONE && (joins[m].c != clo || joins[m].d != chi)) m = joins[m].next;
         if (m != NONE) continue; /* c and d already joined */
         /* flipped: (c, a, d) and (d, b, c); only where both keep their
          * orientation (no fold) */
@@ -282,8 +289,8 @@ lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, lb_error *err) {
         if (!(m1[0] * na[0] + m1[1] * na[1] + m1[2] * na[2] > 0.0) ||
             !(m2[0] * nb[0] + m2[1] * nb[1] + m2[2] * nb[2] > 0.0))
             continue;
-        joins[nmade] = (join){chi, jhead[clo]};
-        jhead[clo] = (uint32_t)nmade++;
+        joins[nmade] = (join){clo, chi, jhead[ch]};
+        jhead[ch] = (uint32_t)nmade++;
         memcpy(T, T1, sizeof T1);
         memcpy(U, T2, sizeof T2);
     }
@@ -307,14 +314,31 @@ static int folded(const lb_mesh *M, const uint8_t *feat, size_t t) {
     return grid > 0;
 }
 
+static int by_index(const void *a, const void *b) {
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The place of v in the ascending list pts of n vertices (v is in it). */
+static size_t place_of(const uint32_t *pts, size_t n, uint32_t v) {
+    size_t lo = 0, hi = n;
+    while (hi - lo > 1) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (pts[mid] <= v)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
 lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, uint8_t *feat,
-                             int threads, lb_error *err) {
-    const size_t nv = M->nvertices, nt = M->ntriangles;
-    /* the points of folded triangles (feat 2) */
+                             const size_t *fan, size_t nfan, int threads, lb_error *err) {
+    /* the points of folded triangles (feat 2): every triangle with a
+     * feature point is a fan, flipped or not */
     size_t nb = 0;
-    for (size_t t = 0; t < nt; ++t) {
-        const uint32_t *T = M->triangles + 3 * t;
-        if (!feat[T[0]] && !feat[T[1]] && !feat[T[2]]) continue; /* no point to move */
+    for (size_t q = 0; q < nfan; ++q) {
+        const size_t t = fan[q];
         if (!folded(M, feat, t)) continue;
         for (int k = 0; k < 3; ++k) {
             const uint32_t v = M->triangles[3 * t + k];
@@ -325,22 +349,32 @@ lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh 
         }
     }
     if (!nb) return LB_OK;
-    uint32_t *idx = malloc(nv * sizeof *idx);
-    double *w = calloc(12 * nb, sizeof *w); /* ring sum, count, then eval arrays */
-    if (!idx || !w) {
-        free(idx);
+    /* those points in ascending order (their rows in w) */
+    uint32_t *pts = malloc(2 * nb * sizeof *pts), *mov = pts + nb;
+    double *w = calloc(15 * nb, sizeof *w); /* ring sum, count, points, then eval arrays */
+    if (!pts || !w) {
+        free(pts);
         free(w);
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
     }
     size_t k = 0;
-    for (size_t v = 0; v < nv; ++v) idx[v] = feat[v] == 2 ? (uint32_t)k++ : UINT32_MAX;
-    double *sum = w, *cnt = w + 3 * nb, *x = w + 4 * nb, *y = x + nb, *z = y + nb, *f = z + nb,
-           *gx = f + nb, *gy = gx + nb, *gz = gy + nb;
-    for (size_t t = 0; t < nt; ++t) {
-        const uint32_t *T = M->triangles + 3 * t;
+    for (size_t q = 0; q < nfan; ++q)
         for (int a = 0; a < 3; ++a) {
-            if (idx[T[a]] == UINT32_MAX) continue;
-            const size_t i = idx[T[a]];
+            const uint32_t v = M->triangles[3 * fan[q] + a];
+            if (feat[v] == 2) {
+                feat[v] = 3; /* listed */
+                pts[k++] = v;
+            }
+        }
+    qsort(pts, nb, sizeof *pts, by_index);
+    for (size_t i = 0; i < nb; ++i) feat[pts[i]] = 2;
+    double *sum = w, *cnt = w + 3 * nb, *x = w + 4 * nb, *y = x + nb, *z = y + nb, *ex = z + nb,
+           *ey = ex + nb, *ez = ey + nb, *f = ez + nb, *gx = f + nb, *gy = gx + nb, *gz = gy + nb;
+    for (size_t q = 0; q < nfan; ++q) {
+        const uint32_t *T = M->triangles + 3 * fan[q];
+        for (int a = 0; a < 3; ++a) {
+            if (feat[T[a]] != 2) continue;
+            const size_t i = place_of(pts, nb, T[a]);
             for (int b = 1; b < 3; ++b)
                 for (int d = 0; d < 3; ++d)
                     sum[3 * i + d] += M->positions[3 * (size_t)T[(a + b) % 3] + d];
@@ -357,12 +391,22 @@ lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh 
     memset(done, 0, nb);
     lb_status s = LB_OK;
     for (int it = 0; it < 8 && !s; ++it) {
-        s = lb_evaluator_eval(ev, nb, x, y, z, f, gx, gy, gz, threads, err);
-        for (size_t i = 0; !s && i < nb; ++i) {
-            if (done[i]) continue;
-            const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
+        /* the points still moving, evaluated together */
+        size_t na = 0;
+        for (size_t i = 0; i < nb; ++i)
+            if (!done[i]) {
+                ex[na] = x[i];
+                ey[na] = y[i];
+                ez[na] = z[i];
+                mov[na++] = (uint32_t)i;
+            }
+        if (!na) break;
+        s = lb_evaluator_eval(ev, na, ex, ey, ez, f, gx, gy, gz, threads, err);
+        for (size_t j = 0; !s && j < na; ++j) {
+            const size_t i = mov[j];
+            const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[j], gy[j], gz[j]};
             double gp[3];
-            const double ph = lb__mesh_phi(g, X, f[i], gf, gp);
+            const double ph = lb__mesh_phi(g, X, f[j], gf, gp);
             const double gl2 = gp[0] * gp[0] + gp[1] * gp[1] + gp[2] * gp[2];
             if (!isfinite(ph) || !(gl2 > 0.0) || !isfinite(gl2)) {
                 done[i] = 2;
@@ -379,17 +423,16 @@ lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh 
             }
         }
     }
-    for (size_t v = 0; !s && v < nv; ++v) {
-        if (idx[v] == UINT32_MAX) continue;
-        const size_t i = idx[v];
+    for (size_t i = 0; i < nb; ++i) {
+        const uint32_t v = pts[i];
         feat[v] = 1;
-        if (done[i] != 1) continue;
+        if (s || done[i] != 1) continue;
         M->positions[3 * v] = x[i];
         M->positions[3 * v + 1] = y[i];
         M->positions[3 * v + 2] = z[i];
         memcpy(M->normals + 3 * v, sum + 3 * i, 3 * sizeof(double));
     }
-    free(idx);
+    free(pts);
     free(w);
     return s;
 }
