@@ -1167,6 +1167,223 @@ static int cmp_pair(const void *a, const void *b) {
  * whose corner normals or triangles name entries out of range is refused by
  * both writers before a byte is written. (Their directions against the
  * closed forms: tests/mesh/test_mesh_features.py.) */
+/* ---- the feature point's fit (features.c), against closed forms ---- */
+
+static double fit_rand(unsigned long long *s) { /* uniform in [0, 1) */
+    *s = *s * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*s >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static void fit_unit(unsigned long long *s, double v[3]) {
+    double l;
+    do {
+        for (int d = 0; d < 3; ++d) v[d] = 2.0 * fit_rand(s) - 1.0;
+        l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    } while (!(l > 0.1 && l <= 1.0));
+    for (int d = 0; d < 3; ++d) v[d] /= l;
+}
+
+static double fit_dot(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void fit_cross(const double *a, const double *b, double c[3]) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* a point on the plane through K with unit normal n, up to r from K */
+static void fit_on_plane(unsigned long long *s, const double *K, const double *n, double r,
+                         double *p) {
+    double u[3];
+    fit_unit(s, u);
+    const double un = fit_dot(u, n), t = r * fit_rand(s);
+    for (int d = 0; d < 3; ++d) p[d] = K[d] + t * (u[d] - un * n[d]);
+}
+
+/* The largest eigenvalue of the symmetric A and its unit vector, by power
+ * iteration from v (not orthogonal to it); enough steps for the vector to
+ * settle when the next eigenvalue is within 3 % of it. */
+static double fit_power(const double A[3][3], double v[3]) {
+    double w = 0.0;
+    for (int k = 0; k < 20000; ++k) {
+        double u[3];
+        for (int d = 0; d < 3; ++d) u[d] = A[d][0] * v[0] + A[d][1] * v[1] + A[d][2] * v[2];
+        w = sqrt(fit_dot(u, u));
+        for (int d = 0; d < 3; ++d) v[d] = u[d] / w;
+    }
+    return w;
+}
+
+/* lb__feature_qef's point for tangent planes whose least-squares point is
+ * known without its method: three planes meet in one corner (the point
+ * itself); two planes at 30 to 150 degrees meet in a line (the point of it
+ * nearest the mass point: the direction along the line is the mass
+ * point's); planes whose normals lie within 3 degrees of one (the mass
+ * point moved along the largest direction of sum n n^T, found here by
+ * power iteration, to the least squares along it); and a corner outside
+ * the box, where the box's nearest point to it is the answer for
+ * orthogonal planes (the squared distances separate by axis). Each kind
+ * 300 times, in random orientations. */
+static void test_feature_fit(void **state) {
+    (void)state;
+    unsigned long long s = 12345;
+    const double lo[3] = {-4, -4, -4}, hi[3] = {4, 4, 4};
+    double worst[5] = {0, 0, 0, 0, 0};
+    for (int it = 0; it < 300; ++it) {
+        double K[3], P[3 * LB__MAXPOLY], N[3 * LB__MAXPOLY], x[3], nn[3][3];
+        for (int d = 0; d < 3; ++d) K[d] = 2.0 * fit_rand(&s) - 1.0;
+        /* three planes, normals at least 30 degrees apart and not near one
+         * plane (their triple product at least 0.3) */
+        do {
+            for (int k = 0; k < 3; ++k) fit_unit(&s, nn[k]);
+            double c[3];
+            fit_cross(nn[0], nn[1], c);
+            if (fabs(fit_dot(c, nn[2])) < 0.3) continue;
+            if (fabs(fit_dot(nn[0], nn[1])) > 0.866 || fabs(fit_dot(nn[0], nn[2])) > 0.866 ||
+                fabs(fit_dot(nn[1], nn[2])) > 0.866)
+                continue;
+            break;
+        } while (1);
+        int m = 0;
+        for (int k = 0; k < 3; ++k)
+            for (int q = 0; q < 2; ++q, ++m) {
+                fit_on_plane(&s, K, nn[k], 0.5, P + 3 * m);
+                memcpy(N + 3 * m, nn[k], sizeof nn[k]);
+            }
+        assert_int_equal(lb__feature_qef(P, N, m, lo, hi, x), 1);
+        for (int d = 0; d < 3; ++d) worst[0] = fmax(worst[0], fabs(x[d] - K[d]));
+
+        /* two planes through the line K + s t */
+        double t[3], a[3], b[3];
+        fit_unit(&s, t);
+        fit_unit(&s, a);
+        const double at = fit_dot(a, t);
+        for (int d = 0; d < 3; ++d) a[d] -= at * t[d];
+        const double al = sqrt(fit_dot(a, a));
+        for (int d = 0; d < 3; ++d) a[d] /= al;
+        fit_cross(t, a, b);
+        const double th = (30.0 + 120.0 * fit_rand(&s)) * M_PI / 180.0;
+        for (int d = 0; d < 3; ++d) {
+            nn[0][d] = a[d];
+            nn[1][d] = cos(th) * a[d] + sin(th) * b[d];
+        }
+        const int m2 = 2 + it % 6; /* 2 to 7 points, both planes */
+        double c[3] = {0, 0, 0};
+        for (int q = 0; q < m2; ++q) {
+            fit_on_plane(&s, K, nn[q % 2], 0.5, P + 3 * q);
+            memcpy(N + 3 * q, nn[q % 2], sizeof nn[0]);
+            for (int d = 0; d < 3; ++d) c[d] += P[3 * q + d] / m2;
+        }
+        assert_int_equal(lb__feature_qef(P, N, m2, lo, hi, x), 1);
+        double ck[3];
+        for (int d = 0; d < 3; ++d) ck[d] = c[d] - K[d];
+        const double along = fit_dot(ck, t);
+        for (int d = 0; d < 3; ++d) worst[1] = fmax(worst[1], fabs(x[d] - (K[d] + along * t[d])));
+
+        /* normals within 3 degrees of n0, points near one plane */
+        double n0[3], A[3][3] = {{0}}, g[3] = {0, 0, 0};
+        fit_unit(&s, n0);
+        const int m3 = 3 + it % 5; /* 3 to 7 points (a polygon has at most 7) */
+        for (int d = 0; d < 3; ++d) c[d] = 0.0;
+        for (int q = 0; q < m3; ++q) {
+            double w[3];
+            fit_unit(&s, w);
+            for (int d = 0; d < 3; ++d) N[3 * q + d] = n0[d] + 0.05 * w[d];
+            const double l = sqrt(fit_dot(N + 3 * q, N + 3 * q));
+            for (int d = 0; d < 3; ++d) N[3 * q + d] /= l;
+            fit_on_plane(&s, K, n0, 0.5, P + 3 * q);
+            for (int d = 0; d < 3; ++d) P[3 * q + d] += 0.01 * (2.0 * fit_rand(&s) - 1.0);
+            for (int d = 0; d < 3; ++d) c[d] += P[3 * q + d] / m3;
+        }
+        assert_true(acos(fmin(1.0, fit_dot(N, n0))) < 3.0 * M_PI / 180.0);
+        for (int q = 0; q < m3; ++q) {
+            const double *nq = N + 3 * q, *pq = P + 3 * q;
+            double r = 0.0;
+            for (int d = 0; d < 3; ++d) r += nq[d] * (pq[d] - c[d]);
+            for (int d = 0; d < 3; ++d) {
+                g[d] += nq[d] * r;
+                for (int e = 0; e < 3; ++e) A[d][e] += nq[d] * nq[e];
+            }
+        }
+        double v[3] = {n0[0], n0[1], n0[2]};
+        const double w1 = fit_power(A, v);
+        assert_int_equal(lb__feature_qef(P, N, m3, lo, hi, x), 1);
+        const double step = fit_dot(v, g) / w1;
+        for (int d = 0; d < 3; ++d) worst[2] = fmax(worst[2], fabs(x[d] - (c[d] + step * v[d])));
+
+        /* the two planes again, their normals tilted by up to 2 degrees
+         * (a curved crease): the direction along the crease has a small
+         * eigenvalue, under the cut, and the mass point's part of the
+         * least squares along it is dropped. The decomposition here: the
+         * largest and smallest eigenvectors by power iteration (on A and
+         * on trace - A), the middle one their cross product. */
+        const int m5 = 3 + it % 5; /* 3 to 7: two normals alone span no third direction */
+        double B3[3][3] = {{0}}, h[3] = {0, 0, 0};
+        for (int d = 0; d < 3; ++d) c[d] = 0.0;
+        for (int q = 0; q < m5; ++q) {
+            double w[3];
+            fit_unit(&s, w);
+            for (int d = 0; d < 3; ++d) N[3 * q + d] = nn[q % 2][d] + 0.035 * w[d];
+            const double l = sqrt(fit_dot(N + 3 * q, N + 3 * q));
+            for (int d = 0; d < 3; ++d) N[3 * q + d] /= l;
+            fit_on_plane(&s, K, nn[q % 2], 0.5, P + 3 * q);
+            for (int d = 0; d < 3; ++d) c[d] += P[3 * q + d] / m5;
+        }
+        for (int q = 0; q < m5; ++q) {
+            const double *nq = N + 3 * q, *pq = P + 3 * q;
+            double r = 0.0;
+            for (int d = 0; d < 3; ++d) r += nq[d] * (pq[d] - c[d]);
+            for (int d = 0; d < 3; ++d) {
+                h[d] += nq[d] * r;
+                for (int e = 0; e < 3; ++e) B3[d][e] += nq[d] * nq[e];
+            }
+        }
+        const double tr = B3[0][0] + B3[1][1] + B3[2][2];
+        double C3[3][3], v1[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]},
+                         v3[3] = {t[0], t[1], t[2]}, v2[3];
+        for (int d = 0; d < 3; ++d)
+            for (int e = 0; e < 3; ++e) C3[d][e] = (d == e ? tr : 0.0) - B3[d][e];
+        const double e1 = fit_power(B3, v1), e3 = tr - fit_power(C3, v3);
+        fit_cross(v1, v3, v2);
+        double e2 = 0.0;
+        for (int d = 0; d < 3; ++d)
+            for (int e = 0; e < 3; ++e) e2 += v2[d] * B3[d][e] * v2[e];
+        /* the case this checks: the middle direction kept, the smallest not
+         * (the fit's cut is 2 % of the largest) */
+        assert_true(e2 > 0.05 * e1 && e3 < 0.01 * e1 && e3 > 0.0);
+        assert_int_equal(lb__feature_qef(P, N, m5, lo, hi, x), 1);
+        const double s1 = fit_dot(v1, h) / e1, s2 = fit_dot(v2, h) / e2;
+        for (int d = 0; d < 3; ++d)
+            worst[4] = fmax(worst[4], fabs(x[d] - (c[d] + s1 * v1[d] + s2 * v2[d])));
+
+        /* three orthogonal planes in a random frame meeting outside a box:
+         * the box point nearest the corner, in that frame's coordinates
+         * (the squared distances to the planes are the frame's axes), is
+         * found when the box is that frame's: use the world axes */
+        const double blo[3] = {-0.5, -0.5, -0.5}, bhi[3] = {0.5, 0.5, 0.5};
+        double Kout[3];
+        for (int d = 0; d < 3; ++d) Kout[d] = 3.0 * (2.0 * fit_rand(&s) - 1.0);
+        m = 0;
+        for (int k = 0; k < 3; ++k) {
+            double e[3] = {0, 0, 0};
+            e[k] = 1.0;
+            for (int q = 0; q < 2; ++q, ++m) {
+                fit_on_plane(&s, Kout, e, 0.4, P + 3 * m);
+                memcpy(N + 3 * m, e, sizeof e);
+            }
+        }
+        assert_int_equal(lb__feature_qef(P, N, m, blo, bhi, x), 1);
+        for (int d = 0; d < 3; ++d)
+            worst[3] = fmax(worst[3], fabs(x[d] - fmin(fmax(Kout[d], blo[d]), bhi[d])));
+    }
+    printf("feature fit, largest distance from the closed form: corner %.3g, crease %.3g, "
+           "near-flat %.3g, clamped corner %.3g, curved crease %.3g\n",
+           worst[0], worst[1], worst[2], worst[3], worst[4]);
+    for (int k = 0; k < 5; ++k) assert_true(worst[k] <= 1e-9);
+}
+
 static void test_corner_normals(void **state) {
     (void)state;
     char path[1100];
@@ -1726,6 +1943,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_min_feature),
         cmocka_unit_test(test_edges),
         cmocka_unit_test(test_corner_normals),
+        cmocka_unit_test(test_feature_fit),
         cmocka_unit_test(test_wide_union),
         cmocka_unit_test(test_mesh_cache),
         cmocka_unit_test(test_mesh_cache_memory),

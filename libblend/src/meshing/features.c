@@ -129,6 +129,116 @@ static inline void qef_step(const double *p, const double *n, int m, const int i
     }
 }
 
+/* Rows a and b of the symmetric S, crossed: a vector S's rows are all
+ * orthogonal to (S's null direction) when a and b are independent. */
+static inline void row_cross(const double S[3][3], int a, int b, double c[3]) {
+    c[0] = S[a][1] * S[b][2] - S[a][2] * S[b][1];
+    c[1] = S[a][2] * S[b][0] - S[a][0] * S[b][2];
+    c[2] = S[a][0] * S[b][1] - S[a][1] * S[b][0];
+}
+
+/* The unit vector v with (A - w I) v = 0 for an eigenvalue w of the
+ * symmetric A that is a distance of at least 1e-6 wmax from the others
+ * (the largest cross product of two rows of A - w I; its length is the
+ * product of the other two eigenvalues' distances to w): 0 when none is. */
+static int eigvec(const double A[3][3], double w, double wmax, double v[3]) {
+    double S[3][3];
+    memcpy(S, A, sizeof S);
+    for (int d = 0; d < 3; ++d) S[d][d] -= w;
+    double c[3][3], best = 0.0;
+    int k = 0;
+    row_cross(S, 0, 1, c[0]);
+    row_cross(S, 0, 2, c[1]);
+    row_cross(S, 1, 2, c[2]);
+    for (int i = 0; i < 3; ++i) {
+        const double l = c[i][0] * c[i][0] + c[i][1] * c[i][1] + c[i][2] * c[i][2];
+        if (l > best) best = l, k = i;
+    }
+    if (!(best > 1e-12 * wmax * wmax * wmax * wmax)) return 0;
+    const double il = 1.0 / sqrt(best);
+    for (int d = 0; d < 3; ++d) v[d] = c[k][d] * il;
+    return 1;
+}
+
+/* y = A^-1 b for the symmetric A (by its cofactors); 0 when A's
+ * determinant is not positive. */
+static int solve3(const double A[3][3], const double b[3], double y[3]) {
+    const double c00 = A[1][1] * A[2][2] - A[1][2] * A[1][2],
+                 c01 = A[0][2] * A[1][2] - A[0][1] * A[2][2],
+                 c02 = A[0][1] * A[1][2] - A[0][2] * A[1][1],
+                 c11 = A[0][0] * A[2][2] - A[0][2] * A[0][2],
+                 c12 = A[0][1] * A[0][2] - A[0][0] * A[1][2],
+                 c22 = A[0][0] * A[1][1] - A[0][1] * A[0][1];
+    const double det = A[0][0] * c00 + A[0][1] * c01 + A[0][2] * c02;
+    if (!(det > 0.0) || !isfinite(det)) return 0;
+    const double id = 1.0 / det;
+    y[0] = (c00 * b[0] + c01 * b[1] + c02 * b[2]) * id;
+    y[1] = (c01 * b[0] + c11 * b[1] + c12 * b[2]) * id;
+    y[2] = (c02 * b[0] + c12 * b[1] + c22 * b[2]) * id;
+    return 1;
+}
+
+/* qef_step over all three coordinates, with the eigenvalues of the 3 x 3
+ * matrix in closed form (the trigonometric solution of its characteristic
+ * cubic) rather than by Jacobi rotations, whose square roots and divisions
+ * were most of the fit's time (a fifth of the features' cost on S2): with
+ * no eigenvalue under the cut, y = A^-1 b; with the smallest under it,
+ * the same solve with that eigenvalue raised to the largest and b's part
+ * along its vector taken out (which leaves y with no part along it); with
+ * two under it, y along the largest's vector alone. The same y as the
+ * rotations' up to rounding. 0 (y untouched) where that is not well
+ * determined: a matrix nearly a multiple of the identity, an eigenvalue
+ * within 1e-6 of another whose vector is needed; the rotations then. */
+static int qef_step3(const double *p, const double *n, int m, const double x0[3], double y[3]) {
+    double A[3][3] = {{0}}, b[3] = {0};
+    for (int i = 0; i < m; ++i) {
+        const double *ni = n + 3 * i, *pi = p + 3 * i;
+        const double r =
+            ni[0] * (pi[0] - x0[0]) + ni[1] * (pi[1] - x0[1]) + ni[2] * (pi[2] - x0[2]);
+        for (int a = 0; a < 3; ++a) {
+            b[a] += ni[a] * r;
+            for (int q = a; q < 3; ++q) A[a][q] += ni[a] * ni[q];
+        }
+    }
+    A[1][0] = A[0][1];
+    A[2][0] = A[0][2];
+    A[2][1] = A[1][2];
+    const double q = (A[0][0] + A[1][1] + A[2][2]) / 3.0;
+    const double d0 = A[0][0] - q, d1 = A[1][1] - q, d2 = A[2][2] - q;
+    const double off = A[0][1] * A[0][1] + A[0][2] * A[0][2] + A[1][2] * A[1][2];
+    const double p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * off;
+    if (!(q > 0.0) || !(p2 > 1e-20 * q * q) || !isfinite(p2)) return 0;
+    const double pp = sqrt(p2 / 6.0);
+    /* det(A - q I) / (2 pp^3), in [-1, 1] up to rounding */
+    const double det = d0 * (d1 * d2 - A[1][2] * A[1][2]) -
+                       A[0][1] * (A[0][1] * d2 - A[1][2] * A[0][2]) +
+                       A[0][2] * (A[0][1] * A[1][2] - d1 * A[0][2]);
+    const double r = fmin(1.0, fmax(-1.0, det / (2.0 * pp * pp * pp)));
+    const double phi = acos(r) / 3.0;
+    const double w1 = q + 2.0 * pp * cos(phi), w3 = q + 2.0 * pp * cos(phi + 2.0943951023931954923),
+                 w2 = 3.0 * q - w1 - w3;
+    if (!(w1 > 0.0)) return 0;
+    const double cut = EIG_CUT * w1;
+    double v[3], z[3];
+    if (w3 > cut) return solve3(A, b, y);
+    if (w2 > cut) {
+        if (!eigvec(A, w3, w1, v)) return 0;
+        const double vb = v[0] * b[0] + v[1] * b[1] + v[2] * b[2], up = w1 - w3;
+        double B[3][3], c[3];
+        for (int a = 0; a < 3; ++a) {
+            c[a] = b[a] - vb * v[a];
+            for (int e = 0; e < 3; ++e) B[a][e] = A[a][e] + up * v[a] * v[e];
+        }
+        if (!solve3(B, c, z)) return 0;
+        memcpy(y, z, sizeof z);
+        return 1;
+    }
+    if (!eigvec(A, w1, w1, v)) return 0;
+    const double vb = (v[0] * b[0] + v[1] * b[1] + v[2] * b[2]) / w1;
+    for (int a = 0; a < 3; ++a) y[a] = v[a] * vb;
+    return 1;
+}
+
 /* The QEF's least-squares point over the free coordinates (free bit d set:
  * x[d] free; the others stay as given in x), starting from the mass point
  * c: x_F = c_F + y (qef_step), x0 = x with c in the free coordinates. */
@@ -142,7 +252,7 @@ static void qef_free(const double *p, const double *n, int m, const double c[3],
     double y[3] = {0, 0, 0};
     if (k == 3) {
         static const int all[3] = {0, 1, 2};
-        qef_step(p, n, m, all, 3, x0, y);
+        if (!qef_step3(p, n, m, x0, y)) qef_step(p, n, m, all, 3, x0, y);
     } else if (k == 2) {
         qef_step(p, n, m, idx, 2, x0, y);
     } else if (k == 1) {
