@@ -792,37 +792,69 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
     double hmin = fmin(g->h[0], fmin(g->h[1], g->h[2]));
     const double tol = 1e-7 * hmin, boxmax = lb__block_boxmax(g, B);
     lb__boxeval *E = &C->S.E;
-    lb__boxeval_load(ev, &B->plan, E);
+    /* the octant plans where the block has them (mesher.c, block_nodes:
+     * a point inside an octant's box is evaluated under that octant's
+     * plan, about half the block's arguments on S2; any other point, in
+     * the block or within a cell or so of it, under the block's) */
+    double obox[8][6];
+    const int octs = B->octmem != NULL;
+    for (int o = 0; octs && o < 8; ++o) {
+        uint32_t l0[3], l1[3];
+        lb__octant_nodes(B, o, l0, l1);
+        lb__node_box(g, B, l0, l1, obox[o], obox[o] + 3);
+    }
     /* each candidate's state; cv, cgx..cgz hold the tangent plane of its
      * last point (cv NAN: none yet) for the crease step, cw its crease data
-     * (CW: the other side's plane, the probe) */
-    uint8_t *state = (uint8_t *)C->S.eact; /* 0 moving, 1 on the surface, 2 rejected */
+     * (CW: the other side's plane, the probe). The scratch's first bytes
+     * (eact): the states, each moving candidate's plan group, and the
+     * candidates in the order evaluated (nc <= 512) */
+    uint8_t *state = (uint8_t *)C->S.eact, *grp = state + 512;
+    uint32_t *ord = (uint32_t *)(void *)(state + 1024);
     memset(state, 0, nc);
     for (int it = 0; it < FEAT_ITER + CREASE_EVALS; ++it) {
-        size_t na = 0;
-        for (size_t c = 0; c < nc; ++c) na += state[c] == 0;
+        /* the moving ones, packed at the scratch's start, by plan group:
+         * octant o (0..7), the block (8) */
+        size_t start[10] = {0};
+        for (size_t c = 0; c < nc; ++c) {
+            if (state[c]) continue;
+            int o = 8;
+            const double X[3] = {C->cx[c], C->cy[c], C->cz[c]};
+            for (int q = 0; octs && q < 8 && o == 8; ++q)
+                if (X[0] >= obox[q][0] && X[0] <= obox[q][3] && X[1] >= obox[q][1] &&
+                    X[1] <= obox[q][4] && X[2] >= obox[q][2] && X[2] <= obox[q][5])
+                    o = q;
+            grp[c] = (uint8_t)o;
+            ++start[o + 1];
+        }
+        for (int q = 0; q < 9; ++q) start[q + 1] += start[q];
+        const size_t na = start[9];
         if (!na) break;
-        /* the moving ones, packed at the scratch's start */
         double *x = C->S.edges, *y = x + na, *z = y + na, *v = z + na, *gxx = v + na,
                *gyy = gxx + na, *gzz = gyy + na;
-        size_t j = 0;
+        size_t fill[9];
+        memcpy(fill, start, sizeof fill);
         for (size_t c = 0; c < nc; ++c)
             if (!state[c]) {
+                const size_t j = fill[grp[c]]++;
                 x[j] = C->cx[c];
                 y[j] = C->cy[c];
                 z[j] = C->cz[c];
-                ++j;
+                ord[j] = (uint32_t)c;
             }
-        lb_status s = lb__boxeval_run(ev, E, na, x, y, z, v, gxx, gyy, gzz, err);
-        if (s) return s;
-        j = 0;
-        for (size_t c = 0; c < nc; ++c) {
-            if (state[c]) continue;
+        for (int q = 0; q < 9; ++q) {
+            const size_t a = start[q], n = start[q + 1] - a;
+            if (!n) continue;
+            lb__boxeval_load(ev, q < 8 ? &B->oct[q] : &B->plan, E);
+            lb_status s = lb__boxeval_run(ev, E, n, x + a, y + a, z + a, v + a, gxx + a, gyy + a,
+                                          gzz + a, err);
+            if (s) return s;
+        }
+        for (size_t j = 0; j < na; ++j) {
+            const size_t c = ord[j];
             double Xc[3] = {x[j], y[j], z[j]};
             const double gf[3] = {gxx[j], gyy[j], gzz[j]};
             double gp[3];
             double ph = lb__mesh_phi_in(g, boxmax, Xc, v[j], gf, gp);
-            ++j;
             double gl2 = gp[0] * gp[0] + gp[1] * gp[1] + gp[2] * gp[2];
             const int valid = isfinite(ph) && gl2 > 0.0 && isfinite(gl2);
             double *W = C->cw + CW * c;
@@ -956,6 +988,7 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
             C->cz[c] = Xc[2] + dx[2];
         }
     }
+    lb__boxeval_load(ev, &B->plan, E); /* the bisection's points: the block's plan */
     lb_status s = settle_by_bisection(ev, g, C, nc, state, tol, hmin, boxmax, err);
     if (s) return s;
     size_t nfeat = 0;
