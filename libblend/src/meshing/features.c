@@ -282,11 +282,20 @@ int lb__feature_qef(const double *p, const double *n, int m, const double lo[3],
     /* slack: a point on the box within rounding counts as inside */
     double tol[3];
     for (int d = 0; d < 3; ++d) tol[d] = 1e-9 * (hi[d] - lo[d]);
+    /* the free minimum inside the box is the global one (most fits) */
     double best[3] = {c[0], c[1], c[2]}, beste = INFINITY;
-    /* the free minimum, then every face (one coordinate fixed), edge (two)
-     * and corner (three) of the box; the first feasible one with the least
-     * error wins (a fixed order: deterministic) */
-    for (int nfix = 0; nfix <= 3; ++nfix) {
+    qef_free(p, n, m, c, 7, best);
+    int in_box = 1;
+    for (int d = 0; d < 3; ++d) in_box &= best[d] >= lo[d] - tol[d] && best[d] <= hi[d] + tol[d];
+    if (in_box) {
+        for (int d = 0; d < 3; ++d) x[d] = fmin(fmax(best[d], lo[d]), hi[d]);
+        return 1;
+    }
+    /* else every face (one coordinate fixed), edge (two) and corner (three)
+     * of the box; the first feasible one with the least error wins (a fixed
+     * order: deterministic) */
+    memcpy(best, c, sizeof best);
+    for (int nfix = 1; nfix <= 3; ++nfix) {
         for (int fixm = 0; fixm < 8; ++fixm) {
             const int cnt = (fixm & 1) + ((fixm >> 1) & 1) + ((fixm >> 2) & 1);
             if (cnt != nfix) continue;
@@ -307,8 +316,6 @@ int lb__feature_qef(const double *p, const double *n, int m, const double lo[3],
                 }
             }
         }
-        /* the free minimum inside the box is the global one: done */
-        if (nfix == 0 && beste < INFINITY) break;
     }
     for (int d = 0; d < 3; ++d) x[d] = fmin(fmax(best[d], lo[d]), hi[d]);
     return 1;
