@@ -33,6 +33,10 @@ void *lb__huge_alloc(size_t bytes) {
     return malloc(bytes ? bytes : 1);
 }
 
+void *lb__array_alloc(size_t bytes) {
+    return malloc(bytes ? bytes : 1);
+}
+
 void lb__huge_free(void *p, size_t bytes) {
     (void)bytes;
     free(p);
@@ -100,6 +104,18 @@ size_t lb__usable_size(void *p) {
 }
 
 #define HUGE_BYTES ((size_t)2 << 20)
+
+void *lb__array_alloc(size_t bytes) {
+#ifdef __GLIBC__
+    if (bytes >= HUGE_BYTES) {
+        void *p = NULL;
+        if (posix_memalign(&p, HUGE_BYTES, bytes)) return NULL;
+        lb__huge_pages(p, bytes);
+        return p;
+    }
+#endif
+    return malloc(bytes ? bytes : 1);
+}
 
 void *lb__huge_alloc(size_t bytes) {
     if (bytes < HUGE_BYTES) return malloc(bytes ? bytes : 1); /* too small for a huge page */

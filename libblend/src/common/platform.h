@@ -25,6 +25,15 @@ LB_INTERNAL FILE *lb__fopen(const char *path, const char *mode);
  * writing (docs/meshing.md, Incremental remeshing). Nothing elsewhere. */
 LB_INTERNAL void lb__huge_pages(void *p, size_t bytes);
 
+/* bytes from malloc's heap (freed with free, resized with realloc) for an
+ * array written once, page by page (a mesh's output): on glibc, from 2 MiB
+ * on, aligned to 2 MiB and advised as lb__huge_pages, so that its first
+ * byte already lies on a huge page (a block from malloc starts wherever
+ * its mapping does: up to 2 MiB of small pages, a fault each, before the
+ * first whole huge page; 40 to 295 faults for the first 3 MiB in one test
+ * against 4); else malloc. NULL when out of memory. */
+LB_INTERNAL void *lb__array_alloc(size_t bytes);
+
 /* bytes of memory on huge pages where the system offers them (on Linux,
  * from 2 MiB on, an anonymous mapping aligned to 2 MiB and advised so, its
  * pages then faulted 2 MiB at a time; else malloc), for large long-lived buffers read

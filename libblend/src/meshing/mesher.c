@@ -180,15 +180,15 @@ typedef struct sel {
  * given room for c elements when c > cap. */
 static int grow(void **p, size_t cap, size_t c, size_t used, size_t sz) {
     if (c <= cap) return 1;
-    /* a new array, advised before the used part is copied in: realloc
-     * would move the pages (mremap) to an address whose 2 MiB alignment
-     * differs, which splits the huge pages into small ones for good, and
-     * on this project's build machine (a PVM guest) a small page can cost
-     * a fault in the host each time it is touched after any unmapping
-     * (docs/meshing.md, Incremental remeshing) */
-    void *q = malloc(c * sz);
+    /* a new array, on huge pages from its first byte (lb__array_alloc)
+     * before the used part is copied in: realloc would move the pages
+     * (mremap) to an address whose 2 MiB alignment differs, which splits
+     * the huge pages into small ones for good, and on this project's build
+     * machine (a PVM guest) a small page can cost a fault in the host each
+     * time it is touched after any unmapping (docs/meshing.md, Incremental
+     * remeshing) */
+    void *q = lb__array_alloc(c * sz);
     if (!q) return 0;
-    lb__huge_pages(q, c * sz);
     if (*p) memcpy(q, *p, used * sz);
     free(*p);
     *p = q;
