@@ -692,6 +692,34 @@ static void *worker(void *arg) {
     return NULL;
 }
 
+lb_status lb__eval_few(const lb_evaluator *ev, lb__boxeval *E, lb__plan *outer, size_t n,
+                       const double *x, const double *y, const double *z, double *v, double *gx,
+                       double *gy, double *gz, lb_error *err) {
+    /* run_blocks for one block of points in their given order */
+    if (n > LB__FEW) return lb__fail(err, LB_ERR_INTERNAL, "lb__eval_few: %zu points", n);
+    if (n > LB__CHUNK) {
+        double bc[3], br[3];
+        point_box(x, y, z, n, bc, br);
+        lb__bounds_pass(ev, bc, br, E->iv, outer);
+    }
+    for (size_t o = 0; o < n; o += LB__CHUNK) {
+        const size_t m = n - o < LB__CHUNK ? n - o : LB__CHUNK;
+        double bc[3], br[3];
+        point_box(x + o, y + o, z + o, m, bc, br);
+        if (n > LB__CHUNK)
+            lb__bounds_pass_sub(ev, outer, bc, br, E->iv, &E->plan);
+        else
+            lb__bounds_pass(ev, bc, br, E->iv, &E->plan);
+        const lb_status s = lb__tape_run_plan(ev, &E->plan, m, x + o, y + o, z + o, E->regs, err);
+        if (s) return s;
+        memcpy(v + o, lb__reg(E->regs, ev->out, 0), m * sizeof *v);
+        memcpy(gx + o, lb__reg(E->regs, ev->out, 1), m * sizeof *gx);
+        memcpy(gy + o, lb__reg(E->regs, ev->out, 2), m * sizeof *gy);
+        memcpy(gz + o, lb__reg(E->regs, ev->out, 3), m * sizeof *gz);
+    }
+    return LB_OK;
+}
+
 lb_status lb_evaluator_eval(const lb_evaluator *ev, size_t n, const double *x, const double *y,
                             const double *z, double *value, double *gx, double *gy, double *gz,
                             int threads, lb_error *err) {

@@ -272,6 +272,16 @@ LB_INTERNAL lb_status lb__boxeval_run(const lb_evaluator *ev, lb__boxeval *E, si
                                       const double *x, const double *y, const double *z, double *v,
                                       double *gx, double *gy, double *gz, lb_error *err);
 LB_INTERNAL void lb__boxeval_free(lb__boxeval *E);
+/* lb_evaluator_eval's values for n <= LB__FEW points on one thread, the
+ * same bits (the same plans: of the points' box, then of each chunk's
+ * within it), in E's registers and plan and outer (a plan allocated for
+ * ev) instead of memory of its own: for the few points the mesher
+ * evaluates after its blocks (lb__feature_unfold), whose scratch would
+ * otherwise be fresh pages each time. E's plan is replaced. */
+#define LB__FEW (4 * LB__CHUNK)
+LB_INTERNAL lb_status lb__eval_few(const lb_evaluator *ev, lb__boxeval *E, lb__plan *outer,
+                                   size_t n, const double *x, const double *y, const double *z,
+                                   double *v, double *gx, double *gy, double *gz, lb_error *err);
 /* A box inside E's box: E's plan becomes that box's (one sub-box pass under
  * the current plan; the culling only tightens), for the runs that follow.
  * Every later point must lie in [bmin, bmax]. */

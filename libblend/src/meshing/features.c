@@ -325,93 +325,128 @@ static void tri_normal(const double *P, const uint32_t *t, double nrm[3]) {
     lb__facing(P + 3 * (size_t)t[0], P + 3 * (size_t)t[1], P + 3 * (size_t)t[2], nrm);
 }
 
-/* The pairs found so far, chained by a hash of their first end: the
- * segments (a, b) waiting for their second fan triangle under a = min(a,
- * b), and the crease edges (c, d) made under c = min(c, d); as many chains
- * as the power of 2 at or above the fan count, so chains are short. A
- * chain per vertex (two heads for every vertex of the mesh, set before
- * the pass) cost more than the pass on S2 (a sixth of the features' time
- * with the scan of every triangle), and a table of all segments with
- * probing spread its probes over megabytes (a cache miss each); the fans
- * come block by block, so the chains one block's fans touch are few. */
+/* The segments (a, b), a < b, waiting for their second fan triangle,
+ * chained by a hash of a; a segment leaves its chain when paired, and its
+ * slot takes the next one, so the table holds about the segments between
+ * merged blocks and blocks still to come, not all of them (a table of
+ * every segment, and two chain heads for every vertex, were 0.8 MB of
+ * fresh pages on S2 at 128 cells: a fault each 4 KiB). */
 #define NONE UINT32_MAX
 typedef struct seg {
     uint32_t a, b; /* its ends, a < b */
-    uint32_t next; /* the next segment in the chain, or NONE */
-    uint32_t f;    /* the fan triangle waiting (its index in fan); NONE: paired */
+    uint32_t next; /* the next segment in the chain, or the next free slot */
+    uint32_t t;    /* the fan triangle waiting */
 } seg;
-typedef struct join {
-    uint32_t c, d, next;
-} join;
 
 static inline uint32_t chain_of(uint32_t v, int shift) {
     return (uint32_t)((v * 0x9E3779B97F4A7C15ull) >> shift);
 }
 
-lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, const size_t *fan, size_t nfan,
+/* Whether the triangles near t (t's fan: a fan's triangles are written one
+ * after the other, LB__MAXPOLY at most) join c and d: a flip between
+ * their fans leaves a triangle with both in each (the fans' triangles
+ * have one feature point each until a flip). */
+static int joined(const lb_mesh *M, size_t t, uint32_t c, uint32_t d) {
+    const size_t lo = t >= LB__MAXPOLY ? t - LB__MAXPOLY : 0,
+                 hi = t + LB__MAXPOLY < M->ntriangles ? t + LB__MAXPOLY : M->ntriangles;
+    for (size_t u = lo; u < hi; ++u) {
+        const uint32_t *T = M->triangles + 3 * u;
+        if ((T[0] == c || T[1] == c || T[2] == c) && (T[0] == d || T[1] == d || T[2] == d))
+            return 1;
+    }
+    return 0;
+}
+
+lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, const size_t *tr, size_t ntr,
                             lb_error *err) {
+    if (!ntr) return LB_OK;
+    if (M->ntriangles >= NONE)
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+    size_t nfan = 0;
+    for (size_t r = 0; r < ntr; ++r)
+        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t) {
+            const uint32_t *T = M->triangles + 3 * t;
+            nfan += (feat[T[0]] + feat[T[1]] + feat[T[2]]) == 1;
+        }
     if (!nfan) return LB_OK;
     int bits = 6;
-    while (((size_t)1 << bits) < nfan) ++bits;
+    while (((size_t)1 << bits) < nfan / 8) ++bits;
     const size_t nh = (size_t)1 << bits;
     const int shift = 64 - bits;
-    /* one block: the segments, the joins (at most nfan / 2 flips), the
-     * two chain heads per hash */
-    const size_t bytes =
-        nfan * sizeof(seg) + (nfan / 2 + 1) * sizeof(join) + 2 * nh * sizeof(uint32_t);
-    unsigned char *mem = nfan < NONE ? lb__huge_alloc(bytes) : NULL;
-    if (!mem) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
-    seg *segs = (seg *)(void *)mem;
-    join *joins = (join *)(void *)(mem + nfan * sizeof(seg));
-    uint32_t *head = (uint32_t *)(void *)(mem + nfan * sizeof(seg) + (nfan / 2 + 1) * sizeof(join)),
-             *jhead = head + nh;
-    memset(head, 0xff, 2 * nh * sizeof *head);
-    size_t nseg = 0, nmade = 0;
+    uint32_t *head = malloc(nh * sizeof *head);
+    size_t cap = 1024, nseg = 0;
+    seg *segs = malloc(cap * sizeof *segs);
+    if (!head || !segs) {
+        free(head);
+        free(segs);
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+    }
+    memset(head, 0xff, nh * sizeof *head);
+    uint32_t freed = NONE; /* the free slots, chained by next */
     /* in the mesh's order: a triangle is changed only when its pair comes,
      * after both were looked at */
-    for (size_t f = 0; f < nfan; ++f) {
-        uint32_t *T = M->triangles + 3 * fan[f];
-        const int k = feat[T[0]] ? 0 : feat[T[1]] ? 1 : 2;
-        const uint32_t a = T[(k + 1) % 3], b = T[(k + 2) % 3];
-        const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
-        const uint32_t h = chain_of(lo, shift);
-        uint32_t i = head[h];
-        while (i != NONE && (segs[i].a != lo || segs[i].b != hi || segs[i].f == NONE))
-            i = segs[i].next;
-        if (i == NONE) { /* the first fan triangle on this segment: wait */
-            segs[nseg] = (seg){lo, hi, head[h], (uint32_t)f};
-            head[h] = (uint32_t)nseg++;
-            continue;
+    for (size_t r = 0; r < ntr; ++r)
+        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t) {
+            uint32_t *T = M->triangles + 3 * t;
+            if ((feat[T[0]] + feat[T[1]] + feat[T[2]]) != 1) continue;
+            const int k = feat[T[0]] ? 0 : feat[T[1]] ? 1 : 2;
+            const uint32_t a = T[(k + 1) % 3], b = T[(k + 2) % 3];
+            const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
+            const uint32_t h = chain_of(lo, shift);
+            uint32_t i = head[h], *link = &head[h];
+            while (i != NONE && (segs[i].a != lo || segs[i].b != hi)) {
+                link = &segs[i].next;
+                i = segs[i].next;
+            }
+            if (i == NONE) { /* the first fan triangle on this segment: wait */
+                if (freed != NONE) {
+                    i = freed;
+                    freed = segs[i].next;
+                } else {
+                    if (nseg == cap) {
+                        seg *q = realloc(segs, 2 * cap * sizeof *segs);
+                        if (!q) {
+                            free(head);
+                            free(segs);
+                            return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+                        }
+                        segs = q;
+                        cap *= 2;
+                    }
+                    i = (uint32_t)nseg++;
+                }
+                segs[i] = (seg){lo, hi, head[h], (uint32_t)t};
+                head[h] = i;
+                continue;
+            }
+            /* the other fan on this segment: triangle (d, b, a); the
+             * segment is paired (no third triangle pairs with it) */
+            uint32_t *U = M->triangles + 3 * (size_t)segs[i].t;
+            *link = segs[i].next;
+            segs[i].next = freed;
+            freed = i;
+            const int kk = feat[U[0]] ? 0 : feat[U[1]] ? 1 : 2;
+            const uint32_t c = T[k], d = U[kk];
+            if (U[(kk + 1) % 3] != b || U[(kk + 2) % 3] != a || c == d) continue;
+            if (joined(M, t, c, d)) continue; /* c and d already joined */
+            /* flipped: (c, a, d) and (d, b, c); only where both keep their
+             * orientation (no fold) */
+            const uint32_t T1[3] = {c, a, d}, T2[3] = {d, b, c};
+            double m1[3], m2[3];
+            tri_normal(M->positions, T1, m1);
+            tri_normal(M->positions, T2, m2);
+            /* each new triangle faces the way the surface does at its
+             * vertex off the crease (a, b: on the grid edges, with the
+             * field's normals) */
+            const double *na = M->normals + 3 * (size_t)a, *nb = M->normals + 3 * (size_t)b;
+            if (!(m1[0] * na[0] + m1[1] * na[1] + m1[2] * na[2] > 0.0) ||
+                !(m2[0] * nb[0] + m2[1] * nb[1] + m2[2] * nb[2] > 0.0))
+                continue;
+            memcpy(T, T1, sizeof T1);
+            memcpy(U, T2, sizeof T2);
         }
-        /* the other fan on this segment: triangle (d, b, a) */
-        uint32_t *U = M->triangles + 3 * fan[segs[i].f];
-        segs[i].f = NONE; /* paired: no third triangle pairs with it */
-        const int kk = feat[U[0]] ? 0 : feat[U[1]] ? 1 : 2;
-        const uint32_t c = T[k], d = U[kk];
-        if (U[(kk + 1) % 3] != b || U[(kk + 2) % 3] != a || c == d) continue;
-        const uint32_t clo = c < d ? c : d, chi = c < d ? d : c, ch = chain_of(clo, shift);
-        uint32_t m = jhead[ch];
-        while (m != NONE && (joins[m].c != clo || joins[m].d != chi)) m = joins[m].next;
-        if (m != NONE) continue; /* c and d already joined */
-        /* flipped: (c, a, d) and (d, b, c); only where both keep their
-         * orientation (no fold) */
-        const uint32_t T1[3] = {c, a, d}, T2[3] = {d, b, c};
-        double m1[3], m2[3];
-        tri_normal(M->positions, T1, m1);
-        tri_normal(M->positions, T2, m2);
-        /* each new triangle faces the way the surface does at its
-         * vertex off the crease (a, b: on the grid edges, with the field's
-         * normals) */
-        const double *na = M->normals + 3 * (size_t)a, *nb = M->normals + 3 * (size_t)b;
-        if (!(m1[0] * na[0] + m1[1] * na[1] + m1[2] * na[2] > 0.0) ||
-            !(m2[0] * nb[0] + m2[1] * nb[1] + m2[2] * nb[2] > 0.0))
-            continue;
-        joins[nmade] = (join){clo, chi, jhead[ch]};
-        jhead[ch] = (uint32_t)nmade++;
-        memcpy(T, T1, sizeof T1);
-        memcpy(U, T2, sizeof T2);
-    }
-    lb__huge_free(mem, bytes);
+    free(head);
+    free(segs);
     return LB_OK;
 }
 
@@ -450,21 +485,23 @@ static size_t place_of(const uint32_t *pts, size_t n, uint32_t v) {
 }
 
 lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, uint8_t *feat,
-                             const size_t *fan, size_t nfan, int threads, lb_error *err) {
-    /* the points of folded triangles (feat 2): every triangle with a
-     * feature point is a fan, flipped or not */
+                             const size_t *tr, size_t ntr, int threads, lb__mscratch *S,
+                             lb_error *err) {
+    /* the points of folded triangles (feat 2) */
     size_t nb = 0;
-    for (size_t q = 0; q < nfan; ++q) {
-        const size_t t = fan[q];
-        if (!folded(M, feat, t)) continue;
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t v = M->triangles[3 * t + k];
-            if (feat[v] == 1) {
-                feat[v] = 2;
-                ++nb;
+    for (size_t r = 0; r < ntr; ++r)
+        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t) {
+            const uint32_t *T = M->triangles + 3 * t;
+            if (!feat[T[0]] && !feat[T[1]] && !feat[T[2]]) continue; /* no point to move */
+            if (!folded(M, feat, t)) continue;
+            for (int k = 0; k < 3; ++k) {
+                const uint32_t v = T[k];
+                if (feat[v] == 1) {
+                    feat[v] = 2;
+                    ++nb;
+                }
             }
         }
-    }
     if (!nb) return LB_OK;
     /* those points in ascending order (their rows in w) */
     uint32_t *pts = malloc(2 * nb * sizeof *pts), *mov = pts + nb;
@@ -475,29 +512,31 @@ lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh 
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
     }
     size_t k = 0;
-    for (size_t q = 0; q < nfan; ++q)
-        for (int a = 0; a < 3; ++a) {
-            const uint32_t v = M->triangles[3 * fan[q] + a];
-            if (feat[v] == 2) {
-                feat[v] = 3; /* listed */
-                pts[k++] = v;
+    for (size_t r = 0; r < ntr; ++r)
+        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t)
+            for (int a = 0; a < 3; ++a) {
+                const uint32_t v = M->triangles[3 * t + a];
+                if (feat[v] == 2) {
+                    feat[v] = 3; /* listed */
+                    pts[k++] = v;
+                }
             }
-        }
     qsort(pts, nb, sizeof *pts, by_index);
     for (size_t i = 0; i < nb; ++i) feat[pts[i]] = 2;
     double *sum = w, *cnt = w + 3 * nb, *x = w + 4 * nb, *y = x + nb, *z = y + nb, *ex = z + nb,
            *ey = ex + nb, *ez = ey + nb, *f = ez + nb, *gx = f + nb, *gy = gx + nb, *gz = gy + nb;
-    for (size_t q = 0; q < nfan; ++q) {
-        const uint32_t *T = M->triangles + 3 * fan[q];
-        for (int a = 0; a < 3; ++a) {
-            if (feat[T[a]] != 2) continue;
-            const size_t i = place_of(pts, nb, T[a]);
-            for (int b = 1; b < 3; ++b)
-                for (int d = 0; d < 3; ++d)
-                    sum[3 * i + d] += M->positions[3 * (size_t)T[(a + b) % 3] + d];
-            cnt[i] += 2.0;
+    for (size_t r = 0; r < ntr; ++r)
+        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t) {
+            const uint32_t *T = M->triangles + 3 * t;
+            for (int a = 0; a < 3; ++a) {
+                if (feat[T[a]] != 2) continue;
+                const size_t i = place_of(pts, nb, T[a]);
+                for (int b = 1; b < 3; ++b)
+                    for (int d = 0; d < 3; ++d)
+                        sum[3 * i + d] += M->positions[3 * (size_t)T[(a + b) % 3] + d];
+                cnt[i] += 2.0;
+            }
         }
-    }
     for (size_t i = 0; i < nb; ++i) {
         x[i] = sum[3 * i] / cnt[i];
         y[i] = sum[3 * i + 1] / cnt[i];
@@ -518,7 +557,9 @@ lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh 
                 mov[na++] = (uint32_t)i;
             }
         if (!na) break;
-        s = lb_evaluator_eval(ev, na, ex, ey, ez, f, gx, gy, gz, threads, err);
+        /* few points: the first thread's scratch, warm from the blocks */
+        s = na <= LB__FEW ? lb__eval_few(ev, &S->E, &S->outer, na, ex, ey, ez, f, gx, gy, gz, err)
+                          : lb_evaluator_eval(ev, na, ex, ey, ez, f, gx, gy, gz, threads, err);
         for (size_t j = 0; !s && j < na; ++j) {
             const size_t i = mov[j];
             const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[j], gy[j], gz[j]};

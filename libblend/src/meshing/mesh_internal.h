@@ -418,19 +418,19 @@ LB_INTERNAL int lb__feature_qef(const double *p, const double *n, int m, const d
                                 const double hi[3], double x[3]);
 /* Flip every cell-face segment between two fans around feature points
  * (feat[v] = 1) into the edge joining the two points, where that keeps
- * both triangles' orientation and makes no edge twice. fan lists M's
- * nfan fan triangles (exactly one corner a feature point), ascending:
- * every triangle with a feature point is one of them, before and after. */
-LB_INTERNAL lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, const size_t *fan,
-                                        size_t nfan, lb_error *err);
+ * both triangles' orientation and makes no edge twice. tr holds ntr
+ * ascending ranges of M's triangles (first, count): every triangle with a
+ * feature point lies in one, before and after. */
+LB_INTERNAL lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, const size_t *tr,
+                                        size_t ntr, lb_error *err);
 /* After the flips: a feature point with a triangle that faces against the
  * surface at each of its grid-edge vertices (a fold: a fan whose segment
  * found no neighbour to flip with) moves to the mean of its ring, put on
  * the surface by Newton steps; where those fail it stays (feat is scratch:
  * 2 marks such points while it runs, 1 again when done). */
 LB_INTERNAL lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M,
-                                         uint8_t *feat, const size_t *fan, size_t nfan, int threads,
-                                         lb_error *err);
+                                         uint8_t *feat, const size_t *tr, size_t ntr, int threads,
+                                         lb__mscratch *S, lb_error *err);
 /* M's corner_normals and nnormals (corners.c): the identity without
  * feature points (feat NULL), else split normals where a feature point's
  * triangles lie on sides of a crease. Evaluates ev with threads. */

@@ -467,10 +467,11 @@ typedef struct mstate {
     /* the feature points' vertex ranges (first, count), for the flips */
     size_t *fr;
     size_t nfr, frcap;
-    /* the fan triangles (those with exactly one feature point), ascending:
-     * the flips and the unfolding look at these alone */
-    size_t *fan;
-    size_t nfan, fancap;
+    /* the triangle ranges (first, count) of the blocks with feature
+     * points, ascending: the fans, which the flips and the unfolding look
+     * at, are among them */
+    size_t *ftr;
+    size_t nftr, ftrcap;
     /* with a cache: each block's entry, which takes its output once merged
      * (its references as offset codes, by nbr) */
     lb__cblock *keep;
@@ -1002,13 +1003,13 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
         S->fr[2 * S->nfr] = base + B->np - B->nfeat;
         S->fr[2 * S->nfr + 1] = B->nfeat;
         ++S->nfr;
-        size_t fc = S->fancap ? S->fancap : 1024;
-        while (fc < S->nfan + B->nt) fc *= 2;
-        if (!grow((void **)&S->fan, S->fancap, fc, S->nfan, sizeof *S->fan)) {
+        if (!room_for((void **)&S->ftr, &S->ftrcap, S->nftr, 2 * sizeof *S->ftr, 64)) {
             S->s = lb__fail(&S->err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
             return 0;
         }
-        S->fancap = fc;
+        S->ftr[2 * S->nftr] = M->ntriangles;
+        S->ftr[2 * S->nftr + 1] = B->nt;
+        ++S->nftr;
     }
     if (B->np) { /* a block may have no vertex (and no arrays) */
         memcpy(M->positions + 3 * base, B->vpos, 3 * B->np * sizeof(double));
@@ -1047,14 +1048,6 @@ static int merge_block(mstate *S, lb__block *B, size_t bi) {
     const uint32_t *src = B->tri;
     const size_t ni = 3 * B->nt;
     for (size_t t = 0; t < ni; ++t) T[t] = xt[src[t]];
-    if (B->nfeat) { /* the fans: one corner among the block's feature points */
-        const uint32_t f0 = np - (uint32_t)B->nfeat, nf = (uint32_t)B->nfeat;
-        for (size_t t = 0; t < B->nt; ++t) {
-            const uint32_t *q = src + 3 * t;
-            if ((q[0] - f0 < nf) + (q[1] - f0 < nf) + (q[2] - f0 < nf) == 1)
-                S->fan[S->nfan++] = M->ntriangles + t;
-        }
-    }
     M->ntriangles += B->nt;
     M->nvertices = nv;
     if (S->keep && !B->borrowed) { /* the cache takes the output */
@@ -1650,8 +1643,10 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         } else {
             for (size_t i = 0; i < R.ms.nfr; ++i)
                 memset(feat + R.ms.fr[2 * i], 1, R.ms.fr[2 * i + 1]);
-            s = lb__feature_flips(M, feat, R.ms.fan, R.ms.nfan, err);
-            if (!s) s = lb__feature_unfold(ev, &g, M, feat, R.ms.fan, R.ms.nfan, (int)nt, err);
+            s = lb__feature_flips(M, feat, R.ms.ftr, R.ms.nftr, err);
+            if (!s)
+                s = lb__feature_unfold(ev, &g, M, feat, R.ms.ftr, R.ms.nftr, (int)nt,
+                                       lb__bctx_scratch(R.ctx[0]), err);
         }
     }
     if (!s && !P.cancelled && opt->simplify > 0.0 && M->ntriangles) /* simplify.c */
@@ -1749,7 +1744,7 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     run_free(&R, RS_FIN, (void *)R.fin);
     free(R.ms.tab);
     free(R.ms.fr);
-    free(R.ms.fan);
+    free(R.ms.ftr);
     run_free(&R, RS_BASE, R.ms.base);
     free(R.ms.xt);
     pthread_mutex_destroy(&R.lock);
