@@ -21,6 +21,7 @@ PACKAGES=(
   slurm-wlm munge            # tests: batch jobs on a single-node Slurm cluster (scripts/slurm-cluster.sh)
   parallel                   # tests: batch task lists through GNU parallel
   time                       # tests: GNU time measures blendtool's peak memory (input limits)
+  valgrind                   # bench: instruction counts (callgrind) beside the timings (run_features_bench.sh)
   gcc-mingw-w64-x86-64       # the Windows DLL, cross-compiled (cmake/mingw-w64-x86_64.cmake)
   wine64                     # tests: the Windows build's test programs (scripts/wine-run.sh)
   libopenvdb-dev             # blendtool vdb: narrow-band level sets written by OpenVDB (tools/vdb, C++)

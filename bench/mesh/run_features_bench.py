@@ -9,11 +9,17 @@ in this process's run so that the machine's load hits both alike; the ratio
 of the medians of the best-of-3 times (bench_mesh). With BASE_BENCH_MESH (the
 mesher before features, built by bench/run_features_bench.sh) also that
 mesher's time in the same rounds, and the time with features against it. Then
-the sharp shapes of
+the same in one process (bench_alternate, beside BENCH_MESH: the libraries
+loaded side by side and alternated 10 x ROUNDS times at 128 cells, 3 x
+ROUNDS at 256; lower quartiles), where the drift between processes started
+seconds apart does not enter. Then the same meshings' instructions (valgrind's callgrind, counted inside
+lb_mesh_create alone): the same every run, where this shared machine's
+times move by a tenth and more between runs. Then the sharp shapes of
 tests/data/features at 64 cells: triangles with and without (the errors are
 the test's). Run by bench/run_features_bench.sh; not a test."""
 import json
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -54,6 +60,52 @@ for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spher
             extra = " %.4f | %.3f |" % (z, b / z)
         print("| %s | %d | %.4f | %.4f | %.3f | %.4f | %.3f | %d / %d |%s" %
               (name, res, a, b, b / a, c, c / a, tri[False], tri[True], extra))
+
+LIB = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(BENCH))), "libblend",
+                   "libblend.so")
+ALT = os.path.join(os.path.dirname(os.path.abspath(BENCH)), "bench_alternate")
+print()
+print("| scene | cells | rounds in one process | with / without | with corner normals / without |" +
+      (" before features / without | with / before |" if BASE else ""))
+print("|---|---|---|---|---|" + ("---|---|" if BASE else ""))
+for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spheres.json")):
+    scene = os.path.join(SRC, "scenes", f)
+    for res in (128, 256):
+        n = (10 if res == 128 else 3) * ROUNDS
+        confs = [LIB + "@0", LIB + "@4", LIB + "@12"]
+        if BASE:
+            confs.append(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(BASE))),
+                                      "libblend", "libblend.so") + "@0")
+        out = subprocess.run([ALT, scene, str(res), str(n)] + confs, check=True,
+                             capture_output=True, text=True).stdout
+        q = [json.loads(line)["ratio_q25"] for line in out.strip().splitlines()]
+        extra = " %.3f | %.3f |" % (q[3], q[1] / q[3]) if BASE else ""
+        print("| %s | %d | %d | %.3f | %.3f |%s" % (name, res, n, q[1], q[2], extra))
+
+
+def instructions(scene, res, features):
+    """instructions per lb_mesh_create (bench_mesh makes 3)"""
+    args = [BASE if features == "base" else BENCH, scene, str(res), "1"] + (
+        ["--features"] if features is True else [])
+    r = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
+                        "--toggle-collect=lb_mesh_create"] + args,
+                       check=True, capture_output=True, text=True)
+    return int(re.search(r"Collected : (\d+)", r.stderr).group(1)) / 3
+
+
+print()
+print("| scene | cells | instructions without | with | with / without |" +
+      (" before features | with / before |" if BASE else ""))
+print("|---|---|---|---|---|" + ("---|---|" if BASE else ""))
+for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spheres.json")):
+    scene = os.path.join(SRC, "scenes", f)
+    for res in (128, 256):
+        a, b = instructions(scene, res, False), instructions(scene, res, True)
+        extra = ""
+        if BASE:
+            z = instructions(scene, res, "base")
+            extra = " %.1f M | %.3f |" % (z / 1e6, b / z)
+        print("| %s | %d | %.1f M | %.1f M | %.3f |%s" % (name, res, a / 1e6, b / 1e6, b / a, extra))
 print()
 print("| shape | cells | triangles without | triangles with |")
 print("|---|---|---|---|")
