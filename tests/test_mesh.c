@@ -1202,6 +1202,21 @@ static void fit_on_plane(unsigned long long *s, const double *K, const double *n
     for (int d = 0; d < 3; ++d) p[d] = K[d] + t * (u[d] - un * n[d]);
 }
 
+/* The fit's moments about c for m points and normals: A = sum n n^T and
+ * g = sum n (n . (p - c)), added to A and g. */
+static void fit_moments(const double *P, const double *N, int m, const double *c, double A[3][3],
+                        double g[3]) {
+    for (int q = 0; q < m; ++q) {
+        const double *nq = N + 3 * q, *pq = P + 3 * q;
+        double r = 0.0;
+        for (int d = 0; d < 3; ++d) r += nq[d] * (pq[d] - c[d]);
+        for (int d = 0; d < 3; ++d) {
+            g[d] += nq[d] * r;
+            for (int e = 0; e < 3; ++e) A[d][e] += nq[d] * nq[e];
+        }
+    }
+}
+
 /* The largest eigenvalue of the symmetric A and its unit vector, by power
  * iteration from v (not orthogonal to it); enough steps for the vector to
  * settle when the next eigenvalue is within 3 % of it. */
@@ -1298,15 +1313,7 @@ static void test_feature_fit(void **state) {
             for (int d = 0; d < 3; ++d) c[d] += P[3 * q + d] / m3;
         }
         assert_true(acos(fmin(1.0, fit_dot(N, n0))) < 3.0 * M_PI / 180.0);
-        for (int q = 0; q < m3; ++q) {
-            const double *nq = N + 3 * q, *pq = P + 3 * q;
-            double r = 0.0;
-            for (int d = 0; d < 3; ++d) r += nq[d] * (pq[d] - c[d]);
-            for (int d = 0; d < 3; ++d) {
-                g[d] += nq[d] * r;
-                for (int e = 0; e < 3; ++e) A[d][e] += nq[d] * nq[e];
-            }
-        }
+        fit_moments(P, N, m3, c, A, g);
         double v[3] = {n0[0], n0[1], n0[2]};
         const double w1 = fit_power(A, v);
         assert_int_equal(lb__feature_qef(P, N, m3, lo, hi, x), 1);
@@ -1331,15 +1338,7 @@ static void test_feature_fit(void **state) {
             fit_on_plane(&s, K, nn[q % 2], 0.5, P + 3 * q);
             for (int d = 0; d < 3; ++d) c[d] += P[3 * q + d] / m5;
         }
-        for (int q = 0; q < m5; ++q) {
-            const double *nq = N + 3 * q, *pq = P + 3 * q;
-            double r = 0.0;
-            for (int d = 0; d < 3; ++d) r += nq[d] * (pq[d] - c[d]);
-            for (int d = 0; d < 3; ++d) {
-                h[d] += nq[d] * r;
-                for (int e = 0; e < 3; ++e) B3[d][e] += nq[d] * nq[e];
-            }
-        }
+        fit_moments(P, N, m5, c, B3, h);
         const double tr = B3[0][0] + B3[1][1] + B3[2][2];
         double C3[3][3], v1[3] = {a[0] + b[0], a[1] + b[1], a[2] + b[2]},
                          v3[3] = {t[0], t[1], t[2]}, v2[3];

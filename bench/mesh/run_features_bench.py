@@ -39,28 +39,36 @@ def run(scene, res, features):
 
 
 KINDS = (False, True, "corners") + (("base",) if BASE else ())
+
+
+def cases():
+    """(name, scene path, cells) of every row: S1 and S2 at 128 and 256 cells"""
+    for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spheres.json")):
+        for res in (128, 256):
+            yield name, os.path.join(SRC, "scenes", f), res
+
+
 print("| scene | cells | without (s) | with (s) | with / without | with corner normals (s) "
       "| corners / without | triangles without / with |" +
       (" before features (s) | with / before |" if BASE else ""))
 print("|---|---|---|---|---|---|---|---|" + ("---|---|" if BASE else ""))
-for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spheres.json")):
-    scene = os.path.join(SRC, "scenes", f)
-    for res in (128, 256):
-        t = {k: [] for k in KINDS}
-        tri = {}
-        for _ in range(ROUNDS):
-            for feat in KINDS:
-                r = run(scene, res, feat)
-                t[feat].append(r["seconds"])
-                tri[feat] = r["triangles"]
-        a, b, c = (statistics.median(t[k]) for k in (False, True, "corners"))
-        extra = ""
-        if BASE:
-            z = statistics.median(t["base"])
-            extra = " %.4f | %.3f |" % (z, b / z)
-        print("| %s | %d | %.4f | %.4f | %.3f | %.4f | %.3f | %d / %d |%s" %
-              (name, res, a, b, b / a, c, c / a, tri[False], tri[True], extra))
+for name, scene, res in cases():
+    t = {k: [] for k in KINDS}
+    tri = {}
+    for _ in range(ROUNDS):
+        for feat in KINDS:
+            r = run(scene, res, feat)
+            t[feat].append(r["seconds"])
+            tri[feat] = r["triangles"]
+    a, b, c = (statistics.median(t[k]) for k in (False, True, "corners"))
+    extra = ""
+    if BASE:
+        z = statistics.median(t["base"])
+        extra = " %.4f | %.3f |" % (z, b / z)
+    print("| %s | %d | %.4f | %.4f | %.3f | %.4f | %.3f | %d / %d |%s" %
+          (name, res, a, b, b / a, c, c / a, tri[False], tri[True], extra))
 
+# the same in one process: bench_alternate beside bench_mesh, the library beside it
 LIB = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(BENCH))), "libblend",
                    "libblend.so")
 ALT = os.path.join(os.path.dirname(os.path.abspath(BENCH)), "bench_alternate")
@@ -68,19 +76,17 @@ print()
 print("| scene | cells | rounds in one process | with / without | with corner normals / without |" +
       (" before features / without | with / before |" if BASE else ""))
 print("|---|---|---|---|---|" + ("---|---|" if BASE else ""))
-for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spheres.json")):
-    scene = os.path.join(SRC, "scenes", f)
-    for res in (128, 256):
-        n = (10 if res == 128 else 3) * ROUNDS
-        confs = [LIB + "@0", LIB + "@4", LIB + "@12"]
-        if BASE:
-            confs.append(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(BASE))),
-                                      "libblend", "libblend.so") + "@0")
-        out = subprocess.run([ALT, scene, str(res), str(n)] + confs, check=True,
-                             capture_output=True, text=True).stdout
-        q = [json.loads(line)["ratio_q25"] for line in out.strip().splitlines()]
-        extra = " %.3f | %.3f |" % (q[3], q[1] / q[3]) if BASE else ""
-        print("| %s | %d | %d | %.3f | %.3f |%s" % (name, res, n, q[1], q[2], extra))
+for name, scene, res in cases():
+    n = (10 if res == 128 else 3) * ROUNDS
+    confs = [LIB + "@0", LIB + "@4", LIB + "@12"]
+    if BASE:
+        confs.append(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(BASE))),
+                                  "libblend", "libblend.so") + "@0")
+    out = subprocess.run([ALT, scene, str(res), str(n)] + confs, check=True,
+                         capture_output=True, text=True).stdout
+    q = [json.loads(line)["ratio_q25"] for line in out.strip().splitlines()]
+    extra = " %.3f | %.3f |" % (q[3], q[1] / q[3]) if BASE else ""
+    print("| %s | %d | %d | %.3f | %.3f |%s" % (name, res, n, q[1], q[2], extra))
 
 
 def instructions(scene, res, features):
@@ -97,15 +103,13 @@ print()
 print("| scene | cells | instructions without | with | with / without |" +
       (" before features | with / before |" if BASE else ""))
 print("|---|---|---|---|---|" + ("---|---|" if BASE else ""))
-for name, f in (("S1", "bench-s1-three-spheres.json"), ("S2", "bench-s2-64-spheres.json")):
-    scene = os.path.join(SRC, "scenes", f)
-    for res in (128, 256):
-        a, b = instructions(scene, res, False), instructions(scene, res, True)
-        extra = ""
-        if BASE:
-            z = instructions(scene, res, "base")
-            extra = " %.1f M | %.3f |" % (z / 1e6, b / z)
-        print("| %s | %d | %.1f M | %.1f M | %.3f |%s" % (name, res, a / 1e6, b / 1e6, b / a, extra))
+for name, scene, res in cases():
+    a, b = instructions(scene, res, False), instructions(scene, res, True)
+    extra = ""
+    if BASE:
+        z = instructions(scene, res, "base")
+        extra = " %.1f M | %.3f |" % (z / 1e6, b / z)
+    print("| %s | %d | %.1f M | %.1f M | %.3f |%s" % (name, res, a / 1e6, b / 1e6, b / a, extra))
 print()
 print("| shape | cells | triangles without | triangles with |")
 print("|---|---|---|---|")
