@@ -5,22 +5,40 @@
  * lb_output, whose unnamed temporary file vanishes with the process; from
  * bt_signals_commit on the output is being put in place and the signals are
  * held, so an output is either complete or absent. blendtool is a program,
- * not the library: this state is its own. */
+ * not the library: this state is its own.
+ *
+ * The mask holds the signals for the thread that sets it, not for threads
+ * already running: the C++ modules (OpenVDB's TBB workers, OpenImageIO's
+ * pool) keep threads after their call returns, with the mask of the time they
+ * were made, and the kernel may hand a signal to any of them, also after the
+ * commit. So the handler and the commit also agree through one atomic phase:
+ * whichever of them moves it first from running wins. A handler that finds
+ * the output being put in place returns (the run ends as if the signal had
+ * come after it); a commit that finds a handler ending the process waits for
+ * that end. */
 #define _POSIX_C_SOURCE 200809L
 #include "blendtool.h"
 
 #include <signal.h>
+#include <stdatomic.h>
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #define MAX_TEMPS 12
 
-static volatile sig_atomic_t child_pid = 0, worker_pid = 0;
+/* lock-free, so the handler may use them (C11 7.14.1.1) */
+_Static_assert(ATOMIC_INT_LOCK_FREE == 2, "blendtool's signal handler needs lock-free atomics");
+
+enum { RUNNING, COMMITTING, ENDING };
+static atomic_int phase = RUNNING;
+/* atomics, not volatile: the handler may run on another thread than the one
+ * that registers a name, and must see the name before its flag */
+static atomic_int child_pid = 0, worker_pid = 0;
 static char temps[MAX_TEMPS][4096 + 640];
-static volatile sig_atomic_t temp_used[MAX_TEMPS];
+static atomic_int temp_used[MAX_TEMPS];
 static char temp_dir[4096];
-static volatile sig_atomic_t temp_dir_used = 0;
+static atomic_int temp_dir_used = 0;
 
 static void say(const char *s) {
     ssize_t w = write(STDERR_FILENO, s, strlen(s));
@@ -28,14 +46,22 @@ static void say(const char *s) {
 }
 
 static void on_signal(int sig) {
-    const pid_t pids[2] = {(pid_t)child_pid, (pid_t)worker_pid};
+    int was = RUNNING;
+    if (!atomic_compare_exchange_strong(&phase, &was, ENDING)) {
+        /* COMMITTING: the output is going in place and the run ends with it;
+         * ENDING: another thread's handler is ending the process */
+        if (was == ENDING)
+            for (;;) pause();
+        return;
+    }
+    const pid_t pids[2] = {(pid_t)atomic_load(&child_pid), (pid_t)atomic_load(&worker_pid)};
     for (int i = 0; i < 2; ++i)
         if (pids[i] > 0) kill(pids[i], SIGTERM);
     for (int i = 0; i < 2; ++i)
         if (pids[i] > 0) waitpid(pids[i], NULL, 0);
     for (int i = 0; i < MAX_TEMPS; ++i)
-        if (temp_used[i]) unlink(temps[i]);
-    if (temp_dir_used) rmdir(temp_dir);
+        if (atomic_load(&temp_used[i])) unlink(temps[i]);
+    if (atomic_load(&temp_dir_used)) rmdir(temp_dir);
     say(sig == SIGINT    ? "\nblendtool: interrupted (SIGINT); no output was written\n"
         : sig == SIGTERM ? "blendtool: terminated (SIGTERM); no output was written\n"
                          : "blendtool: hung up (SIGHUP); no output was written\n");
@@ -82,10 +108,10 @@ int bt_signals_temp(const char *path) {
     hold(&old);
     int slot = -1;
     for (int i = 0; i < MAX_TEMPS && slot < 0; ++i)
-        if (!temp_used[i] && strlen(path) < sizeof temps[i]) slot = i;
+        if (!atomic_load(&temp_used[i]) && strlen(path) < sizeof temps[i]) slot = i;
     if (slot >= 0) {
         strcpy(temps[slot], path);
-        temp_used[slot] = 1;
+        atomic_store(&temp_used[slot], 1);
     }
     restore(&old);
     return slot;
@@ -95,29 +121,32 @@ void bt_signals_untemp(int slot) {
     if (slot < 0 || slot >= MAX_TEMPS) return;
     sigset_t old;
     hold(&old);
-    temp_used[slot] = 0;
+    atomic_store(&temp_used[slot], 0);
     restore(&old);
 }
 
 void bt_signals_temp_dir(const char *dir) {
     sigset_t old;
     hold(&old);
-    temp_dir_used = 0;
+    atomic_store(&temp_dir_used, 0);
     if (dir && strlen(dir) < sizeof temp_dir) {
         strcpy(temp_dir, dir);
-        temp_dir_used = 1;
+        atomic_store(&temp_dir_used, 1);
     }
     restore(&old);
 }
 
 void bt_signals_child(pid_t pid) {
-    child_pid = pid;
+    atomic_store(&child_pid, (int)pid);
 }
 
 void bt_signals_worker(pid_t pid) {
-    worker_pid = pid;
+    atomic_store(&worker_pid, (int)pid);
 }
 
 void bt_signals_commit(void) {
     hold(NULL);
+    int was = RUNNING;
+    if (!atomic_compare_exchange_strong(&phase, &was, COMMITTING) && was == ENDING)
+        for (;;) pause(); /* a handler on another thread removes the output and exits */
 }

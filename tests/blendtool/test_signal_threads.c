@@ -1,0 +1,222 @@
+/* blendtool's signal handling (tools/blendtool/signals.c) when the kernel
+ * hands the signal to a thread other than the main one. The C++ modules
+ * blendtool loads keep worker threads after their call returns (OpenVDB's
+ * TBB pool, made while `blendtool vdb` writes), with the signal mask of the
+ * time they were made: bt_signals_commit's mask does not cover them. A
+ * signal reaching one of them while the output is put in place must not end
+ * the run with 128 + N and the output there; one reaching it before must
+ * end the run as on the main thread, and a commit that meets a handler
+ * already ending the run must not put the output in place.
+ *
+ * Each case runs in a child process (the handler exits it); the parent
+ * checks its exit status and what it left. */
+#define _POSIX_C_SOURCE 200809L
+#include "blendtool.h"
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+
+#include <cmocka.h>
+
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+static char dir[256];
+static char temp[300], marker[300];
+
+static void nap(double s) {
+    struct timespec t = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
+    while (nanosleep(&t, &t) && errno == EINTR) {
+    }
+}
+
+static int exists(const char *p) {
+    struct stat st;
+    return lstat(p, &st) == 0;
+}
+
+static void touch(const char *p) {
+    const int fd = open(p, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    if (fd >= 0) close(fd);
+}
+
+/* a worker like TBB's: made while the signals are open, sleeping in the
+ * kernel when the signal comes (the handler runs on it, then it wakes) */
+static void *worker(void *arg) {
+    (void)arg;
+    struct timespec t = {0, 300000000L};
+    nanosleep(&t, NULL); /* ends early when the handler runs here */
+    return NULL;
+}
+
+/* runs fn in a child; returns its exit status (or 1000 + a killing signal) */
+static int in_child(void (*fn)(void)) {
+    fflush(NULL);
+    const pid_t pid = fork();
+    if (pid == 0) {
+        fn();
+        _exit(0);
+    }
+    int st = 0;
+    while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+    }
+    return WIFEXITED(st) ? WEXITSTATUS(st) : 1000 + WTERMSIG(st);
+}
+
+static void setup_files(void) {
+    unlink(temp);
+    unlink(marker);
+    touch(temp);
+}
+
+/* ---- a signal on a worker thread before the commit: the run ends ---- */
+
+static void before_commit(void) {
+    bt_signals_install();
+    bt_signals_temp(temp);
+    pthread_t t;
+    pthread_create(&t, NULL, worker, NULL);
+    nap(0.05);
+    pthread_kill(t, SIGHUP);
+    pthread_join(t, NULL);
+    nap(2.0); /* the handler exits the process long before */
+    touch(marker);
+}
+
+static void test_thread_before_commit(void **state) {
+    (void)state;
+    setup_files();
+    const int rc = in_child(before_commit);
+    assert_int_equal(rc, 128 + SIGHUP);
+    assert_false(exists(temp)); /* the handler removed the registered file */
+    assert_false(exists(marker));
+}
+
+/* ---- a signal on a worker thread while the output goes in place ---- */
+
+static void after_commit(void) {
+    bt_signals_install();
+    const int slot = bt_signals_temp(temp);
+    pthread_t t;
+    pthread_create(&t, NULL, worker, NULL);
+    nap(0.05);
+    bt_signals_commit();
+    pthread_kill(t, SIGTERM);
+    pthread_join(t, NULL); /* the handler has run on the worker */
+    /* as bt_output_commit: the temporary file is the output now */
+    bt_signals_untemp(slot);
+    touch(marker);
+}
+
+static void test_thread_after_commit(void **state) {
+    (void)state;
+    setup_files();
+    const int rc = in_child(after_commit);
+    /* before signals.c's phase, the handler ran on the worker and exited
+     * 143 with the output already there */
+    assert_int_equal(rc, 0);
+    assert_true(exists(temp));
+    assert_true(exists(marker));
+}
+
+/* ---- the same on the main thread: held, and dropped at exit ---- */
+
+static void main_after_commit(void) {
+    bt_signals_install();
+    bt_signals_temp(temp);
+    bt_signals_commit();
+    raise(SIGINT);
+    nap(0.1);
+    touch(marker);
+}
+
+static void test_main_after_commit(void **state) {
+    (void)state;
+    setup_files();
+    assert_int_equal(in_child(main_after_commit), 0);
+    assert_true(exists(temp));
+    assert_true(exists(marker));
+}
+
+/* ---- a commit while a worker's handler is ending the run ---- */
+
+/* a child process that takes 0.6 s to end after SIGTERM, so that the
+ * handler (which ends and waits for it first) is still running when the
+ * main thread reaches the commit */
+static void slow_term(int sig) {
+    (void)sig;
+    struct timespec t = {0, 600000000L};
+    nanosleep(&t, NULL);
+    _exit(0);
+}
+
+static void commit_meets_handler(void) {
+    int ready[2];
+    if (pipe(ready)) _exit(90);
+    const pid_t slow = fork();
+    if (slow == 0) {
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = slow_term;
+        sigaction(SIGTERM, &sa, NULL);
+        close(ready[0]);
+        if (write(ready[1], "x", 1) != 1) _exit(91);
+        for (;;) pause();
+    }
+    char c;
+    close(ready[1]);
+    if (read(ready[0], &c, 1) != 1) _exit(92);
+    bt_signals_install();
+    bt_signals_temp(temp);
+    bt_signals_child(slow);
+    pthread_t t;
+    pthread_create(&t, NULL, worker, NULL);
+    nap(0.05);
+    pthread_kill(t, SIGHUP);
+    nap(0.2); /* the handler is waiting for the slow child */
+    bt_signals_commit();
+    /* reached only if the commit went on: the output would be put in
+     * place while the handler removes it and exits 129 */
+    touch(marker);
+    _exit(0);
+}
+
+static void test_commit_meets_handler(void **state) {
+    (void)state;
+    setup_files();
+    const int rc = in_child(commit_meets_handler);
+    assert_int_equal(rc, 128 + SIGHUP);
+    assert_false(exists(temp));
+    assert_false(exists(marker));
+}
+
+int main(void) {
+    snprintf(dir, sizeof dir, "%s/lb-signal-threads-XXXXXX",
+             getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
+    if (!mkdtemp(dir)) {
+        perror(dir);
+        return 1;
+    }
+    snprintf(temp, sizeof temp, "%s/out.lbtmp", dir);
+    snprintf(marker, sizeof marker, "%s/went-on", dir);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_thread_before_commit),
+        cmocka_unit_test(test_thread_after_commit),
+        cmocka_unit_test(test_main_after_commit),
+        cmocka_unit_test(test_commit_meets_handler),
+    };
+    const int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    unlink(temp);
+    unlink(marker);
+    rmdir(dir);
+    return failed;
+}
