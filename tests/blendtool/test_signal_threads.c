@@ -149,19 +149,22 @@ static void test_main_after_commit(void **state) {
 
 /* ---- a commit while a worker's handler is ending the run ---- */
 
-/* a child process that takes 0.6 s to end after SIGTERM, so that the
- * handler (which ends and waits for it first) is still running when the
- * main thread reaches the commit */
+/* a child process that says when SIGTERM came (the handler has taken the
+ * phase by then: it ends the child first), then takes 0.6 s to end, so the
+ * handler is still waiting for it when the main thread reaches the commit */
+static int term_came = -1;
+
 static void slow_term(int sig) {
     (void)sig;
+    if (write(term_came, "t", 1) != 1) _exit(93);
     struct timespec t = {0, 600000000L};
     nanosleep(&t, NULL);
     _exit(0);
 }
 
 static void commit_meets_handler(void) {
-    int ready[2];
-    if (pipe(ready)) _exit(90);
+    int ready[2], came[2];
+    if (pipe(ready) || pipe(came)) _exit(90);
     const pid_t slow = fork();
     if (slow == 0) {
         struct sigaction sa;
@@ -169,11 +172,14 @@ static void commit_meets_handler(void) {
         sa.sa_handler = slow_term;
         sigaction(SIGTERM, &sa, NULL);
         close(ready[0]);
+        close(came[0]);
+        term_came = came[1];
         if (write(ready[1], "x", 1) != 1) _exit(91);
         for (;;) pause();
     }
     char c;
     close(ready[1]);
+    close(came[1]);
     if (read(ready[0], &c, 1) != 1) _exit(92);
     bt_signals_install();
     bt_signals_temp(temp);
@@ -182,7 +188,8 @@ static void commit_meets_handler(void) {
     pthread_create(&t, NULL, worker, NULL);
     nap(0.05);
     pthread_kill(t, SIGHUP);
-    nap(0.2); /* the handler is waiting for the slow child */
+    /* the handler is ending the run (whatever the machine's load) */
+    if (read(came[0], &c, 1) != 1) _exit(94);
     bt_signals_commit();
     /* reached only if the commit went on: the output would be put in
      * place while the handler removes it and exits 129 */
