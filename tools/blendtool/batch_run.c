@@ -282,7 +282,7 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
         } else if ((s = lb_level_set_create(ev, &o, &ls, &e))) {
             rc = bt_fail(CMD, J->scenes[T->scene], s, &e);
         } else if (!(rc = bt_vdb_bytes(CMD, J->scenes[T->scene], ls, J->vdb_blender, scene_hash,
-                                       T->sets, T->nsets, &bytes, &len))) {
+                                       T->sets, T->nsets, o.threads, &bytes, &len))) {
             rc = hashed_bytes(full, bytes, len, hexes[k]);
         }
         free(bytes);

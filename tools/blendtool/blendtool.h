@@ -293,20 +293,21 @@ int bt_wants_help(int argc, char **argv);
 #include "lbvdb.h"
 
 typedef struct bt_vdb {
-    int (*write_level_set)(const lb_level_set *ls, double shift, const lbv_meta *meta, size_t nmeta,
-                           const char *uuid_seed, unsigned char **data, size_t *size, char *err,
-                           size_t errlen);
+    int (*level_set_file)(const lb_level_set *ls, double shift, const lbv_meta *meta, size_t nmeta,
+                          const char *uuid_seed, unsigned threads, unsigned char **data,
+                          size_t *size, char *err, size_t errlen);
 } bt_vdb;
 /* The OpenVDB functions, or NULL after printing why they cannot be loaded. */
 const bt_vdb *bt_vdb_get(const char *cmd);
 /* The .vdb file of a level set (malloc'd bytes in *data), its grids carrying
  * the scene's hash, libblend's version, the voxel size, band and voxel
  * centres and the --set paths; blender: voxel centres placed for Blender
- * (the transform moved by half a voxel down each axis). An exit code, after
+ * (the transform moved by half a voxel down each axis); threads: OpenVDB's
+ * threads (the command's --threads: 0 one per CPU). An exit code, after
  * printing why. */
 int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls, int blender,
-                 const uint64_t hash[2], const bt_set *sets, size_t nsets, unsigned char **data,
-                 size_t *size);
+                 const uint64_t hash[2], const bt_set *sets, size_t nsets, unsigned threads,
+                 unsigned char **data, size_t *size);
 /* --bounds "x0,y0,z0,x1,y1,z1" (commas or spaces) into bmin, bmax: 0, or
  * BT_EXIT_BAD_INPUT after saying what is expected */
 int bt_bounds_arg(const char *cmd, const char *text, double bmin[3], double bmax[3]);

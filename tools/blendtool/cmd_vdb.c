@@ -21,10 +21,10 @@ const bt_vdb *bt_vdb_get(const char *cmd) {
     char why[3 * (PATH_MAX + 64) + 512];
     void *h = bt_module_open("LIBBLEND_VDB", "liblbvdb.so", "OpenVDB module", why, sizeof why);
     if (h) {
-        api.write_level_set =
-            (int (*)(const lb_level_set *, double, const lbv_meta *, size_t, const char *,
-                     unsigned char **, size_t *, char *, size_t))dlsym(h, "lbv_write_level_set");
-        if (!api.write_level_set) {
+        api.level_set_file =
+            (int (*)(const lb_level_set *, double, const lbv_meta *, size_t, const char *, unsigned,
+                     unsigned char **, size_t *, char *, size_t))dlsym(h, "lbv_level_set_file");
+        if (!api.level_set_file) {
             snprintf(why, sizeof why,
                      "the OpenVDB module liblbvdb.so lacks its functions (not the one built "
                      "with this blendtool)");
@@ -156,8 +156,8 @@ static int parse_args(int argc, char **argv, vdb_args *A) {
 }
 
 int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls, int blender,
-                 const uint64_t hash[2], const bt_set *sets, size_t nsets, unsigned char **data,
-                 size_t *size) {
+                 const uint64_t hash[2], const bt_set *sets, size_t nsets, unsigned threads,
+                 unsigned char **data, size_t *size) {
     const bt_vdb *V = bt_vdb_get(cmd);
     if (!V) return BT_EXIT_INTERNAL;
     char hex[33], settings[160], params[4096], err[1024] = "";
@@ -174,7 +174,8 @@ int bt_vdb_bytes(const char *cmd, const char *scene_path, const lb_level_set *ls
                               {"libblend:version", BT_VERSION},
                               {"libblend:level_set", settings},
                               {"libblend:parameters", params}};
-    if (V->write_level_set(ls, blender ? -0.5 : 0.0, meta, 4, hex, data, size, err, sizeof err)) {
+    if (V->level_set_file(ls, blender ? -0.5 : 0.0, meta, 4, hex, threads, data, size, err,
+                          sizeof err)) {
         bt_error(cmd, "%s: writing the level set failed: %s", scene_path, err);
         return BT_EXIT_INTERNAL;
     }
@@ -210,7 +211,8 @@ static int run(int argc, char **argv) {
         rc = bt_fail(CMD, A.scene_path, s, &e);
         goto done;
     }
-    if ((rc = bt_vdb_bytes(CMD, A.scene_path, ls, A.blender, hash, A.sets, A.nsets, &bytes, &len)))
+    if ((rc = bt_vdb_bytes(CMD, A.scene_path, ls, A.blender, hash, A.sets, A.nsets, A.o.threads,
+                           &bytes, &len)))
         goto done;
     clock_gettime(CLOCK_MONOTONIC, &t1);
     if (fwrite(bytes, 1, len, w.f) != len) {

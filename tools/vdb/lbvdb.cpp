@@ -4,6 +4,7 @@
 #include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/SignedFloodFill.h>
+#include <tbb/task_arena.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -82,14 +83,10 @@ bool set_uuid(std::string &bytes, const char *seed) {
 
 } // namespace
 
-extern "C" int lbv_write_level_set(const lb_level_set *ls, double shift, const lbv_meta *meta,
-                                   size_t nmeta, const char *uuid_seed, unsigned char **data,
-                                   size_t *size, char *err, size_t errlen) {
-    *data = nullptr;
-    *size = 0;
+static int file_bytes(const lb_level_set *ls, double shift, const lbv_meta *meta, size_t nmeta,
+                      const char *uuid_seed, unsigned char **data, size_t *size, char *err,
+                      size_t errlen) {
     try {
-        static std::once_flag once;
-        std::call_once(once, [] { openvdb::initialize(); });
         const float bg = ls->background;
         openvdb::GridPtrVec grids;
         auto surface =
@@ -153,4 +150,27 @@ extern "C" int lbv_write_level_set(const lb_level_set *ls, double shift, const l
         say(err, errlen, "OpenVDB failed");
     }
     return -1;
+}
+
+extern "C" int lbv_level_set_file(const lb_level_set *ls, double shift, const lbv_meta *meta,
+                                  size_t nmeta, const char *uuid_seed, unsigned threads,
+                                  unsigned char **data, size_t *size, char *err, size_t errlen) {
+    *data = nullptr;
+    *size = 0;
+    int rc = -1;
+    try {
+        static std::once_flag once;
+        std::call_once(once, [] { openvdb::initialize(); });
+        // OpenVDB's threaded steps (the flood fill) run on TBB's workers: in
+        // an arena of the caller's count (1: the calling thread alone, no
+        // worker made), one per CPU for 0
+        tbb::task_arena arena(threads ? static_cast<int>(threads) : tbb::task_arena::automatic);
+        arena.execute(
+            [&] { rc = file_bytes(ls, shift, meta, nmeta, uuid_seed, data, size, err, errlen); });
+    } catch (const std::exception &e) {
+        say(err, errlen, e.what());
+    } catch (...) {
+        say(err, errlen, "OpenVDB failed");
+    }
+    return rc;
 }

@@ -34,10 +34,12 @@ typedef struct lbv_meta {
  * shift: added to every voxel's world position, in voxels on each axis (0:
  * voxel (i, j, k) at (i h, j h, k h), OpenVDB's and Houdini's reading;
  * -0.5: where Blender, which puts a voxel's centre at index + 1/2, shows it
- * at (i h, j h, k h)). */
-int lbv_write_level_set(const lb_level_set *ls, double shift, const lbv_meta *meta, size_t nmeta,
-                        const char *uuid_seed, unsigned char **data, size_t *size, char *err,
-                        size_t errlen);
+ * at (i h, j h, k h)). threads: OpenVDB's threads for the call (its TBB
+ * workers), 0 for one per CPU; 1 makes no thread. The bytes are the same for
+ * every count. */
+int lbv_level_set_file(const lb_level_set *ls, double shift, const lbv_meta *meta, size_t nmeta,
+                       const char *uuid_seed, unsigned threads, unsigned char **data, size_t *size,
+                       char *err, size_t errlen);
 
 #ifdef __cplusplus
 }
