@@ -63,8 +63,11 @@ int bt_parse_long(const char *cmd, const char *option, const char *text, long lo
                   const char *what, long *out);
 
 /* Parse a thread count (0 = all CPUs). Returns 0 or prints an error and
- * returns -1. */
+ * returns -1. The last count parsed (or set: a job's threads) is also the
+ * image module's (bt_threads_asked: 0 when none was given). */
 int bt_parse_threads(const char *cmd, const char *text, int *threads);
+void bt_threads_set(int n);
+int bt_threads_asked(void);
 
 /* The folder of the running executable (from /proc/self/exe) into out;
  * -1 when unknown or longer than n. */
@@ -246,6 +249,7 @@ typedef struct bt_imageio {
     int (*write_pixels)(const float *rgb, int w, int h, const lbi_text *texts, size_t ntexts,
                         lbi_format format, const lbi_meta *meta, size_t nmeta, unsigned char **data,
                         size_t *size, char *err, size_t errlen);
+    void (*set_threads)(int n);
 } bt_imageio;
 
 /* A module of blendtool's (a C++ library behind a C interface, file

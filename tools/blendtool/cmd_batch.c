@@ -336,6 +336,7 @@ static int run(int argc, char **argv) {
     job J;
     if ((rc = batch_parse_job(&J, o.file))) goto done;
     if (o.threads >= 0) J.threads = o.threads;
+    bt_threads_set(J.threads); /* the image and OpenVDB modules' too */
     const size_t nt = batch_ntasks_of(&J);
     if (nt > MAX_TASKS) {
         rc = batch_bad(&J, "$", "%zu tasks (scenes x sweep values x frames); allowed: at most %d",

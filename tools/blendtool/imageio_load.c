@@ -61,13 +61,17 @@ const bt_imageio *bt_imageio_try(char *why, size_t whylen) {
     api.write_pixels =
         (int (*)(const float *, int, int, const lbi_text *, size_t, lbi_format, const lbi_meta *,
                  size_t, unsigned char **, size_t *, char *, size_t))dlsym(h, "lbi_write_pixels");
-    if (!api.convert || !api.contact_sheet || !api.compare || !api.write_pixels) {
+    api.set_threads = (void (*)(int))dlsym(h, "lbi_set_threads");
+    if (!api.convert || !api.contact_sheet || !api.compare || !api.write_pixels ||
+        !api.set_threads) {
         snprintf(why, whylen,
                  "the image module liblbimageio.so lacks its functions (not the one built "
                  "with this blendtool)");
         dlclose(h);
         return NULL;
     }
+    /* the command's --threads binds OpenImageIO's and OpenEXR's pools too */
+    api.set_threads(bt_threads_asked());
     loaded = 1;
     return &api;
 }

@@ -92,12 +92,23 @@ int bt_parse_long(const char *cmd, const char *option, const char *text, long lo
     return 0;
 }
 
+static int threads_asked; /* the command's --threads (one command a process) */
+
 int bt_parse_threads(const char *cmd, const char *text, int *threads) {
     long v = 0;
     if (bt_parse_long(cmd, "--threads", text, 0, 1024, "an integer (0: one per CPU)", &v))
         return -1;
     *threads = (int)v;
+    threads_asked = (int)v;
     return 0;
+}
+
+void bt_threads_set(int n) {
+    threads_asked = n;
+}
+
+int bt_threads_asked(void) {
+    return threads_asked;
 }
 
 int bt_self_dir(char *out, size_t n) {

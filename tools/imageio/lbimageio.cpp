@@ -150,6 +150,13 @@ extern "C" int lbi_contact_sheet(const char *const *images, const char *const *l
     return write_buf(sheet, format, meta, nmeta, data, size, err, errlen);
 }
 
+extern "C" void lbi_set_threads(int n) {
+    // OpenImageIO's pool: the caller plus n - 1 workers (0: one per CPU)
+    OIIO::attribute("threads", n);
+    // OpenEXR's pool: -1 none (the calling thread), 0 one per CPU, else n
+    OIIO::attribute("exr_threads", n == 1 ? -1 : n);
+}
+
 extern "C" int lbi_write_pixels(const float *rgb, int w, int h, const lbi_text *texts,
                                 size_t ntexts, lbi_format format, const lbi_meta *meta,
                                 size_t nmeta, unsigned char **data, size_t *size, char *err,

@@ -23,6 +23,11 @@ typedef enum lbi_format {
     LBI_EXR_FLOAT, /* OpenEXR, 32-bit floats, zip compression */
 } lbi_format;
 
+/* The threads OpenImageIO and OpenEXR may use for the process's later calls
+ * (their pools are the process's): 0 one per CPU (their default), 1 the
+ * calling thread alone, n at most n. Call before the first image. */
+void lbi_set_threads(int n);
+
 /* one metadata entry: PNG text chunks, EXR string attributes */
 typedef struct lbi_meta {
     const char *key, *value;
