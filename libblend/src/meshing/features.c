@@ -321,6 +321,13 @@ int lb__feature_qef(const double *p, const double *n, int m, const double lo[3],
     return 1;
 }
 
+/* Every triangle t of the ranges tr (ntr pairs: first triangle, count) that
+ * the merge recorded for the blocks with feature points, in the mesh's
+ * order. */
+#define FOR_RANGE_TRIANGLES(t, tr, ntr)                                                            \
+    for (size_t r_ = 0; r_ < (ntr); ++r_)                                                          \
+        for (size_t t = (tr)[2 * r_]; t < (tr)[2 * r_] + (tr)[2 * r_ + 1]; ++t)
+
 static void tri_normal(const double *P, const uint32_t *t, double nrm[3]) {
     lb__facing(P + 3 * (size_t)t[0], P + 3 * (size_t)t[1], P + 3 * (size_t)t[2], nrm);
 }
@@ -362,15 +369,13 @@ lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, const size_t *tr, s
     if (!ntr) return LB_OK;
     if (M->ntriangles >= NONE)
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
-    size_t nfan = 0;
-    for (size_t r = 0; r < ntr; ++r)
-        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t) {
-            const uint32_t *T = M->triangles + 3 * t;
-            nfan += (feat[T[0]] + feat[T[1]] + feat[T[2]]) == 1;
-        }
-    if (!nfan) return LB_OK;
+    /* chain heads for a sixteenth of the ranges' triangles, counted from
+     * the ranges without a pass over the triangles: a chain's length
+     * decides how fast a segment is found, never which */
+    size_t ntri = 0;
+    for (size_t r = 0; r < ntr; ++r) ntri += tr[2 * r + 1];
     int bits = 6;
-    while (((size_t)1 << bits) < nfan / 8) ++bits;
+    while (((size_t)1 << bits) < ntri / 16) ++bits;
     const size_t nh = (size_t)1 << bits;
     const int shift = 64 - bits;
     uint32_t *head = malloc(nh * sizeof *head);
@@ -385,66 +390,65 @@ lb_status lb__feature_flips(lb_mesh *M, const uint8_t *feat, const size_t *tr, s
     uint32_t freed = NONE; /* the free slots, chained by next */
     /* in the mesh's order: a triangle is changed only when its pair comes,
      * after both were looked at */
-    for (size_t r = 0; r < ntr; ++r)
-        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t) {
-            uint32_t *T = M->triangles + 3 * t;
-            if ((feat[T[0]] + feat[T[1]] + feat[T[2]]) != 1) continue;
-            const int k = feat[T[0]] ? 0 : feat[T[1]] ? 1 : 2;
-            const uint32_t a = T[(k + 1) % 3], b = T[(k + 2) % 3];
-            const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
-            const uint32_t h = chain_of(lo, shift);
-            uint32_t i = head[h], *link = &head[h];
-            while (i != NONE && (segs[i].a != lo || segs[i].b != hi)) {
-                link = &segs[i].next;
-                i = segs[i].next;
-            }
-            if (i == NONE) { /* the first fan triangle on this segment: wait */
-                if (freed != NONE) {
-                    i = freed;
-                    freed = segs[i].next;
-                } else {
-                    if (nseg == cap) {
-                        seg *q = realloc(segs, 2 * cap * sizeof *segs);
-                        if (!q) {
-                            free(head);
-                            free(segs);
-                            return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
-                        }
-                        segs = q;
-                        cap *= 2;
-                    }
-                    i = (uint32_t)nseg++;
-                }
-                segs[i] = (seg){lo, hi, head[h], (uint32_t)t};
-                head[h] = i;
-                continue;
-            }
-            /* the other fan on this segment: triangle (d, b, a); the
-             * segment is paired (no third triangle pairs with it) */
-            uint32_t *U = M->triangles + 3 * (size_t)segs[i].t;
-            *link = segs[i].next;
-            segs[i].next = freed;
-            freed = i;
-            const int kk = feat[U[0]] ? 0 : feat[U[1]] ? 1 : 2;
-            const uint32_t c = T[k], d = U[kk];
-            if (U[(kk + 1) % 3] != b || U[(kk + 2) % 3] != a || c == d) continue;
-            if (joined(M, t, c, d)) continue; /* c and d already joined */
-            /* flipped: (c, a, d) and (d, b, c); only where both keep their
-             * orientation (no fold) */
-            const uint32_t T1[3] = {c, a, d}, T2[3] = {d, b, c};
-            double m1[3], m2[3];
-            tri_normal(M->positions, T1, m1);
-            tri_normal(M->positions, T2, m2);
-            /* each new triangle faces the way the surface does at its
-             * vertex off the crease (a, b: on the grid edges, with the
-             * field's normals) */
-            const double *na = M->normals + 3 * (size_t)a, *nb = M->normals + 3 * (size_t)b;
-            if (!(m1[0] * na[0] + m1[1] * na[1] + m1[2] * na[2] > 0.0) ||
-                !(m2[0] * nb[0] + m2[1] * nb[1] + m2[2] * nb[2] > 0.0))
-                continue;
-            memcpy(T, T1, sizeof T1);
-            memcpy(U, T2, sizeof T2);
+    FOR_RANGE_TRIANGLES(t, tr, ntr) {
+        uint32_t *T = M->triangles + 3 * t;
+        if ((feat[T[0]] + feat[T[1]] + feat[T[2]]) != 1) continue;
+        const int k = feat[T[0]] ? 0 : feat[T[1]] ? 1 : 2;
+        const uint32_t a = T[(k + 1) % 3], b = T[(k + 2) % 3];
+        const uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
+        const uint32_t h = chain_of(lo, shift);
+        uint32_t i = head[h], *link = &head[h];
+        while (i != NONE && (segs[i].a != lo || segs[i].b != hi)) {
+            link = &segs[i].next;
+            i = segs[i].next;
         }
+        if (i == NONE) { /* the first fan triangle on this segment: wait */
+            if (freed != NONE) {
+                i = freed;
+                freed = segs[i].next;
+            } else {
+                if (nseg == cap) {
+                    seg *q = realloc(segs, 2 * cap * sizeof *segs);
+                    if (!q) {
+                        free(head);
+                        free(segs);
+                        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+                    }
+                    segs = q;
+                    cap *= 2;
+                }
+                i = (uint32_t)nseg++;
+            }
+            segs[i] = (seg){lo, hi, head[h], (uint32_t)t};
+            head[h] = i;
+            continue;
+        }
+        /* the other fan on this segment: triangle (d, b, a); the
+         * segment is paired (no third triangle pairs with it) */
+        uint32_t *U = M->triangles + 3 * (size_t)segs[i].t;
+        *link = segs[i].next;
+        segs[i].next = freed;
+        freed = i;
+        const int kk = feat[U[0]] ? 0 : feat[U[1]] ? 1 : 2;
+        const uint32_t c = T[k], d = U[kk];
+        if (U[(kk + 1) % 3] != b || U[(kk + 2) % 3] != a || c == d) continue;
+        if (joined(M, t, c, d)) continue; /* c and d already joined */
+        /* flipped: (c, a, d) and (d, b, c); only where both keep their
+         * orientation (no fold) */
+        const uint32_t T1[3] = {c, a, d}, T2[3] = {d, b, c};
+        double m1[3], m2[3];
+        tri_normal(M->positions, T1, m1);
+        tri_normal(M->positions, T2, m2);
+        /* each new triangle faces the way the surface does at its
+         * vertex off the crease (a, b: on the grid edges, with the
+         * field's normals) */
+        const double *na = M->normals + 3 * (size_t)a, *nb = M->normals + 3 * (size_t)b;
+        if (!(m1[0] * na[0] + m1[1] * na[1] + m1[2] * na[2] > 0.0) ||
+            !(m2[0] * nb[0] + m2[1] * nb[1] + m2[2] * nb[2] > 0.0))
+            continue;
+        memcpy(T, T1, sizeof T1);
+        memcpy(U, T2, sizeof T2);
+    }
     free(head);
     free(segs);
     return LB_OK;
@@ -487,56 +491,52 @@ static size_t place_of(const uint32_t *pts, size_t n, uint32_t v) {
 lb_status lb__feature_unfold(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, uint8_t *feat,
                              const size_t *tr, size_t ntr, int threads, lb__mscratch *S,
                              lb_error *err) {
-    /* the points of folded triangles (feat 2) */
-    size_t nb = 0;
-    for (size_t r = 0; r < ntr; ++r)
-        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t) {
-            const uint32_t *T = M->triangles + 3 * t;
-            if (!feat[T[0]] && !feat[T[1]] && !feat[T[2]]) continue; /* no point to move */
-            if (!folded(M, feat, t)) continue;
-            for (int k = 0; k < 3; ++k) {
-                const uint32_t v = T[k];
-                if (feat[v] == 1) {
-                    feat[v] = 2;
-                    ++nb;
+    /* the points of folded triangles (feat 2), listed as they are marked
+     * (twice as many slots: the second half lists the moving ones later) */
+    size_t nb = 0, cap = 0;
+    uint32_t *pts = NULL;
+    FOR_RANGE_TRIANGLES(t, tr, ntr) {
+        const uint32_t *T = M->triangles + 3 * t;
+        if (!feat[T[0]] && !feat[T[1]] && !feat[T[2]]) continue; /* no point to move */
+        if (!folded(M, feat, t)) continue;
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = T[k];
+            if (feat[v] != 1) continue;
+            if (2 * nb + 2 > cap) {
+                cap = cap ? 2 * cap : 64;
+                uint32_t *q = realloc(pts, cap * sizeof *pts);
+                if (!q) {
+                    free(pts);
+                    return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
                 }
+                pts = q;
             }
+            feat[v] = 2;
+            pts[nb++] = v;
         }
+    }
     if (!nb) return LB_OK;
-    /* those points in ascending order (their rows in w) */
-    uint32_t *pts = malloc(2 * nb * sizeof *pts), *mov = pts + nb;
+    /* in ascending order (their rows in w) */
+    qsort(pts, nb, sizeof *pts, by_index);
+    uint32_t *mov = pts + nb;
     double *w = calloc(15 * nb, sizeof *w); /* ring sum, count, points, then eval arrays */
-    if (!pts || !w) {
+    if (!w) {
         free(pts);
-        free(w);
         return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
     }
-    size_t k = 0;
-    for (size_t r = 0; r < ntr; ++r)
-        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t)
-            for (int a = 0; a < 3; ++a) {
-                const uint32_t v = M->triangles[3 * t + a];
-                if (feat[v] == 2) {
-                    feat[v] = 3; /* listed */
-                    pts[k++] = v;
-                }
-            }
-    qsort(pts, nb, sizeof *pts, by_index);
-    for (size_t i = 0; i < nb; ++i) feat[pts[i]] = 2;
     double *sum = w, *cnt = w + 3 * nb, *x = w + 4 * nb, *y = x + nb, *z = y + nb, *ex = z + nb,
            *ey = ex + nb, *ez = ey + nb, *f = ez + nb, *gx = f + nb, *gy = gx + nb, *gz = gy + nb;
-    for (size_t r = 0; r < ntr; ++r)
-        for (size_t t = tr[2 * r]; t < tr[2 * r] + tr[2 * r + 1]; ++t) {
-            const uint32_t *T = M->triangles + 3 * t;
-            for (int a = 0; a < 3; ++a) {
-                if (feat[T[a]] != 2) continue;
-                const size_t i = place_of(pts, nb, T[a]);
-                for (int b = 1; b < 3; ++b)
-                    for (int d = 0; d < 3; ++d)
-                        sum[3 * i + d] += M->positions[3 * (size_t)T[(a + b) % 3] + d];
-                cnt[i] += 2.0;
-            }
+    FOR_RANGE_TRIANGLES(t, tr, ntr) {
+        const uint32_t *T = M->triangles + 3 * t;
+        for (int a = 0; a < 3; ++a) {
+            if (feat[T[a]] != 2) continue;
+            const size_t i = place_of(pts, nb, T[a]);
+            for (int b = 1; b < 3; ++b)
+                for (int d = 0; d < 3; ++d)
+                    sum[3 * i + d] += M->positions[3 * (size_t)T[(a + b) % 3] + d];
+            cnt[i] += 2.0;
         }
+    }
     for (size_t i = 0; i < nb; ++i) {
         x[i] = sum[3 * i] / cnt[i];
         y[i] = sum[3 * i + 1] / cnt[i];
