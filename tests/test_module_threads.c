@@ -61,9 +61,9 @@ static size_t new_threads(const long *before, size_t nb, const long *after, size
     return k;
 }
 
-/* In a child: load the module, then (threads) do the work, write the bytes
- * to fd and the count of threads the work left to *made (through the exit
- * status: 100 + made, or < 100 on a failure). */
+/* In a child: load the module, do the work with `threads`, write the bytes
+ * to fd and exit with 100 + the number of threads the work left alive
+ * (below 100: a failure, said on stderr). */
 static void child_vdb(unsigned threads, int fd) {
     lb_error e = {LB_OK, ""};
     lb_scene *sc = NULL;
