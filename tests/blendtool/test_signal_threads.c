@@ -6,7 +6,10 @@
  * signal reaching one of them while the output is put in place must not end
  * the run with 128 + N and the output there; one reaching it before must
  * end the run as on the main thread, and a commit that meets a handler
- * already ending the run must not put the output in place.
+ * already ending the run must not put the output in place. `batch` goes on
+ * after each output: there a signal that came during a commit ends the run
+ * once the output is in place, and the work after it runs with the signals
+ * open.
  *
  * Each case runs in a child process (the handler exits it); the parent
  * checks its exit status and what it left. */
@@ -31,7 +34,7 @@
 #include <unistd.h>
 
 static char dir[256];
-static char temp[300], marker[300];
+static char temp[300], marker[300], after[300];
 
 static void nap(double s) {
     struct timespec t = {(time_t)s, (long)((s - (double)(time_t)s) * 1e9)};
@@ -75,6 +78,7 @@ static int in_child(void (*fn)(void)) {
 static void setup_files(void) {
     unlink(temp);
     unlink(marker);
+    unlink(after);
     touch(temp);
 }
 
@@ -206,6 +210,79 @@ static void test_commit_meets_handler(void **state) {
     assert_false(exists(marker));
 }
 
+/* ---- batch: the run goes on after an output, so a signal that came during
+ * its commit ends the run once the output is in place ---- */
+
+static void going_on_worker(void) {
+    bt_signals_install();
+    bt_signals_going_on();
+    const int slot = bt_signals_temp(temp);
+    pthread_t t;
+    pthread_create(&t, NULL, worker, NULL);
+    nap(0.05);
+    bt_signals_commit();
+    pthread_kill(t, SIGTERM);
+    pthread_join(t, NULL);
+    bt_signals_untemp(slot);
+    touch(marker); /* the output is in place */
+    bt_signals_reopen();
+    touch(after); /* the next task: never reached */
+}
+
+static void test_going_on_worker(void **state) {
+    (void)state;
+    setup_files();
+    /* before bt_signals_reopen, batch held the signals after its first
+     * output to the end of the job */
+    assert_int_equal(in_child(going_on_worker), 128 + SIGTERM);
+    assert_true(exists(temp));
+    assert_true(exists(marker));
+    assert_false(exists(after));
+}
+
+static void going_on_main(void) {
+    bt_signals_install();
+    bt_signals_going_on();
+    bt_signals_temp(temp);
+    bt_signals_commit();
+    raise(SIGHUP); /* held on this thread */
+    touch(marker);
+    bt_signals_reopen();
+    touch(after);
+}
+
+static void test_going_on_main(void **state) {
+    (void)state;
+    setup_files();
+    assert_int_equal(in_child(going_on_main), 128 + SIGHUP);
+    assert_true(exists(marker));
+    assert_false(exists(after));
+}
+
+/* going on with no signal: the next output's work runs with the signals
+ * open (a signal then ends the run, removing the next temporary file) */
+static void going_on_then_signal(void) {
+    bt_signals_install();
+    bt_signals_going_on();
+    const int slot = bt_signals_temp(marker);
+    bt_signals_commit();
+    bt_signals_untemp(slot);
+    bt_signals_reopen();
+    bt_signals_temp(temp); /* the next output */
+    raise(SIGINT);
+    touch(after);
+}
+
+static void test_going_on_then_signal(void **state) {
+    (void)state;
+    setup_files();
+    touch(marker);
+    assert_int_equal(in_child(going_on_then_signal), 128 + SIGINT);
+    assert_true(exists(marker));
+    assert_false(exists(temp));
+    assert_false(exists(after));
+}
+
 int main(void) {
     snprintf(dir, sizeof dir, "%s/lb-signal-threads-XXXXXX",
              getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp");
@@ -215,15 +292,17 @@ int main(void) {
     }
     snprintf(temp, sizeof temp, "%s/out.lbtmp", dir);
     snprintf(marker, sizeof marker, "%s/went-on", dir);
+    snprintf(after, sizeof after, "%s/went-on-after", dir);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_thread_before_commit),
-        cmocka_unit_test(test_thread_after_commit),
-        cmocka_unit_test(test_main_after_commit),
-        cmocka_unit_test(test_commit_meets_handler),
+        cmocka_unit_test(test_thread_before_commit), cmocka_unit_test(test_thread_after_commit),
+        cmocka_unit_test(test_main_after_commit),    cmocka_unit_test(test_commit_meets_handler),
+        cmocka_unit_test(test_going_on_worker),      cmocka_unit_test(test_going_on_main),
+        cmocka_unit_test(test_going_on_then_signal),
     };
     const int failed = cmocka_run_group_tests(tests, NULL, NULL);
     unlink(temp);
     unlink(marker);
+    unlink(after);
     rmdir(dir);
     return failed;
 }

@@ -12,6 +12,7 @@ by the next render.
 
 usage: test_signals.py BLENDTOOL SOURCE_DIR WORK_DIR
 """
+import json
 import os
 import random
 import shutil
@@ -196,6 +197,73 @@ def kill_case(name, args_of, out_name, named, trials=5):
         fail(f"kill render: stale render folders not removed: {os.listdir(env['TMPDIR'])}")
 
 
+def batch_case():
+    """blendtool batch goes on after each output, so a signal must end it at
+    once there too (a farm's scheduler sends SIGTERM on a cancel or a time
+    limit): 128 + the signal, the outputs finished before it whole (the
+    bytes of an undisturbed run), nothing partial, and a rerun completes the
+    job with the same bytes. Before 2026-12-05 the first output's commit held
+    the signals for good and the job ran to its end."""
+    global checked
+    d = fresh("batch")
+    env = env_for(d, False)
+
+    def job(name):
+        path = os.path.join(d, name + ".json")
+        with open(path, "w") as f:
+            json.dump({"format": "libblend-job", "version": 1, "name": "m", "scene": S2,
+                       "sweep": [{"path": "root.args[0].radius",
+                                  "range": {"from": 0.2, "to": 0.3, "count": 24}}],
+                       "outputs": {"mesh": {"format": "ply", "resolution": 160}},
+                       "output_dir": os.path.join(d, name)}, f)
+        return path
+
+    def plys(folder):
+        return sorted(f for f in os.listdir(folder) if f.endswith(".ply"))
+
+    ref_job = job("ref")
+    duration = timed(["batch", ref_job, "--threads", "1"], env)
+    ref_dir = os.path.join(d, "ref")
+    ref = {f: open(os.path.join(ref_dir, f), "rb").read() for f in plys(ref_dir)}
+    if len(ref) != 24:
+        fail(f"batch: the undisturbed run wrote {len(ref)} meshes, want 24")
+    n = 0
+    for sig in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT):
+        for lo, hi in ((0.15, 0.4), (0.4, 0.8)):
+            n += 1
+            name = f"run{n}"
+            path = job(name)
+            out = os.path.join(d, name)
+            delay = duration * rng.uniform(lo, hi)
+            t = time.monotonic()
+            rc, delivered, err = run(["batch", path, "--threads", "1"], env, sig=sig, delay=delay)
+            took = time.monotonic() - t
+            label = f"batch {sig.name} at {delay:.2f} s of {duration:.2f} s"
+            if not delivered:
+                continue
+            checked += 1
+            if rc != 128 + sig:
+                fail(f"{label}: exit status {rc} after {took:.2f} s, want {128 + sig}: {err}")
+            got = plys(out) if os.path.isdir(out) else []
+            for f in got:
+                if open(os.path.join(out, f), "rb").read() != ref.get(f):
+                    fail(f"{label}: {f} is not the undisturbed run's")
+            if not got or len(got) == 24:
+                print(f"{label}: {len(got)} meshes before the signal")
+            hidden = [os.path.join(r, f) for r, _, fs in os.walk(out) for f in fs
+                      if "lbtmp" in f] if os.path.isdir(out) else []
+            if hidden:
+                fail(f"{label}: temporary files left: {hidden}")
+            if os.listdir(env["TMPDIR"]):
+                fail(f"{label}: left in TMPDIR: {os.listdir(env['TMPDIR'])}")
+            rc, _, err = run(["batch", path, "--threads", "1"], env)
+            done = {f: open(os.path.join(out, f), "rb").read() for f in plys(out)}
+            if rc != 0 or done != ref:
+                fail(f"{label}: the rerun gave {rc} and {len(done)} meshes "
+                     f"({sum(done.get(f) == ref[f] for f in ref)} the undisturbed bytes): {err}")
+    print(f"batch: {n} signalled runs during a {duration:.2f} s job, each resumed")
+
+
 def main():
     os.makedirs(WORK, exist_ok=True)
     points = os.path.join(WORK, "points.txt")
@@ -231,6 +299,7 @@ def main():
                   "mesh.obj", named)
     kill_case("render", lambda o: ["render", S1, "-o", o, "--width", "160", "--height", "120",
                                    "--threads", "1"], "image.png", False)
+    batch_case()
     print(f"{checked} signalled runs checked")
     if checked < 60:
         fail(f"only {checked} signalled runs checked (want >= 60)")

@@ -156,6 +156,11 @@ void bt_signals_temp_dir(const char *dir); /* NULL: none */
 void bt_signals_child(pid_t pid);          /* 0: none */
 void bt_signals_worker(pid_t pid);         /* a second child (the Blender worker); 0: none */
 void bt_signals_commit(void);              /* hold the signals from here to exit */
+/* batch: the signals open again after each output (bt_signals_reopen, which
+ * bt_output_commit calls), and a signal that came during the commit ends the
+ * run there, the output complete */
+void bt_signals_going_on(void);
+void bt_signals_reopen(void); /* nothing unless bt_signals_going_on was called */
 
 /* ---- rendering (cmd_pov.c) ---- */
 

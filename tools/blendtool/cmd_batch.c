@@ -330,6 +330,7 @@ static int run_tasks(const job *J, const batch_opts *o, size_t lo, size_t hi, co
 }
 
 static int run(int argc, char **argv) {
+    bt_signals_going_on(); /* a signal ends the job between outputs, not after the last */
     batch_opts o;
     int rc = parse_options(argc, argv, &o);
     if (rc) return rc;

@@ -178,8 +178,7 @@ int bt_output_open(const char *cmd, const char *path, bt_out *out) {
     return BT_EXIT_OK;
 }
 
-int bt_output_commit(const char *cmd, bt_out *out) {
-    bt_signals_commit();
+static int commit(const char *cmd, bt_out *out) {
     if (!out->o) {
         if (fflush(out->f) != 0 || ferror(out->f)) {
             bt_error(cmd, "writing to standard output failed: %s", strerror(errno));
@@ -196,6 +195,13 @@ int bt_output_commit(const char *cmd, bt_out *out) {
         return BT_EXIT_INTERNAL;
     }
     return BT_EXIT_OK;
+}
+
+int bt_output_commit(const char *cmd, bt_out *out) {
+    bt_signals_commit();
+    const int rc = commit(cmd, out);
+    bt_signals_reopen(); /* batch: the signals open again, the output in place */
+    return rc;
 }
 
 void bt_output_discard(bt_out *out) {

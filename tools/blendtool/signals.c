@@ -15,7 +15,12 @@
  * whichever of them moves it first from running wins. A handler that finds
  * the output being put in place returns (the run ends as if the signal had
  * come after it); a commit that finds a handler ending the process waits for
- * that end. */
+ * that end.
+ *
+ * A command that writes one output holds the signals from its commit to its
+ * exit. `batch` goes on after each output (the next task), so it calls
+ * bt_signals_going_on: its commits end with bt_signals_reopen, which opens
+ * the signals again and ends the run with a signal that came meanwhile. */
 #define _POSIX_C_SOURCE 200809L
 #include "blendtool.h"
 
@@ -32,6 +37,9 @@ _Static_assert(ATOMIC_INT_LOCK_FREE == 2, "blendtool's signal handler needs lock
 
 enum { RUNNING, COMMITTING, ENDING };
 static atomic_int phase = RUNNING;
+static atomic_int pending = 0;  /* a signal that came while an output went in place */
+static atomic_int going_on = 0; /* more work follows an output (batch) */
+static sigset_t before_commit;  /* the main thread's mask before the commit held it */
 /* atomics, not volatile: the handler may run on another thread than the one
  * that registers a name, and must see the name before its flag */
 static atomic_int child_pid = 0, worker_pid = 0;
@@ -48,10 +56,12 @@ static void say(const char *s) {
 static void on_signal(int sig) {
     int was = RUNNING;
     if (!atomic_compare_exchange_strong(&phase, &was, ENDING)) {
-        /* COMMITTING: the output is going in place and the run ends with it;
-         * ENDING: another thread's handler is ending the process */
+        /* ENDING: another thread's handler is ending the process;
+         * COMMITTING: the output goes in place first, then the run ends
+         * with it (or, going on, at bt_signals_reopen) */
         if (was == ENDING)
             for (;;) pause();
+        atomic_store(&pending, sig);
         return;
     }
     const pid_t pids[2] = {(pid_t)atomic_load(&child_pid), (pid_t)atomic_load(&worker_pid)};
@@ -62,9 +72,17 @@ static void on_signal(int sig) {
     for (int i = 0; i < MAX_TEMPS; ++i)
         if (atomic_load(&temp_used[i])) unlink(temps[i]);
     if (atomic_load(&temp_dir_used)) rmdir(temp_dir);
-    say(sig == SIGINT    ? "\nblendtool: interrupted (SIGINT); no output was written\n"
-        : sig == SIGTERM ? "blendtool: terminated (SIGTERM); no output was written\n"
-                         : "blendtool: hung up (SIGHUP); no output was written\n");
+    if (atomic_load(&going_on))
+        say(sig == SIGINT    ? "\nblendtool: interrupted (SIGINT); the outputs finished before it "
+                               "are kept, nothing partial is left\n"
+            : sig == SIGTERM ? "blendtool: terminated (SIGTERM); the outputs finished before it "
+                               "are kept, nothing partial is left\n"
+                             : "blendtool: hung up (SIGHUP); the outputs finished before it are "
+                               "kept, nothing partial is left\n");
+    else
+        say(sig == SIGINT    ? "\nblendtool: interrupted (SIGINT); no output was written\n"
+            : sig == SIGTERM ? "blendtool: terminated (SIGTERM); no output was written\n"
+                             : "blendtool: hung up (SIGHUP); no output was written\n");
     _exit(128 + sig);
 }
 
@@ -145,8 +163,23 @@ void bt_signals_worker(pid_t pid) {
 }
 
 void bt_signals_commit(void) {
-    hold(NULL);
+    sigset_t old;
+    hold(&old);
     int was = RUNNING;
-    if (!atomic_compare_exchange_strong(&phase, &was, COMMITTING) && was == ENDING)
+    if (atomic_compare_exchange_strong(&phase, &was, COMMITTING))
+        before_commit = old;
+    else if (was == ENDING)
         for (;;) pause(); /* a handler on another thread removes the output and exits */
+}
+
+void bt_signals_going_on(void) {
+    atomic_store(&going_on, 1);
+}
+
+void bt_signals_reopen(void) {
+    int was = COMMITTING;
+    if (!atomic_load(&going_on) || !atomic_compare_exchange_strong(&phase, &was, RUNNING)) return;
+    const int sig = atomic_exchange(&pending, 0);
+    restore(&before_commit); /* one held on this thread arrives here */
+    if (sig) raise(sig);     /* one that reached another thread meanwhile */
 }
