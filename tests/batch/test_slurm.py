@@ -2,7 +2,9 @@
 """blendtool batch on a real Slurm cluster (single node, this machine):
 an 8-task job in 4 array tasks gives the same bytes as a local run; an
 array task killed mid-render leaves nothing corrupt, and resubmitting the
-same script redoes only its unfinished task; the same for a job rendered by
+same script redoes only its unfinished task; an array task cancelled with
+scancel (SIGTERM) ends within seconds with its finished outputs whole, and
+the resubmission does the rest; the same kill for a job rendered by
 Blender workers (8 tasks in 2 array tasks, one killed while its Blender
 renders: the Blender goes with it).
 
@@ -186,6 +188,54 @@ try:
     check(redone == [5], "the resubmission redid only the killed task: %s" % redone)
     check({k: v for k, v in digest(kout).items() if k != "farm_sheet.png"} == kref,
           "and every output now equals the reference")
+
+    # scancel (a farm's cancel; a time limit does the same): Slurm sends
+    # SIGTERM to the array task's processes, and its blendtool must end at
+    # once, its finished outputs whole, not run its remaining tasks (until
+    # 2026-12-05 the first output's commit held the signals to the job's end,
+    # so a cancelled array task ran on until KillWait's SIGKILL)
+    dc, jc = job_in("cancel", slow)
+    r = subprocess.run([BT, "batch", jc, "--slurm", "--array-size", "1"], capture_output=True,
+                       text=True)
+    script = r.stdout.strip()
+    check(r.returncode == 0, "cancel: batch --slurm writes the script: " + r.stderr[-500:])
+    sub = subprocess.run(["sbatch", "--parsable", script], capture_output=True, text=True,
+                         timeout=60)
+    jobid = sub.stdout.strip().split(";")[0]
+    check(sub.returncode == 0 and jobid.isdigit(), "cancel: submitted: %r %r" % (sub.stdout, sub.stderr))
+    clog = os.path.join(dc, "out", "logs", "farm_shard_0.jsonl")
+    deadline, pids = time.time() + 300, []
+    while time.time() < deadline and not pids:
+        if os.path.exists(clog) and any(json.loads(l)["event"] == "task_start" and
+                                        json.loads(l)["task"] == 2
+                                        for l in open(clog) if l.strip()):
+            for pid in subprocess.run(["pgrep", "-f", "--", "--shard 0/1"], capture_output=True,
+                                      text=True).stdout.split():
+                st = proc_stat(pid)
+                if st:
+                    pids.append((pid, st[1]))
+        else:
+            time.sleep(0.05)
+    check(pids, "cancel: the array task reached its third task")
+    t = time.time()
+    subprocess.run(["scancel", jobid], timeout=60)
+    while time.time() - t < 60 and any(proc_state(q, s0) not in (None, "Z", "X") for q, s0 in pids):
+        time.sleep(0.05)
+    ended = time.time() - t
+    print("cancel: the array task's blendtool ended %.2f s after scancel" % ended)
+    check(ended < 10, "cancel: the array task's blendtool ended %.2f s after scancel (want < 10 s; "
+          "Slurm's SIGKILL would come at 30)" % ended)
+    cout = os.path.join(dc, "out")
+    done = [json.loads(l)["task"] for l in open(clog)
+            if '"task_end"' in l and json.loads(l)["status"] == "done"]
+    check(2 <= len(done) < 8, "cancel: it stopped partway (tasks done: %s)" % done)
+    for n, h in digest(cout).items():
+        check(kref.get(n) == h, "after scancel, %s is complete (the reference's bytes)" % n)
+    r, redone = resubmit(script, cout, 1)
+    check(r.returncode == 0 and sorted(redone) == [k for k in range(8) if k not in done],
+          "cancel: the resubmission did the rest: %s (%s)" % (redone, r.stderr[-300:]))
+    check({k: v for k, v in digest(cout).items() if k != "farm_sheet.png"} == kref,
+          "cancel: and every output now equals the reference")
 
     # A Blender job (outputs.image.renderer "blender"): 8 tasks in 2 array
     # tasks, each running one worker Blender; array task 1 is killed while
