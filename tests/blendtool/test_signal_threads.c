@@ -75,11 +75,17 @@ static int in_child(void (*fn)(void)) {
     return WIFEXITED(st) ? WEXITSTATUS(st) : 1000 + WTERMSIG(st);
 }
 
-static void setup_files(void) {
+/* Runs fn in a child (the registered file made first) and checks its exit
+ * status and which of the files it left; no case reaches `after`. */
+static void expect(void (*fn)(void), int rc, int temp_left, int marker_left) {
     unlink(temp);
     unlink(marker);
     unlink(after);
     touch(temp);
+    assert_int_equal(in_child(fn), rc);
+    assert_int_equal(exists(temp), temp_left);
+    assert_int_equal(exists(marker), marker_left);
+    assert_false(exists(after));
 }
 
 /* ---- a signal on a worker thread before the commit: the run ends ---- */
@@ -98,11 +104,8 @@ static void before_commit(void) {
 
 static void test_thread_before_commit(void **state) {
     (void)state;
-    setup_files();
-    const int rc = in_child(before_commit);
-    assert_int_equal(rc, 128 + SIGHUP);
-    assert_false(exists(temp)); /* the handler removed the registered file */
-    assert_false(exists(marker));
+    /* the handler removed the registered file */
+    expect(before_commit, 128 + SIGHUP, 0, 0);
 }
 
 /* ---- a signal on a worker thread while the output goes in place ---- */
@@ -123,13 +126,9 @@ static void after_commit(void) {
 
 static void test_thread_after_commit(void **state) {
     (void)state;
-    setup_files();
-    const int rc = in_child(after_commit);
     /* before signals.c's phase, the handler ran on the worker and exited
      * 143 with the output already there */
-    assert_int_equal(rc, 0);
-    assert_true(exists(temp));
-    assert_true(exists(marker));
+    expect(after_commit, 0, 1, 1);
 }
 
 /* ---- the same on the main thread: held, and dropped at exit ---- */
@@ -145,10 +144,7 @@ static void main_after_commit(void) {
 
 static void test_main_after_commit(void **state) {
     (void)state;
-    setup_files();
-    assert_int_equal(in_child(main_after_commit), 0);
-    assert_true(exists(temp));
-    assert_true(exists(marker));
+    expect(main_after_commit, 0, 1, 1);
 }
 
 /* ---- a commit while a worker's handler is ending the run ---- */
@@ -203,11 +199,7 @@ static void commit_meets_handler(void) {
 
 static void test_commit_meets_handler(void **state) {
     (void)state;
-    setup_files();
-    const int rc = in_child(commit_meets_handler);
-    assert_int_equal(rc, 128 + SIGHUP);
-    assert_false(exists(temp));
-    assert_false(exists(marker));
+    expect(commit_meets_handler, 128 + SIGHUP, 0, 0);
 }
 
 /* ---- batch: the run goes on after an output, so a signal that came during
@@ -231,13 +223,9 @@ static void going_on_worker(void) {
 
 static void test_going_on_worker(void **state) {
     (void)state;
-    setup_files();
     /* before bt_signals_reopen, batch held the signals after its first
      * output to the end of the job */
-    assert_int_equal(in_child(going_on_worker), 128 + SIGTERM);
-    assert_true(exists(temp));
-    assert_true(exists(marker));
-    assert_false(exists(after));
+    expect(going_on_worker, 128 + SIGTERM, 1, 1);
 }
 
 static void going_on_main(void) {
@@ -253,15 +241,13 @@ static void going_on_main(void) {
 
 static void test_going_on_main(void **state) {
     (void)state;
-    setup_files();
-    assert_int_equal(in_child(going_on_main), 128 + SIGHUP);
-    assert_true(exists(marker));
-    assert_false(exists(after));
+    expect(going_on_main, 128 + SIGHUP, 0, 1);
 }
 
 /* going on with no signal: the next output's work runs with the signals
  * open (a signal then ends the run, removing the next temporary file) */
 static void going_on_then_signal(void) {
+    touch(marker); /* the output before */
     bt_signals_install();
     bt_signals_going_on();
     const int slot = bt_signals_temp(marker);
@@ -275,12 +261,7 @@ static void going_on_then_signal(void) {
 
 static void test_going_on_then_signal(void **state) {
     (void)state;
-    setup_files();
-    touch(marker);
-    assert_int_equal(in_child(going_on_then_signal), 128 + SIGINT);
-    assert_true(exists(marker));
-    assert_false(exists(temp));
-    assert_false(exists(after));
+    expect(going_on_then_signal, 128 + SIGINT, 0, 1);
 }
 
 int main(void) {
