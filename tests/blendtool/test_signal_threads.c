@@ -110,8 +110,12 @@ static void test_thread_before_commit(void **state) {
 
 /* ---- a signal on a worker thread while the output goes in place ---- */
 
-static void after_commit(void) {
+/* SIGTERM on a worker while the output goes in place, as bt_output_commit
+ * does it; going_on: as batch, which then opens the signals again and would
+ * go on to its next task */
+static void commit_with_worker_signal(int going_on) {
     bt_signals_install();
+    if (going_on) bt_signals_going_on();
     const int slot = bt_signals_temp(temp);
     pthread_t t;
     pthread_create(&t, NULL, worker, NULL);
@@ -119,9 +123,15 @@ static void after_commit(void) {
     bt_signals_commit();
     pthread_kill(t, SIGTERM);
     pthread_join(t, NULL); /* the handler has run on the worker */
-    /* as bt_output_commit: the temporary file is the output now */
+    /* the temporary file is the output now */
     bt_signals_untemp(slot);
     touch(marker);
+    bt_signals_reopen();
+    if (going_on) touch(after); /* the next task: never reached */
+}
+
+static void after_commit(void) {
+    commit_with_worker_signal(0);
 }
 
 static void test_thread_after_commit(void **state) {
@@ -206,19 +216,7 @@ static void test_commit_meets_handler(void **state) {
  * its commit ends the run once the output is in place ---- */
 
 static void going_on_worker(void) {
-    bt_signals_install();
-    bt_signals_going_on();
-    const int slot = bt_signals_temp(temp);
-    pthread_t t;
-    pthread_create(&t, NULL, worker, NULL);
-    nap(0.05);
-    bt_signals_commit();
-    pthread_kill(t, SIGTERM);
-    pthread_join(t, NULL);
-    bt_signals_untemp(slot);
-    touch(marker); /* the output is in place */
-    bt_signals_reopen();
-    touch(after); /* the next task: never reached */
+    commit_with_worker_signal(1);
 }
 
 static void test_going_on_worker(void **state) {
