@@ -162,8 +162,11 @@ try:
         check(not pw, "hostile folder %r: nothing from the path ran: %s" % (name, pw))
 
     # kill one array task mid-render, then resubmit the same script
+    # (renders of about 1.7 s, killed 0.3 s after the task starts: until
+    # 2026-12-05 they were 320 x 240, 6.8 s each, for the same check, 112 s
+    # of the test)
     slow = dict(JOB, outputs={"mesh": {"resolution": 40},
-                              "image": {"width": 320, "height": 240, "quality": 11}})
+                              "image": {"width": 128, "height": 96, "quality": 11}})
     dk, jk = job_in("kill", slow)
     dref, jref = job_in("kill-ref", slow)
     r = subprocess.run([BT, "batch", jref], capture_output=True, text=True)
