@@ -20,7 +20,11 @@ apart over every triangle (a simplified triangle can be 100 cells long):
 - corner normals (OBJ) on the simplified boxes are still their faces';
 - S1 and S2 (smooth) simplified: fewer triangles, the same bytes with 1 and
   2 threads;
-- bad tolerances exit 2 naming the option and write nothing."""
+- bad tolerances exit 2 naming the option and write nothing;
+- --merge-flat (no tolerance): the boxes in 12, 12 and 36 triangles, exact
+  to 1e-5 cells, every corner kept; the cylinder cut by a slab with its
+  caps merged, its error no larger; S1 and S2 the same bytes (nothing
+  flat)."""
 import os
 import subprocess
 import sys
@@ -158,6 +162,45 @@ for sname in ("bench-s1-three-spheres", "bench-s2-64-spheres"):
     check(len(F) < 0.8 * len(F0), "%s: %d triangles of %d (bar: under 0.8x)" %
           (tag, len(F), len(F0)))
     check(outs[0] == outs[1], "%s: the same bytes with 1 and 2 threads" % tag)
+
+# ---- --merge-flat: flat regions merged, no tolerance ----
+# the boxes' faces become two triangles each, exact, every corner kept; the
+# cylinder cut by a slab has its caps merged and its wall untouched (its
+# error no larger); smooth scenes have nothing flat (the same bytes)
+for name in ("cube", "rotated-cube", "two-boxes"):
+    dist, corners = box_like(name)
+    for res in (32, 64, 128):
+        h = cell_size(scene(name), res)
+        tag = "%s at %d --merge-flat" % (name, res)
+        V0, _N0, F0 = meshcheck.read(mesh(shape(name), res, "--features"))
+        V, _N, F = meshcheck.read(mesh(shape(name), res, "--features", "--merge-flat"))
+        topology(tag, V, F)
+        subset(tag, V, V0)
+        err = dist(dense_samples(V, F, h)).max() / h
+        check(err <= 1e-5, "%s: largest error %.2g cells (bar 1e-5)" % (tag, err))
+        cd = max(np.linalg.norm(V - c, axis=1).min() for c in corners) / h
+        check(cd <= 0.01, "%s: farthest corner %.2g cells from a vertex (bar 0.01)" % (tag, cd))
+        want = 36 if name == "two-boxes" else 12
+        check(len(F) == want, "%s: %d triangles (want %d; %d unmerged)" % (tag, len(F), want,
+                                                                          len(F0)))
+distance = cylinder_slab()[0]
+for res in (32, 64, 128):
+    h = cell_size(scene("cylinder-slab"), res)
+    tag = "cylinder-slab at %d --merge-flat" % res
+    V0, _N0, F0 = meshcheck.read(mesh(shape("cylinder-slab"), res, "--features"))
+    V, _N, F = meshcheck.read(mesh(shape("cylinder-slab"), res, "--features", "--merge-flat"))
+    topology(tag, V, F)
+    subset(tag, V, V0)
+    err0 = distance(dense_samples(V0, F0, h))[0].max() / h
+    err = distance(dense_samples(V, F, h))[0].max() / h
+    check(err <= err0 + 1e-6 and len(F) < 0.8 * len(F0),
+          "%s: largest error %.3g cells (unmerged %.3g), %d triangles of %d" %
+          (tag, err, err0, len(F), len(F0)))
+for sname in ("bench-s1-three-spheres", "bench-s2-64-spheres"):
+    path = os.path.join(SRC, "scenes", sname + ".json")
+    a = open(mesh(path, 96, "--features"), "rb").read()
+    b = open(mesh(path, 96, "--features", "--merge-flat"), "rb").read()
+    check(a == b, "%s at 96: nothing flat, the same bytes with --merge-flat" % sname)
 
 # ---- bad tolerances ----
 for bad in ("0", "-0.1", "1.5", "nan", "inf", "0.1x", ""):

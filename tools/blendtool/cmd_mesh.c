@@ -107,6 +107,8 @@ static int parse_args(int argc, char **argv, mesh_args *A) {
             A->o.flags |= LB_MESH_TETRAHEDRA;
         } else if (strcmp(argv[i], "--features") == 0) {
             A->o.flags |= LB_MESH_FEATURES;
+        } else if (strcmp(argv[i], "--merge-flat") == 0) {
+            A->o.flags |= LB_MESH_MERGE_FLAT;
         } else if (strcmp(argv[i], "--quiet") == 0 || strcmp(argv[i], "-q") == 0) {
             A->quiet = 1;
         } else if (bt_scene_arg(CMD, argv[i], &A->scene_path)) {
@@ -197,7 +199,7 @@ const bt_command bt_cmd_mesh = {
     "usage: blendtool mesh SCENE -o OUT.{ply,obj,stl,glb} [--resolution N | --cell-size H]\n"
     "                      [--bounds x0,y0,z0,x1,y1,z1] [--open] [--threads N] [--quiet]\n"
     "                      [--format ply|obj|stl|glb] [--set PATH=VALUE]... [--tetrahedra]\n"
-    "                      [--features] [--simplify TOL]\n\n"
+    "                      [--features] [--merge-flat] [--simplify TOL]\n\n"
     "Meshes the scene's surface inside the region (the scene's bounds, or --bounds):\n"
     "closed and manifold, vertices on the surface with normals from the analytic\n"
     "gradient. Where the region cuts the solid the mesh is closed on the region's\n"
@@ -214,6 +216,9 @@ const bt_command bt_cmd_mesh = {
     "                  unions, slabs, the region's cap) exactly: a vertex on the crease\n"
     "                  or corner of each cell it passes through; .obj and .glb also\n"
     "                  get each side of a crease its own normal (sharp shading)\n"
+    "  --merge-flat    flat faces in few triangles: where the surface is a plane (with\n"
+    "                  --features, a box's face: 2 triangles), no tolerance, the surface\n"
+    "                  unchanged\n"
     "  --simplify TOL  fewer triangles where the surface allows: merge triangles\n"
     "                  wherever the result stays within TOL cells of the field (0 < TOL\n"
     "                  <= 1; e.g. 0.1), never across a crease; with --features a flat\n"

@@ -69,6 +69,17 @@ extern "C" {
  * crease sharp; costs a third more of the meshing time where many cells
  * are creased (docs/meshing.md, Sharp features). Ignored without features. */
 #define LB_MESH_CORNER_NORMALS 8u
+/* merge flat regions: where the surface is a plane (a box's side, a slab's,
+ * a cylinder's cap; with LB_MESH_FEATURES their creases are mesh edges),
+ * the triangles there become a triangulation of the region's outline, its
+ * vertices inside and on straight creases between two flat regions gone.
+ * No tolerance: every point of the surface stays where it was, and every
+ * vertex is one of the unmerged mesh's; still closed, 2-manifold and
+ * independent of the thread count. One thread, after the meshing; about a
+ * tenth of the meshing's time where there is something to merge, nothing
+ * where there is not (docs/meshing.md, Flat regions). Also the first step of
+ * simplify (below). */
+#define LB_MESH_MERGE_FLAT 16u
 
 /* Called on the calling thread with the fraction of work done, in [0, 1];
  * return non-zero to cancel the run (lb_mesh_create then fails with

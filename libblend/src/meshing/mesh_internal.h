@@ -449,6 +449,14 @@ LB_INTERNAL lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb
                                    const volatile int *cancel, lb_mesh_progress_fn progress,
                                    void *user, double base, double weight, lb_error *err);
 
+/* Flat regions merged (flat.c): where triangles lie in one plane with the
+ * field's gradient its normal, the region's outline (without the vertices
+ * inside it, or on a straight crease between two such regions) is cut into
+ * as few triangles as it needs; the surface does not move, the mesh stays a
+ * closed 2-manifold (else the pass leaves it as it was); feat (may be
+ * NULL) is compacted with the vertices. */
+LB_INTERNAL lb_status lb__merge_flat(const lb__grid *g, lb_mesh *M, uint8_t *feat, lb_error *err);
+
 /* One cell (i, j, k) with corner values c (some inside, some outside; bit o
  * of cfg set: corner o inside): its polygons, by the cube cases or by the
  * Kuhn split. 0 when out of memory. */

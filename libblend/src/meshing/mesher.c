@@ -1517,10 +1517,11 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
                         "%s: threads = %d; allowed: 0 (one per CPU) or a positive count", FN,
                         opt->threads);
     if (opt->flags & ~(unsigned)(LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA | LB_MESH_FEATURES |
-                                 LB_MESH_CORNER_NORMALS))
+                                 LB_MESH_CORNER_NORMALS | LB_MESH_MERGE_FLAT))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: flags = %#x; allowed: 0 or LB_MESH_OPEN_BOUNDARY | "
-                        "LB_MESH_TETRAHEDRA | LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS",
+                        "LB_MESH_TETRAHEDRA | LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS | "
+                        "LB_MESH_MERGE_FLAT",
                         FN, opt->flags);
     if (!(opt->simplify >= 0.0 && opt->simplify <= LB_MESH_MAX_SIMPLIFY))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
@@ -1649,6 +1650,9 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
                                        lb__bctx_scratch(R.ctx[0]), err);
         }
     }
+    if (!s && !P.cancelled && ((opt->flags & LB_MESH_MERGE_FLAT) || opt->simplify > 0.0) &&
+        M->ntriangles) /* flat.c */
+        s = lb__merge_flat(&g, M, feat, err);
     if (!s && !P.cancelled && opt->simplify > 0.0 && M->ntriangles) /* simplify.c */
         s = lb__simplify(ev, &g, M, feat, opt->simplify, max_memory, opt->cancel, P.fn, P.user,
                          P.base, 0.95 - P.base, err);
