@@ -251,9 +251,24 @@ lb_status lb__merge_flat(const lb__grid *g, lb_mesh *M, uint8_t *feat, lb_error 
     F.feat = feat;
     const double h = fmin(g->h[0], fmin(g->h[1], g->h[2]));
     F.tol = FLAT_TOL * h;
-    /* most curved meshes have no flat triangle at all: nothing to set up */
+    /* a curved mesh has no flat triangle of grid-edge vertices and a tenth
+     * of a cell's area or more (tinier ones pass on_plane on S1 and S2, their
+     * normals and vertices too close to differ): then nothing to set up */
     size_t nflat = 0;
     for (size_t t = 0; t < nt && nflat < 3; ++t) {
+        const uint32_t *U = M->triangles + 3 * t;
+        if (feat && (feat[U[0]] | feat[U[1]] | feat[U[2]])) continue;
+        const double *n0 = M->normals + 3 * (size_t)U[0], *n1 = M->normals + 3 * (size_t)U[1],
+                     *n2 = M->normals + 3 * (size_t)U[2];
+        if (!(n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] >= NORMAL_COS) ||
+            !(n0[0] * n2[0] + n0[1] * n2[1] + n0[2] * n2[2] >= NORMAL_COS))
+            continue; /* the quick test first: most triangles bend */
+        const double *a = pos(M, U[0]), *b = pos(M, U[1]), *c = pos(M, U[2]);
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                     w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                             u[0] * w[1] - u[1] * w[0]};
+        if (!(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] >= 0.04 * h * h * h * h)) continue;
         double P[4];
         nflat += seed_plane(&F, t, P) && on_plane(&F, (uint32_t)t, P);
     }
