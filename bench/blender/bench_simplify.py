@@ -6,8 +6,8 @@
 For a CSG scene (two overlapping boxes, with Sharp Features), the stool of
 the bounded-blending paper (with Sharp Features) and S2 (64 spheres), at 64
 and 128 cells: the synchronous update (live.update_now: mesh, then the
-Blender mesh data, Blender's own normals) with Simplify 0 and 0.1 cells,
-alternating, 7 rounds; medians, and of each the libblend and Blender parts.
+Blender mesh data, Blender's own normals) plain, with Merge Flat, and with
+Simplify 0.1 cells, alternating, 7 rounds; medians, and of each the libblend and Blender parts.
 Prints one "BENCH {json}" line per configuration, then a table."""
 import json
 import os
@@ -32,6 +32,7 @@ SCENES = (("two boxes (CSG)", os.path.join(SRC, "tests", "data", "features", "tw
            True),
           ("stool", os.path.join(SRC, "scenes", "hsu-bounded-fig7-stool.json"), True),
           ("S2", os.path.join(SRC, "scenes", "bench-s2-64-spheres.json"), False))
+CONFIGS = (("plain", 0.0, False), ("merge_flat", 0.0, True), ("simplified", 0.1, False))
 rows = []
 for name, path, feat in SCENES:
     bpy.ops.libblend.import_scene(filepath=path, with_render=False)
@@ -41,32 +42,35 @@ for name, path, feat in SCENES:
     out.libblend.normals = "FACES"
     for res in (64, 128):
         out.libblend.preview_resolution = res
-        t = {0.0: [], 0.1: []}
-        parts = {0.0: [], 0.1: []}
+        t = {k: [] for k, _s, _m in CONFIGS}
+        parts = {k: [] for k, _s, _m in CONFIGS}
         tris = {}
         for _ in range(ROUNDS):
-            for simp in (0.0, 0.1):
+            for k, simp, flat in CONFIGS:
                 out.libblend.simplify = simp
+                out.libblend.merge_flat = flat
                 t0 = time.perf_counter()
                 ok, msg = live.update_now(out)
-                t[simp].append(time.perf_counter() - t0)
+                t[k].append(time.perf_counter() - t0)
                 assert ok, msg
-                parts[simp].append(live.state_of(out).last)
-                tris[simp] = len(out.data.polygons)
+                parts[k].append(live.state_of(out).last)
+                tris[k] = len(out.data.polygons)
         r = {"scene": name, "cells": res, "features": feat}
-        for simp in (0.0, 0.1):
-            k = "simplified" if simp else "plain"
-            r[k] = {"ms": 1000 * statistics.median(t[simp]), "triangles": tris[simp],
-                    "libblend_ms": 1000 * statistics.median(p["mesh"] for p in parts[simp]),
-                    "blender_ms": 1000 * statistics.median(p["apply"] for p in parts[simp])}
+        for k, _s, _m in CONFIGS:
+            r[k] = {"ms": 1000 * statistics.median(t[k]), "triangles": tris[k],
+                    "libblend_ms": 1000 * statistics.median(p["mesh"] for p in parts[k]),
+                    "blender_ms": 1000 * statistics.median(p["apply"] for p in parts[k])}
         print("BENCH " + json.dumps(r), flush=True)
         rows.append(r)
 
-print("\n| scene | cells | update without (libblend / Blender) | with Simplify 0.1 (libblend / "
-      "Blender) | triangles without / with | with / without |")
-print("|---|---|---|---|---|---|")
+print("\n| scene | cells | update without (libblend / Blender) | with Merge Flat (libblend / "
+      "Blender) | with Simplify 0.1 (libblend / Blender) | triangles without / merged / "
+      "simplified | merged / without | simplified / without |")
+print("|---|---|---|---|---|---|---|---|")
 for r in rows:
-    a, b = r["plain"], r["simplified"]
-    print("| %s | %d | %.0f ms (%.0f / %.0f) | %.0f ms (%.0f / %.0f) | %d / %d | %.1fx |" %
-          (r["scene"], r["cells"], a["ms"], a["libblend_ms"], a["blender_ms"], b["ms"],
-           b["libblend_ms"], b["blender_ms"], a["triangles"], b["triangles"], b["ms"] / a["ms"]))
+    a, m, b = r["plain"], r["merge_flat"], r["simplified"]
+    print("| %s | %d | %.0f ms (%.0f / %.0f) | %.0f ms (%.0f / %.0f) | %.0f ms (%.0f / %.0f) | "
+          "%d / %d / %d | %.2fx | %.1fx |" %
+          (r["scene"], r["cells"], a["ms"], a["libblend_ms"], a["blender_ms"], m["ms"],
+           m["libblend_ms"], m["blender_ms"], b["ms"], b["libblend_ms"], b["blender_ms"],
+           a["triangles"], m["triangles"], b["triangles"], m["ms"] / a["ms"], b["ms"] / a["ms"]))

@@ -116,6 +116,10 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
                             "cells of the field, never across a crease (with Sharp Features a "
                             "flat face becomes a few large triangles). 0 = off", default=0.0,
                             min=0.0, max=1.0, step=5, precision=2, update=_changed)
+    merge_flat: BoolProperty(name="Merge Flat", description="flat faces (a box's sides, a "
+                             "slab's, a cylinder's caps) as few large triangles, the surface "
+                             "unchanged: fewer triangles for Blender to take in", default=False,
+                             update=_changed)
     normals: EnumProperty(name="Normals", items=[
         ("AUTO", "Auto", "analytic normals below 250k triangles, Blender's smooth normals above"),
         ("ANALYTIC", "Analytic", "libblend's exact normals as custom split normals"),

@@ -126,6 +126,7 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
         layout.prop(s, "normals")
         layout.prop(s, "open_boundary")
         layout.prop(s, "sharp_features")
+        layout.prop(s, "merge_flat")
         layout.prop(s, "simplify")
         box = layout.box()
         box.label(text="Bake (render resolution, one file per frame)")

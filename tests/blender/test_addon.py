@@ -1165,6 +1165,22 @@ check(sjob.key != cjob.key and abs(sjob.simplify - 0.1) < 1e-6,
 cube.libblend.simplify = 0.0
 check(live.update_now(cube)[0] and len(cube.data.polygons) > 1000,
       "Simplify off again: the full mesh (%d triangles)" % len(cube.data.polygons))
+# Merge Flat: the same 12 triangles with no tolerance (each face two
+# triangles, its corners the cube's), its own part of the mesh key
+cube.libblend.merge_flat = True
+check(live.update_now(cube)[0], "mesh the cube with Merge Flat")
+flat_cos, flat_corner = face_cos(cube)
+check(len(cube.data.polygons) == 12 and len(cube.data.vertices) == 8 and flat_cos > 0.9999 and
+      flat_corner < 1e-5,
+      "Merge Flat: the cube in %d triangles (want 12), %d vertices, corners kept (%.2g), face "
+      "normals (cos %.6f)" % (len(cube.data.polygons), len(cube.data.vertices), flat_corner,
+                              flat_cos))
+fjob = live.prepare(cube, 26)
+check(fjob.key not in (cjob.key, sjob.key) and fjob.merge_flat,
+      "Merge Flat is part of the mesh key")
+cube.libblend.merge_flat = False
+check(live.update_now(cube)[0] and len(cube.data.polygons) > 1000,
+      "Merge Flat off again: the full mesh (%d triangles)" % len(cube.data.polygons))
 
 # ---------------------------------------------------------------- incremental remeshing
 # Each field keeps its last mesh's blocks (lb_mesh_cache): moving one sphere
