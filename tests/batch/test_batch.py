@@ -279,6 +279,7 @@ CASES = [
     ("mesh features", dict(good, outputs={"mesh": {"features": "yes"}}), "$.outputs.mesh.features"),
     ("mesh simplify", dict(good, outputs={"mesh": {"simplify": 1.5}}), "$.outputs.mesh.simplify"),
     ("simplify type", dict(good, outputs={"mesh": {"simplify": "0.1"}}), "$.outputs.mesh.simplify"),
+    ("merge_flat type", dict(good, outputs={"mesh": {"merge_flat": 1}}), "$.outputs.mesh.merge_flat"),
     ("image format", dict(good, outputs={"image": {"format": "jpg"}}), "$.outputs.image.format"),
     ("image bits", dict(good, outputs={"image": {"bits": 12}}), "bits"),
     ("exr bits", dict(good, outputs={"image": {"format": "exr", "bits": 16}}), "$.outputs.image.bits"),
@@ -435,6 +436,12 @@ r = bt("batch", write_job(os.path.join(cdir, "job.json"), cj))
 faces = [l for l in open(objs[0]).read().splitlines() if l.startswith("f ")] if objs else []
 check(r.returncode == 0 and len(faces) > 1000,
       "simplify changed to 0: the task is redone, %d triangles %s" % (len(faces), why(r)))
+cj["outputs"]["mesh"]["merge_flat"] = True
+jsonschema.validate(cj, SCHEMA)
+r = bt("batch", write_job(os.path.join(cdir, "job.json"), cj))
+faces = [l for l in open(objs[0]).read().splitlines() if l.startswith("f ")] if objs else []
+check(r.returncode == 0 and len(faces) == 12 and all("//" in f for f in faces),
+      "merge_flat true: the task is redone, the cube in %d triangles %s" % (len(faces), why(r)))
 
 # ---- blendtool compare
 a, b = os.path.join(out1, "cmp_0000.png"), os.path.join(out1, "cmp_0004.png")

@@ -63,6 +63,7 @@ typedef struct job {
     lb_mesh_format mesh_fmt;
     int mesh_features;    /* LB_MESH_FEATURES (and corner normals in OBJ / GLB) */
     double mesh_simplify; /* lb_mesh_options.simplify, cells; 0 = off */
+    int mesh_merge_flat;  /* LB_MESH_MERGE_FLAT */
     int pov, pov_w, pov_h;
     /* outputs.vdb: a narrow-band level set (voxel size, or voxels along the
      * longest side; band in voxels; LB_LEVEL_SET_* extra grids) */

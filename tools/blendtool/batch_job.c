@@ -413,7 +413,8 @@ static int parse_outputs(job *J, const cJSON *o) {
     if (rc) return rc;
     const cJSON *m = cJSON_GetObjectItemCaseSensitive(o, "mesh");
     if (m) {
-        static const char *const mk[] = {"format", "resolution", "features", "simplify", NULL};
+        static const char *const mk[] = {"format",   "resolution", "features",
+                                         "simplify", "merge_flat", NULL};
         if (!cJSON_IsObject(m))
             return batch_bad(J, "$.outputs.mesh", "expected an object, found %s", lb__json_kind(m));
         if ((rc = check_keys(J, m, "$.outputs.mesh", mk))) return rc;
@@ -442,6 +443,13 @@ static int parse_outputs(job *J, const cJSON *o) {
                              "and corners) or false",
                              lb__json_kind(ft));
         J->mesh_features = cJSON_IsTrue(ft);
+        const cJSON *mf = cJSON_GetObjectItemCaseSensitive(m, "merge_flat");
+        if (mf && !cJSON_IsBool(mf))
+            return batch_bad(J, "$.outputs.mesh.merge_flat",
+                             "expected true or false, found %s; allowed: true (flat faces in few "
+                             "triangles, the surface unchanged) or false",
+                             lb__json_kind(mf));
+        J->mesh_merge_flat = cJSON_IsTrue(mf);
         const cJSON *sp = cJSON_GetObjectItemCaseSensitive(m, "simplify");
         if (sp && (!cJSON_IsNumber(sp) || !(sp->valuedouble >= 0.0) ||
                    !(sp->valuedouble <= LB_MESH_MAX_SIMPLIFY)))

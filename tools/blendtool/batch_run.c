@@ -230,6 +230,7 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
                       (J->mesh_fmt == LB_MESH_FORMAT_OBJ || J->mesh_fmt == LB_MESH_FORMAT_GLB
                            ? LB_MESH_CORNER_NORMALS
                            : 0u);
+        if (J->mesh_merge_flat) o.flags |= LB_MESH_MERGE_FLAT;
         lb_mesh *m = NULL;
         hashed_out H;
         if (!lb_scene_bounds(sc, o.bmin, o.bmax)) {
