@@ -94,20 +94,29 @@ def subset(tag, V, V0):
 
 
 # ---- boxes: flat faces in few triangles, exact, corners kept ----
+def box_mesh(name, res, err_bar, *opts):
+    """a box shape meshed with --features and opts: closed, oriented and
+    manifold, its vertices the unsimplified mesh's, within err_bar cells of
+    the true surface, every convex corner within 0.01 cells of a vertex;
+    returns (V, F, the unsimplified F, tag)"""
+    dist, corners = box_like(name)
+    h = cell_size(scene(name), res)
+    tag = "%s at %d %s" % (name, res, " ".join(opts))
+    V0, _N0, F0 = meshcheck.read(mesh(shape(name), res, "--features"))
+    V, _N, F = meshcheck.read(mesh(shape(name), res, "--features", *opts))
+    topology(tag, V, F)
+    subset(tag, V, V0)
+    err = dist(dense_samples(V, F, h)).max() / h
+    check(err <= err_bar, "%s: largest error %.2g cells (bar %g)" % (tag, err, err_bar))
+    cd = max(np.linalg.norm(V - c, axis=1).min() for c in corners) / h
+    check(cd <= 0.01, "%s: farthest corner %.2g cells from a vertex (bar 0.01)" % (tag, cd))
+    return V, F, F0, tag
+
+
 LIBFIVE_128 = {"rotated-cube": 47588, "two-boxes": 15540}
 for name in ("cube", "rotated-cube", "two-boxes"):
-    dist, corners = box_like(name)
     for res in (32, 64, 128):
-        h = cell_size(scene(name), res)
-        tag = "%s at %d --simplify 0.1" % (name, res)
-        V0, _N0, F0 = meshcheck.read(mesh(shape(name), res, "--features"))
-        V, _N, F = meshcheck.read(mesh(shape(name), res, "--features", "--simplify", "0.1"))
-        topology(tag, V, F)
-        subset(tag, V, V0)
-        err = dist(dense_samples(V, F, h)).max() / h
-        check(err <= 0.01, "%s: largest error %.2g cells (bar 0.01)" % (tag, err))
-        cd = max(np.linalg.norm(V - c, axis=1).min() for c in corners) / h
-        check(cd <= 0.01, "%s: farthest corner %.2g cells from a vertex (bar 0.01)" % (tag, cd))
+        V, F, F0, tag = box_mesh(name, res, 0.01, "--simplify", "0.1")
         if name == "cube":
             check(len(F) <= 100, "%s: %d triangles (bar 100; %d unsimplified)" %
                   (tag, len(F), len(F0)))
@@ -168,23 +177,15 @@ for sname in ("bench-s1-three-spheres", "bench-s2-64-spheres"):
 # cylinder cut by a slab has its caps merged and its wall untouched (its
 # error no larger); smooth scenes have nothing flat (the same bytes)
 for name in ("cube", "rotated-cube", "two-boxes"):
-    dist, corners = box_like(name)
     for res in (32, 64, 128):
-        h = cell_size(scene(name), res)
-        tag = "%s at %d --merge-flat" % (name, res)
-        V0, _N0, F0 = meshcheck.read(mesh(shape(name), res, "--features"))
-        V, _N, F = meshcheck.read(mesh(shape(name), res, "--features", "--merge-flat"))
-        topology(tag, V, F)
-        subset(tag, V, V0)
-        err = dist(dense_samples(V, F, h)).max() / h
-        check(err <= 1e-5, "%s: largest error %.2g cells (bar 1e-5)" % (tag, err))
-        cd = max(np.linalg.norm(V - c, axis=1).min() for c in corners) / h
-        check(cd <= 0.01, "%s: farthest corner %.2g cells from a vertex (bar 0.01)" % (tag, cd))
+        V, F, F0, tag = box_mesh(name, res, 1e-5, "--merge-flat")
         want = 36 if name == "two-boxes" else 12
         check(len(F) == want, "%s: %d triangles (want %d; %d unmerged)" % (tag, len(F), want,
                                                                           len(F0)))
+# (at 32 and 64 cells: at 128 the merged caps' long triangles, sampled half
+# a cell apart, are some 10^8 points)
 distance = cylinder_slab()[0]
-for res in (32, 64, 128):
+for res in (32, 64):
     h = cell_size(scene("cylinder-slab"), res)
     tag = "cylinder-slab at %d --merge-flat" % res
     V0, _N0, F0 = meshcheck.read(mesh(shape("cylinder-slab"), res, "--features"))

@@ -460,19 +460,9 @@ lb_status lb__merge_flat(const lb__grid *g, lb_mesh *M, uint8_t *feat, lb_error 
             if (same != 1 || back != 1) goto done; /* left as it was */
         }
     /* the kept vertices in their order (vmark: the new index) */
-    size_t n = 0;
-    for (size_t v = 0; v < nv; ++v) {
-        if (F.vstart[v] == F.vstart[v + 1]) continue;
-        vmark[v] = (uint32_t)n;
-        if (n != v) {
-            memcpy(M->positions + 3 * n, M->positions + 3 * v, 3 * sizeof *M->positions);
-            memcpy(M->normals + 3 * n, M->normals + 3 * v, 3 * sizeof *M->normals);
-            if (feat) feat[n] = feat[v];
-        }
-        ++n;
-    }
+    for (size_t v = 0; v < nv; ++v) vmark[v] = F.vstart[v] == F.vstart[v + 1] ? NONE : 0;
+    lb__keep_vertices(M, feat, vmark);
     for (size_t i = 0; i < 3 * m; ++i) M->triangles[i] = vmark[tris[i]];
-    M->nvertices = n;
     M->ntriangles = m;
     goto done;
 nomem:

@@ -449,6 +449,12 @@ LB_INTERNAL lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb
                                    const volatile int *cancel, lb_mesh_progress_fn progress,
                                    void *user, double base, double weight, lb_error *err);
 
+/* Keep the vertices whose to[v] is not UINT32_MAX, in their order (their
+ * positions, normals and feat, which may be NULL), and set to[v] to each
+ * one's new index; M->nvertices becomes their count (simplify.c). The
+ * triangles are the caller's to renumber. */
+LB_INTERNAL void lb__keep_vertices(lb_mesh *M, uint8_t *feat, uint32_t *to);
+
 /* Flat regions merged (flat.c): where triangles lie in one plane with the
  * field's gradient its normal, the region's outline (without the vertices
  * inside it, or on a straight crease between two such regions) is cut into

@@ -652,13 +652,10 @@ static lb_status setup(simp *S, lb_error *err) {
     return LB_OK;
 }
 
-/* Drop the moved vertices and the dead triangles, keeping both orders. */
-static void compact(simp *S, uint8_t *feat) {
-    lb_mesh *M = S->M;
-    uint32_t *to = S->stamp; /* reused: new index per vertex */
+void lb__keep_vertices(lb_mesh *M, uint8_t *feat, uint32_t *to) {
     size_t n = 0;
     for (size_t v = 0; v < M->nvertices; ++v) {
-        if (S->kind[v] == GONE) continue;
+        if (to[v] == NONE) continue;
         to[v] = (uint32_t)n;
         if (n != v) {
             memcpy(M->positions + 3 * n, M->positions + 3 * v, 3 * sizeof *M->positions);
@@ -667,13 +664,21 @@ static void compact(simp *S, uint8_t *feat) {
         }
         ++n;
     }
+    M->nvertices = n;
+}
+
+/* Drop the moved vertices and the dead triangles, keeping both orders. */
+static void compact(simp *S, uint8_t *feat) {
+    lb_mesh *M = S->M;
+    uint32_t *to = S->stamp; /* reused: new index per vertex */
+    for (size_t v = 0; v < M->nvertices; ++v) to[v] = S->kind[v] == GONE ? NONE : 0;
+    lb__keep_vertices(M, feat, to);
     size_t m = 0;
     for (size_t t = 0; t < M->ntriangles; ++t) {
         if (S->tdead[t]) continue;
         for (int k = 0; k < 3; ++k) M->triangles[3 * m + k] = to[M->triangles[3 * t + k]];
         ++m;
     }
-    M->nvertices = n;
     M->ntriangles = m;
 }
 
