@@ -30,7 +30,7 @@
  *    region that cannot be cut (an outline folded within rounding) is left
  *    as it was, and the outline vertices it shares are kept on both sides:
  *    the decisions are made again until every region either merges or
- *    stays.
+ *    stays (MAX_ROUNDS rounds at most; then nothing is merged).
  * 5. Check. Every directed edge of the result must have exactly one
  *    opposite: a closed 2-manifold still. Where it would not be (an outline
  *    diagonal that is also an edge elsewhere), the pass leaves the mesh as
@@ -51,6 +51,7 @@
 #define FLAT_TOL 1e-6           /* cells: a vertex this close to the plane is on it */
 #define NORMAL_COS (1.0 - 1e-9) /* grid-edge normals this close to the plane's */
 #define MAX_LOOP 4096           /* outline vertices of a region at most (ear clipping) */
+#define MAX_ROUNDS 8            /* rounds of decisions after failed outlines, at most */
 
 typedef struct {
     const lb_mesh *M;
@@ -360,7 +361,7 @@ lb_status lb__merge_flat(const lb__grid *g, lb_mesh *M, uint8_t *feat, lb_error 
     lxy = malloc(2 * MAX_LOOP * sizeof *lxy);
     if (!lp || !lprev || !lnext || !lout || !lxy) goto nomem;
     /* steps 3 and 4, until no merged region fails */
-    for (;;) {
+    for (int pass = 0;; ++pass) {
         for (size_t v = 0; v < nv; ++v) {
             uint32_t r0 = NONE, r1 = NONE;
             int go = F.vstart[v] < F.vstart[v + 1];
@@ -398,7 +399,7 @@ lb_status lb__merge_flat(const lb__grid *g, lb_mesh *M, uint8_t *feat, lb_error 
          * into triangles, in place of its triangles at its first one's */
         int failed = 0;
         m = 0;
-        for (size_t t = 0; t < nt && !failed; ++t) {
+        for (size_t t = 0; t < nt; ++t) {
             const uint32_t r = F.rid[t];
             if (r == NONE || F.rstate[r] != 1) {
                 memcpy(tris + 3 * m++, T + 3 * t, 3 * sizeof *T);
@@ -435,12 +436,17 @@ lb_status lb__merge_flat(const lb__grid *g, lb_mesh *M, uint8_t *feat, lb_error 
             if (v != start || n < 3 || !clip(lxy, n, 1e-12 * h * h, lprev, lnext, lout)) {
                 F.rstate[r] = 2; /* left as it was; the decisions again */
                 failed = 1;
-                break;
+                continue;
             }
             for (uint32_t i = 0; i < 3 * (n - 2); ++i) tris[3 * m + i] = lp[lout[i]];
             m += n - 2;
         }
         if (!failed) break;
+        /* every region that failed this round is out; one that kept an
+         * outline vertex for such a neighbour can fail in the next. A few
+         * rounds at most, so no mesh costs more than a few passes: then the
+         * mesh stays as it was */
+        if (pass == MAX_ROUNDS - 1) goto done;
     }
     if (m == nt) goto done; /* nothing merged */
     /* step 5: every directed edge once, with one opposite (the output's
