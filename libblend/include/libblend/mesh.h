@@ -75,8 +75,8 @@ extern "C" {
  * vertices inside and on straight creases between two flat regions gone.
  * No tolerance: every point of the surface stays where it was, and every
  * vertex is one of the unmerged mesh's; still closed, 2-manifold and
- * independent of the thread count. One thread, after the meshing; a third to
- * a half of the meshing's work where there is something to merge, about 1 %
+ * independent of the thread count. One thread, after the meshing; about half
+ * of the meshing's work where there is something to merge, about 1 %
  * where there is not (docs/meshing.md, Flat regions). Also the first step of
  * simplify (below). */
 #define LB_MESH_MERGE_FLAT 16u
