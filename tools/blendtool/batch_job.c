@@ -45,6 +45,18 @@ static int get_int(const job *J, const cJSON *o, const char *key, const char *pa
     return 0;
 }
 
+/* An optional boolean o[key] at path into *out (false when absent); what
+ * says what true does. */
+static int get_bool(const job *J, const cJSON *o, const char *key, const char *path,
+                    const char *what, int *out) {
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+    if (v && !cJSON_IsBool(v))
+        return batch_bad(J, path, "expected true or false, found %s; allowed: true (%s) or false",
+                         lb__json_kind(v), what);
+    *out = cJSON_IsTrue(v);
+    return 0;
+}
+
 char *batch_dupstr(const char *s) {
     char *d = malloc(strlen(s) + 1);
     if (d) strcpy(d, s);
@@ -436,20 +448,12 @@ static int parse_outputs(job *J, const cJSON *o) {
         if ((rc = get_int(J, m, "resolution", "$.outputs.mesh", 1, LB_MESH_MAX_CELLS_PER_AXIS, &r)))
             return rc;
         J->mesh_res = (int)r;
-        const cJSON *ft = cJSON_GetObjectItemCaseSensitive(m, "features");
-        if (ft && !cJSON_IsBool(ft))
-            return batch_bad(J, "$.outputs.mesh.features",
-                             "expected true or false, found %s; allowed: true (keep sharp creases "
-                             "and corners) or false",
-                             lb__json_kind(ft));
-        J->mesh_features = cJSON_IsTrue(ft);
-        const cJSON *mf = cJSON_GetObjectItemCaseSensitive(m, "merge_flat");
-        if (mf && !cJSON_IsBool(mf))
-            return batch_bad(J, "$.outputs.mesh.merge_flat",
-                             "expected true or false, found %s; allowed: true (flat faces in few "
-                             "triangles, the surface unchanged) or false",
-                             lb__json_kind(mf));
-        J->mesh_merge_flat = cJSON_IsTrue(mf);
+        if ((rc = get_bool(J, m, "features", "$.outputs.mesh.features",
+                           "keep sharp creases and corners", &J->mesh_features)) ||
+            (rc = get_bool(J, m, "merge_flat", "$.outputs.mesh.merge_flat",
+                           "flat faces in few triangles, the surface unchanged",
+                           &J->mesh_merge_flat)))
+            return rc;
         const cJSON *sp = cJSON_GetObjectItemCaseSensitive(m, "simplify");
         if (sp && (!cJSON_IsNumber(sp) || !(sp->valuedouble >= 0.0) ||
                    !(sp->valuedouble <= LB_MESH_MAX_SIMPLIFY)))

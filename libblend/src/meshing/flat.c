@@ -60,7 +60,6 @@ typedef struct {
     uint32_t *vstart, *vt; /* vertex -> its triangles (CSR) */
     uint32_t *adj;         /* 3 t + k -> the triangle across t's edge k (NONE: none) */
     uint32_t *rid;         /* triangle -> region (NONE: in none) */
-    uint32_t *rfirst;      /* region -> its first triangle */
     double *rplane;        /* region -> unit normal, offset */
     uint8_t *rstate;       /* region: 0 not a disk, 1 merged, 2 left as it was */
     uint32_t nr;
@@ -128,16 +127,13 @@ static int regions(flat *F, uint32_t *queue) {
         if (!seed_plane(F, s, P) || !on_plane(F, (uint32_t)s, P)) continue;
         if (F->nr == cap) {
             cap = cap ? 2 * cap : 64;
-            uint32_t *rf = realloc(F->rfirst, cap * sizeof *rf);
-            if (rf) F->rfirst = rf;
             double *rp = realloc(F->rplane, 4 * cap * sizeof *rp);
             if (rp) F->rplane = rp;
             uint8_t *rs = realloc(F->rstate, cap);
             if (rs) F->rstate = rs;
-            if (!rf || !rp || !rs) return 0;
+            if (!rp || !rs) return 0;
         }
         const uint32_t r = F->nr++;
-        F->rfirst[r] = (uint32_t)s;
         memcpy(F->rplane + 4 * r, P, sizeof P);
         F->rstate[r] = 0;
         size_t qa = 0, qb = 0;
@@ -478,7 +474,6 @@ done:
     free(F.vt);
     free(F.adj);
     free(F.rid);
-    free(F.rfirst);
     free(F.rplane);
     free(F.rstate);
     free(queue);
