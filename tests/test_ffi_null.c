@@ -392,7 +392,7 @@ static lb_status c_pov(unsigned mask, int size, lb_error *err, int *hs) {
     *hs = 1;
     char path[128];
     snprintf(path, sizeof path, "%s/s.pov", C.tmpdir);
-    const lb_pov_options o = {0, 0, 0.0, 2.0, 1, 0, 0, 0.0};
+    const lb_pov_options o = {0, 0, 0.0, 2.0, 1, 0, 0, 0.0, 0};
     double g;
     lb_status s =
         lb_scene_write_pov(P(0, C.scene), P(1, C.ev), P(2, &o), P(3, path), P(4, &g), P(5, err));

@@ -85,7 +85,8 @@ class _PovOptions(ctypes.Structure):
     _fields_ = [("include_only", ctypes.c_int), ("silhouette", ctypes.c_int),
                 ("aspect", ctypes.c_double), ("max_gradient", ctypes.c_double),
                 ("threads", ctypes.c_int), ("mesh_resolution", ctypes.c_int),
-                ("mesh_features", ctypes.c_int), ("mesh_simplify", ctypes.c_double)]
+                ("mesh_features", ctypes.c_int), ("mesh_simplify", ctypes.c_double),
+                ("mesh_merge_flat", ctypes.c_int)]
 
 
 class _Material(ctypes.Structure):

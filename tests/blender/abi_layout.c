@@ -57,6 +57,7 @@ int main(void) {
     FIELD(lb_pov_options, mesh_resolution);
     FIELD(lb_pov_options, mesh_features);
     FIELD(lb_pov_options, mesh_simplify);
+    FIELD(lb_pov_options, mesh_merge_flat);
     END();
     BEGIN(lb_material, "_Material");
     FIELD(lb_material, color);

@@ -15,6 +15,9 @@
   shading (at most 0.5 % of the object's pixels off its shade by 0.05,
   against 3.75 % for the smooth mesh, measured 2026-12-04: 0.30 %); --features
   without --mesh exits 2;
+- with --features --merge-flat (no tolerance) the cube is the same 8
+  vertices and 12 triangles, and its silhouette the isosurface's;
+  --merge-flat without --mesh exits 2;
 - materials stay the scene's: a two-material scene shaded both ways has
   the same mean colour over the object to 3 % per channel, and each
   material's colour dominates the half of the image where its primitive is;
@@ -142,10 +145,22 @@ if len(shades) == 3:
     check(len(obj) > 1000 and off_s <= 0.005 and off_m > 4 * max(off_s, 0.002),
           "the cube's faces shade as the isosurface's with --features (%.2f %% of the pixels "
           "off; %.2f %% without)" % (100 * off_s, 100 * off_m))
-r = run(BT, "pov", cube, "--features", "-o", os.path.join(WORK, "bad.pov"))
-check(r.returncode == 2 and "--mesh" in r.stderr and
-      not os.path.exists(os.path.join(WORK, "bad.pov")),
-      "pov --features without --mesh: exit %d, %s" % (r.returncode, r.stderr.strip()))
+# flat regions merged without a tolerance (no vertex moves): the same cube
+fpov = os.path.join(WORK, "cube-flat.pov")
+r = run(BT, "pov", cube, "--mesh", 32, "--features", "--merge-flat", "-o", fpov)
+if check(r.returncode == 0, "pov --mesh 32 --features --merge-flat: %s" % r.stderr):
+    text = open(fpov).read()
+    nf = re.search(r"face_indices \{ (\d+),", text)
+    vv = re.search(r"vertex_vectors \{ (\d+),", text)
+    check(nf and vv and int(nf.group(1)) == 12 and int(vv.group(1)) == 8,
+          "the cube's mesh2 with --merge-flat: %s vertices, %s faces (without it: thousands)" %
+          (vv and vv.group(1), nf and nf.group(1)))
+silhouette("cube-flat", cube, ("--features", "--merge-flat"))
+for opt in ("--features", "--merge-flat"):
+    r = run(BT, "pov", cube, opt, "-o", os.path.join(WORK, "bad.pov"))
+    check(r.returncode == 2 and "--mesh" in r.stderr and opt in r.stderr and
+          not os.path.exists(os.path.join(WORK, "bad.pov")),
+          "pov %s without --mesh: exit %d, %s" % (opt, r.returncode, r.stderr.strip()))
 
 # ---- materials: the same colours both ways
 two = json.load(open(scene))

@@ -31,7 +31,7 @@ static int check_scene(const char *src, const char *work, const char *path, int 
     char pov[4096], out[4096], cmd[16384];
     snprintf(pov, sizeof pov, "%s/scene.pov", work);
     snprintf(out, sizeof out, "%s/scene.txt", work);
-    lb_pov_options o = {1, 0, 0.0, 0.0, 1, 0, 0, 0.0};
+    lb_pov_options o = {1, 0, 0.0, 0.0, 1, 0, 0, 0.0, 0};
     const lb_status s = lb_scene_write_pov(sc, ev, &o, pov, NULL, &e);
     if (s) {
         fprintf(stderr, "%s: %s\n", path, e.message);

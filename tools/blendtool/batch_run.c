@@ -252,7 +252,7 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
     }
     if (!rc && J->pov) {
         snprintf(full, sizeof full, "%s/%s", J->outdir, names[k]);
-        lb_pov_options o = {0, 0, (double)J->pov_w / (double)J->pov_h, 0.0, threads, 0, 0, 0.0};
+        lb_pov_options o = {0, 0, (double)J->pov_w / (double)J->pov_h, 0.0, threads, 0, 0, 0.0, 0};
         hashed_out H;
         if (!(rc = hashed_open(full, &H))) {
             if ((s = lb_scene_write_pov_stream(sc, ev, &o, H.f, NULL, &e))) {
@@ -295,7 +295,7 @@ int batch_run_task(const job *J, const task *T, const char *ident, const uint64_
         bt_render_dir R;
         if ((rc = bt_render_dir_open(&R)) == 0) {
             lb_pov_options o = {
-                0, 0, (double)J->img_w / (double)J->img_h, 0.0, threads, J->img_mesh, 0, 0.0};
+                0, 0, (double)J->img_w / (double)J->img_h, 0.0, threads, J->img_mesh, 0, 0.0, 0};
             if (J->blender)
                 rc = blender_render(J, T, &R, threads, L);
             else if ((s = lb_scene_write_pov(sc, ev, &o, R.pov, NULL, &e)))

@@ -17,7 +17,7 @@ static int parse_int(const char *cmd, const char *opt, const char *v, long lo, l
 typedef struct povargs {
     const char *scene, *out;
     int include_only, width, height, threads, quality, silhouette, bits, alpha, quiet, antialias,
-        mesh, features;
+        mesh, features, merge_flat;
     double simplify;
     const char *pixel;
     bt_set sets[BT_MAX_SETS];
@@ -65,6 +65,8 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
                 return -1;
         } else if (strcmp(argv[i], "--features") == 0) {
             a->features = 1;
+        } else if (strcmp(argv[i], "--merge-flat") == 0) {
+            a->merge_flat = 1;
         } else if ((r = bt_option(cmd, argc, argv, &i, "--simplify", &v))) {
             if (r < 0) return -1;
             char *end = NULL;
@@ -87,11 +89,13 @@ static int parse(const char *cmd, int argc, char **argv, povargs *a, int render)
             return -1;
         }
     }
-    if ((a->features || a->simplify > 0.0) && !a->mesh) {
+    if ((a->features || a->merge_flat || a->simplify > 0.0) && !a->mesh) {
         bt_error(cmd,
                  "%s without --mesh N; allowed: with --mesh N (they shape libblend's mesh; "
                  "the isosurface is exact)",
-                 a->features ? "--features" : "--simplify");
+                 a->features     ? "--features"
+                 : a->merge_flat ? "--merge-flat"
+                                 : "--simplify");
         return -1;
     }
     if (a->mesh && a->include_only) {
@@ -128,7 +132,8 @@ static int export(const char *cmd, const povargs *a, FILE *f, const char *out_na
                               a->threads,
                               a->mesh,
                               a->features,
-                              a->simplify};
+                              a->simplify,
+                              a->merge_flat};
     const lb_status s = lb_scene_write_pov_stream(sc, ev, &o, f, NULL, &e);
     if (s == LB_ERR_IO) {
         bt_error(cmd, "%s: writing the POV-Ray scene failed (%s); nothing was written", out_name,
@@ -192,7 +197,8 @@ static int run_render(int argc, char **argv) {
         bt_hash_hex(hash, hex);
         bt_render_settings(settings, sizeof settings, &P, a.silhouette, a.mesh);
         const size_t sl = strlen(settings); /* the mesh's own options, when given */
-        snprintf(settings + sl, sizeof settings - sl, "%s", a.features ? " features" : "");
+        snprintf(settings + sl, sizeof settings - sl, "%s%s", a.features ? " features" : "",
+                 a.merge_flat ? " merge-flat" : "");
         if (a.simplify > 0.0) {
             const size_t sl2 = strlen(settings);
             snprintf(settings + sl2, sizeof settings - sl2, " simplify %g", a.simplify);
@@ -229,7 +235,8 @@ const bt_command bt_cmd_pov = {
     "pov", "the scene as a POV-Ray 3.7 file (isosurface with a computed max_gradient)",
     "usage: blendtool pov SCENE -o OUT.pov [--include-only] [--silhouette] [--width W --height "
     "H]\n"
-    "                     [--mesh N [--features] [--simplify TOL]] [--set PATH=VALUE]...\n\n"
+    "                     [--mesh N [--features] [--merge-flat] [--simplify TOL]]\n"
+    "                     [--set PATH=VALUE]...\n\n"
     "Writes a complete POV-Ray 3.7 scene: the field as functions built with\n"
     "libblend.inc, one isosurface over the scene's bounds with a max_gradient\n"
     "computed by libblend, camera, lights and material from the scene's render\n"
@@ -245,6 +252,8 @@ const bt_command bt_cmd_pov = {
     "                  seconds to render where a soft or local blend takes minutes\n"
     "  --features      with --mesh: sharp creases and corners kept, each side of a\n"
     "                  crease shaded with its own normal (normal_indices)\n"
+    "  --merge-flat    with --mesh: flat regions in few triangles, no vertex moved\n"
+    "                  (as blendtool mesh --merge-flat)\n"
     "  --simplify TOL  with --mesh: merge triangles within TOL cells of the field\n"
     "                  (0 < TOL <= 1; as blendtool mesh --simplify)\n"
     "  --width, --height  the image's aspect ratio for the camera (640 x 480)\n"
@@ -259,7 +268,7 @@ const bt_command bt_cmd_render = {
     "usage: blendtool render SCENE -o OUT.{png,exr} [--width W] [--height H] [--threads N]\n"
     "                        [--quality Q] [--silhouette] [--bits 8|16] [--pixel half|float]\n"
     "                        [--alpha] [--antialias] [--quiet]\n"
-    "                        [--mesh N [--features] [--simplify TOL]]\n"
+    "                        [--mesh N [--features] [--merge-flat] [--simplify TOL]]\n"
     "                        [--set PATH=VALUE]...\n\n"
     "Exports the scene (as blendtool pov) and runs povray on it; povray's progress\n"
     "streams to standard error (--quiet: into a log, shown only if povray fails).\n"

@@ -57,6 +57,9 @@ typedef struct lb_pov_options {
                              (LB_MESH_FEATURES) and each side of a crease shaded with its own
                              normal (LB_MESH_CORNER_NORMALS, as the mesh2's normal_indices) */
     double mesh_simplify; /* with mesh_resolution: lb_mesh_options.simplify (cells, 0 = off) */
+    int mesh_merge_flat;  /* with mesh_resolution, non-zero: flat regions merged into few
+                             triangles (LB_MESH_MERGE_FLAT: no vertex moves; mesh_simplify
+                             merges them too) */
 } lb_pov_options;
 
 /* ---- render defaults every exporter shares (the POV-Ray writer and the

@@ -339,7 +339,7 @@ static void include_tail(sbuf *b, const lb_scene *scene, double g, double diag) 
 /* The whole .pov text into b (freed by the caller). */
 static lb_status pov_text(const lb_scene *scene, const lb_evaluator *ev, const lb_pov_options *opt,
                           sbuf *out, double *out_gradient, lb_error *err) {
-    lb_pov_options o = {0, 0, 0.0, 0.0, 0, 0, 0, 0.0};
+    lb_pov_options o = {0, 0, 0.0, 0.0, 0, 0, 0, 0.0, 0};
     if (opt) o = *opt;
     if (!scene->has_bounds)
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,

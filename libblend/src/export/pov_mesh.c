@@ -25,6 +25,7 @@ lb_status lb__pov_mesh(sbuf *b, const lb_evaluator *ev, const double lo[3], cons
     mo.threads = o->threads;
     mo.simplify = o->mesh_simplify;
     if (o->mesh_features) mo.flags = LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS;
+    if (o->mesh_merge_flat) mo.flags |= LB_MESH_MERGE_FLAT;
     lb_mesh *m = NULL;
     const lb_status s = lb_mesh_create(ev, &mo, &m, err);
     if (s) return s;
