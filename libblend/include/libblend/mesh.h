@@ -11,7 +11,10 @@
  *    the surface (refined along its grid edge by a safeguarded root solve to
  *    |f| / |grad f| <= 1e-7 cell sizes) with its normal from the analytic
  *    gradient (with LB_MESH_FEATURES, a crease or corner point to the same
- *    tolerance, its normal the mean of its cell polygon's). Closed (every
+ *    tolerance, its normal the mean of its cell polygon's; and a local
+ *    union's blending volume narrower than a quarter cell is meshed as the
+ *    sharp union it rounds: there the vertices are on the clean union,
+ *    within about the volume's radius of the surface). Closed (every
  *    edge in exactly two triangles) and 2-manifold;
  *    where the region cuts the solid the mesh is closed by a cap on the
  *    region's faces, or left open with LB_MESH_OPEN_BOUNDARY.
@@ -62,7 +65,12 @@ extern "C" {
  * region's cap), the cell gets a vertex on the crease or corner, found from
  * the normals by a least-squares fit within the cell and put on the surface;
  * still closed, manifold and independent of the thread count (docs/meshing.md,
- * Sharp features). Not with LB_MESH_TETRAHEDRA (ignored there). */
+ * Sharp features). A local union's blending volume of radius under a quarter
+ * of the smallest cell side, a fillet the grid cannot hold, is meshed as the
+ * clean union there (its crease kept, the fillet left out: no vertex can
+ * hold it, and the fans from a vertex on it cut the sides beyond it by a
+ * tenth of a cell). Not with LB_MESH_TETRAHEDRA
+ * (ignored there). */
 #define LB_MESH_FEATURES 4u
 /* with LB_MESH_FEATURES: also a normal per side of each crease for the
  * triangle corners there (lb_mesh.corner_normals), so renderers shade the

@@ -40,7 +40,7 @@ void lb__local_bounds(const lb_evaluator *ev, const lb__instr *in, const lb__iv 
         const double a = (lb__op_flags(nd) & LB__R_CURVES)
                              ? lb__local_nearest(in->curves, bc, &c, Q, &dist)
                              : 1.0;
-        if (a < 1.0) {
+        if (a < 1.0 && in->curves->comp[c].R >= ev->sharp_below) {
             const lb__component *P = &in->curves->comp[c];
             double dw, gm[3];
             const double ub = lb__barthe_eval(m, P->p, P->q, gb);

@@ -47,7 +47,7 @@ lb_status lb__local_run(const lb_evaluator *ev, const lb__instr *in, size_t n, c
             uint32_t c = 0;
             double Q[3] = {0.0, 0.0, 0.0}, dist = 0.0;
             const double a = lb__local_nearest(in->curves, X, &c, Q, &dist);
-            if (a < 1.0) {
+            if (a < 1.0 && in->curves->comp[c].R >= ev->sharp_below) {
                 const lb__component *K = &in->curves->comp[c];
                 double dw, gub[2], gm[3];
                 const double v = lb__wyvill(a, &dw);

@@ -66,6 +66,10 @@ struct lb_evaluator {
     int cullable;        /* some operator can drop arguments per box (lb__bounds_pass) */
     double cost;         /* instruction runs per point for the whole tape (the cost model) */
     double compile_cost; /* instruction runs the local unions' curve finding took */
+    /* a local union's blending volumes of radius R below this are not
+     * blended: the clean union there (0 for every compiled evaluator; the
+     * mesher's copy with sharp features sets it, mesher.c) */
+    double sharp_below;
 };
 
 /* What one box needs (argument culling, libfive-style tape specialisation):

@@ -21,6 +21,9 @@
 
 #define LB__MB 8      /* cells per block side */
 #define LB__MAXPOLY 7 /* most vertices of one cell polygon (cubes: 7, tetrahedra: 4) */
+/* with sharp features, a local union's blending volume of radius below this
+ * many cells is meshed as the clean union (mesher.c) */
+#define LB__SHARP_BLEND 0.25
 /* nodes of the largest block */
 #define LB__SLAB_NODES ((size_t)(LB__MB + 1) * (LB__MB + 1) * (LB__MB + 1))
 /* crossing edges a block can have: one per node and axis mask (every

@@ -1531,6 +1531,16 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     lb_status s = make_grid(ev, opt, &g, err);
     if (s) return s;
     lb__mctable_init(&g.mc); /* extraction only: not in make_grid, which fits() calls */
+    /* with sharp features, a local union's blending volume narrower than
+     * LB__SHARP_BLEND cells is meshed as the sharp union it rounds: the
+     * evaluator's copy for this mesh says so (docs/meshing.md, "Blends
+     * below a cell") */
+    lb_evaluator sharp;
+    if (g.features && !g.tetrahedra) {
+        sharp = *ev;
+        sharp.sharp_below = LB__SHARP_BLEND * fmin(g.h[0], fmin(g.h[1], g.h[2]));
+        ev = &sharp;
+    }
     const size_t max_memory = opt->max_memory ? opt->max_memory : LB_MESH_DEFAULT_MAX_MEMORY;
     const size_t max_blocks = max_memory / BLOCK_BYTES;
     run R;
