@@ -107,7 +107,14 @@ typedef struct simp {
     vec32 ru, rv, nu, nv, tmp; /* scratch: rings and neighbour sets */
     double *s;                 /* samples: 7 arrays of scap */
     size_t scap;
-    lb_status est;  /* the evaluator's failure */
+    lb_status est; /* the evaluator's failure */
+    /* the evaluation of a move's samples: lb__eval_few's registers and
+     * plans, allocated once (lb_evaluator_eval's own, the same bits, took
+     * a fifth of the simplification's instructions in malloc and free on
+     * S2 at 128 cells); few: both allocated */
+    lb__boxeval E;
+    lb__plan outer;
+    int few;
     uint32_t *mark; /* per vertex (fresh) */
     uint32_t tok;
 } simp;
@@ -344,8 +351,10 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser,
     }
     double *x = S->s, *y = x + S->scap, *z = y + S->scap, *f = z + S->scap, *gx = f + S->scap,
            *gy = gx + S->scap, *gz = gy + S->scap;
-    if ((S->est = lb_evaluator_eval(S->ev, total, x, y, z, f, gx, gy, gz, 1, err)) != LB_OK)
-        return -2;
+    S->est = S->few && total <= LB__FEW
+                 ? lb__eval_few(S->ev, &S->E, &S->outer, total, x, y, z, f, gx, gy, gz, err)
+                 : lb_evaluator_eval(S->ev, total, x, y, z, f, gx, gy, gz, 1, err);
+    if (S->est != LB_OK) return -2;
     for (size_t i = 0; i < total; ++i) {
         const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
         double gp[3];
@@ -716,6 +725,9 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     if (!S.next || !S.head || !S.tail || !S.tdead || !S.kind || !S.sn || !S.Q || !S.stamp ||
         !S.mark)
         s = nomem(err);
+    /* without them, lb_evaluator_eval's own (the same values) */
+    S.few =
+        lb__boxeval_alloc(ev, &S.E, NULL) == LB_OK && lb__plan_alloc(ev, &S.outer, NULL) == LB_OK;
     if (!s) s = setup(&S, err);
     vec32 cand = {NULL, 0, 0};
     double *cost = NULL; /* the moves' costs */
@@ -794,5 +806,7 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     free(S.nv.a);
     free(S.tmp.a);
     free(S.s);
+    lb__boxeval_free(&S.E);
+    lb__plan_free(&S.outer);
     return s;
 }
