@@ -82,8 +82,8 @@ LB_INTERNAL lb_status lb__pov_local(pctx *c, const lb__node *n, int id, const ch
 #define LB_POV_VERBATIM_END "// end of libblend mesh data"
 /* "mesh2 { vertex_vectors ... face_indices ... " of a mesh of ev over
  * [lo, hi] at o's mesh_resolution cells, with its mesh_features,
- * mesh_simplify and mesh_merge_flat (the caller writes the texture and the closing brace);
- * nothing and *empty = 1 when the mesh has no triangle */
+ * mesh_simplify and mesh_merge_flat (the caller writes the texture and
+ * the closing brace); nothing and *empty = 1 when the mesh has no triangle */
 LB_INTERNAL lb_status lb__pov_mesh(sbuf *b, const lb_evaluator *ev, const double lo[3],
                                    const double hi[3], const lb_pov_options *o, int *empty,
                                    lb_error *err);
