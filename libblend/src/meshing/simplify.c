@@ -45,8 +45,14 @@
  *      longer than 64 cells is sampled more coarsely), a coarse lattice of
  *      3 steps first, and each sample's distance estimate
  *      |phi_c| / |grad phi_c| must be within the tolerance; phi_c includes
- *      the region's cap.
- *    A vertex whose every move fails waits until a neighbour moves.
+ *      the region's cap. The samples are evaluated under the plan of a
+ *      window (a box of 8 cells a side, one every 4 cells on each axis,
+ *      made by one interval pass and kept) narrowed to the triangles' box,
+ *      when they fit in one; otherwise under their own box's plan.
+ *    A move that failed its shape or field check is not checked again while
+ *    u's ring is unchanged (those checks see nothing else). A vertex whose
+ *    every move fails waits until a neighbour moves; when every move failed
+ *    those checks, until its own ring changes.
  * 4. The survivors keep their positions and normals (every vertex is still
  *    a point of the original mesh, on the surface) and their order; the
  *    triangles keep theirs.
@@ -70,14 +76,20 @@
 #define TURN_COS 0.5    /* a moved triangle's normal turns by at most 60 degrees */
 #define SLIVER 1e-4     /* a moved triangle's area over its longest edge squared, at least */
 #define CHECK_EVERY 256 /* vertices tried between looks at the cancel flag */
-/* bytes the pass needs at most per triangle (corner lists, the sorted edges
- * and facings of the setup) and per vertex (lists' ends, kind, crease
- * neighbours, quadric, stamps, and its heap entries: one, then about ten
- * per move nearby), for the memory cap */
-#define TRI_BYTES 96
-#define VERTEX_BYTES 288
+/* bytes the pass needs at most per triangle (corner lists, the edges before
+ * and after sorting and the facings of the setup) and per vertex (lists'
+ * ends, kind, crease neighbours, quadric, stamps, failed moves, the sort's
+ * counts, and its heap entries: one, then about ten per move nearby), for
+ * the memory cap (and WSLOTS window plans, each at most the tape's size) */
+#define TRI_BYTES 144
+#define VERTEX_BYTES 297
 #define FLAT 1e-6 /* cells: a ring this close to one plane is flat */
 #define TIE 1e-4  /* the edge length's weight in a move's cost (h^2 len^2) */
+/* The plans of windows: boxes of 2 WSTEP cells a side, WSTEP cells apart on
+ * each axis, so that any box up to WSTEP cells a side lies in one of them;
+ * WSLOTS of them kept (a direct-mapped cache) */
+#define WSTEP 4
+#define WSLOTS 4096
 
 typedef struct hent {
     double cost;
@@ -117,6 +129,16 @@ typedef struct simp {
     int few;
     uint32_t *mark; /* per vertex (fresh) */
     uint32_t tok;
+    /* per vertex: the moves onto its neighbours (bit i: the i-th of its
+     * ring's neighbours, in ring order) that failed a check of shape or
+     * field; kept while its ring is unchanged, since those checks see
+     * nothing else: tried again, they would fail again */
+    uint32_t *failed;
+    uint8_t *stuck; /* per vertex: every move failed so (not queued again) */
+    /* window plans: slot k holds the window wkey[k] (UINT64_MAX: none) */
+    uint64_t *wkey;
+    lb__cplan *wplan;
+    double sbox[6]; /* the moved triangles' box (near_surface): min, max */
 } simp;
 
 static lb_status nomem(lb_error *err) {
@@ -279,6 +301,7 @@ static int moves(simp *S, uint32_t u, vec32 *t, double *best) {
 
 static int requeue(simp *S, uint32_t u) {
     ++S->stamp[u];
+    if (S->stuck[u]) return 1;
     double c;
     if (!moves(S, u, &S->tmp, &c)) return 1;
     return hpush(S, c, u);
@@ -311,6 +334,42 @@ static size_t lattice_size(int n) {
     return (size_t)(n + 1) * (size_t)(n + 2) / 2 - 3; /* without the corners */
 }
 
+/* The plan of the window holding the box S->sbox (the moved triangles'),
+ * made once for the window and kept in its slot (an interval pass over the
+ * window instead of one over the samples' box for every move: the same
+ * values, since a plan only leaves out what provably changes nothing in
+ * its box); NULL when the box spans more than WSTEP cells on an axis or
+ * when memory is short (S->est set then: LB_ERR_NO_MEMORY). */
+static const lb__cplan *window_plan(simp *S, lb_error *err) {
+    uint64_t key = 0;
+    double bmin[3], bmax[3];
+    for (int d = 0; d < 3; ++d) {
+        const double lo = S->sbox[d], hi = S->sbox[3 + d];
+        const double step = WSTEP * S->g->h[d], pad = 1e-9 * S->g->h[d];
+        double w = floor((lo - S->g->origin[d]) / step);
+        /* the window from w: [w, w + 2) steps, the box inside it by a
+         * margin (one step lower where rounding put lo at its edge), within
+         * 2^20 windows of the origin (the grid has at most 8192 cells a
+         * side) */
+        if (!(S->g->origin[d] + w * step <= lo - pad)) w -= 1.0;
+        if (!(w >= -1.0 && w < 1048575.0)) return NULL;
+        bmin[d] = S->g->origin[d] + w * step;
+        bmax[d] = bmin[d] + 2.0 * step;
+        if (!(bmin[d] <= lo - pad && hi <= bmax[d] - pad)) return NULL;
+        key |= (uint64_t)(w + 1.0) << (21 * d);
+    }
+    const size_t k = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 52) % WSLOTS;
+    if (S->wkey[k] == key) return &S->wplan[k];
+    if (S->wkey[k] != UINT64_MAX) lb__cplan_free(&S->wplan[k]);
+    S->wkey[k] = UINT64_MAX;
+    double bc[3], br[3];
+    lb__box_centre(bmin, bmax, bc, br);
+    lb__bounds_pass(S->ev, bc, br, S->E.iv, &S->outer);
+    if ((S->est = lb__cplan_make(S->ev, &S->outer, &S->wplan[k], err))) return NULL;
+    S->wkey[k] = key;
+    return &S->wplan[k];
+}
+
 /* The triangles of u's ring (S->ru) that u's move onto v keeps, with v for
  * u: every point of their lattices (but the corners; at most maxn steps
  * along an edge) within the tolerance of the surface, by one evaluation: 1,
@@ -320,6 +379,10 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser,
     *coarser = 0;
     const uint32_t *T = S->M->triangles;
     size_t total = 0;
+    for (int d = 0; d < 3; ++d) {
+        S->sbox[d] = INFINITY;
+        S->sbox[3 + d] = -INFINITY;
+    }
     for (int pass = 0; pass < 2; ++pass) {
         size_t m = 0;
         for (size_t i = 0; i < S->ru.n; ++i) {
@@ -334,6 +397,11 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser,
             }
             if (pass == 0) {
                 total += lattice_size(n);
+                for (int k = 0; k < 3; ++k)
+                    for (int d = 0; d < 3; ++d) {
+                        S->sbox[d] = fmin(S->sbox[d], q[k][d]);
+                        S->sbox[3 + d] = fmax(S->sbox[3 + d], q[k][d]);
+                    }
                 continue;
             }
             double *x = S->s, *y = x + S->scap, *z = y + S->scap;
@@ -351,9 +419,19 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser,
     }
     double *x = S->s, *y = x + S->scap, *z = y + S->scap, *f = z + S->scap, *gx = f + S->scap,
            *gy = gx + S->scap, *gz = gy + S->scap;
-    S->est = S->few && total <= LB__FEW
-                 ? lb__eval_few(S->ev, &S->E, &S->outer, total, x, y, z, f, gx, gy, gz, err)
-                 : lb_evaluator_eval(S->ev, total, x, y, z, f, gx, gy, gz, 1, err);
+    S->est = LB_OK;
+    const lb__cplan *C = S->few ? window_plan(S, err) : NULL;
+    if (S->est) return -2;
+    if (C) { /* the window's plan narrowed to the triangles' box */
+        lb__boxeval_load(S->ev, C, &S->E);
+        lb__plan_load(S->ev, &S->E.plan, &S->outer);
+        lb__boxeval_narrow(S->ev, &S->E, &S->outer, S->sbox, S->sbox + 3);
+        S->est = lb__boxeval_run(S->ev, &S->E, total, x, y, z, f, gx, gy, gz, err);
+    } else {
+        S->est = S->few && total <= LB__FEW
+                     ? lb__eval_few(S->ev, &S->E, &S->outer, total, x, y, z, f, gx, gy, gz, err)
+                     : lb_evaluator_eval(S->ev, total, x, y, z, f, gx, gy, gz, 1, err);
+    }
     if (S->est != LB_OK) return -2;
     for (size_t i = 0; i < total; ++i) {
         const double X[3] = {x[i], y[i], z[i]}, gf[3] = {gx[i], gy[i], gz[i]};
@@ -433,10 +511,10 @@ static int flat_ring(const simp *S, uint32_t u) {
     return 1;
 }
 
-/* Whether u can move onto v now: 1 yes, 0 no, -1 out of memory, -2 the
- * evaluator failed. S->ru and S->nu hold u's ring and neighbours (the same
- * for every move of u tried); v's go into S->rv and S->nv. */
-static int can_move(simp *S, uint32_t u, uint32_t v, lb_error *err) {
+/* Whether the mesh stays a closed 2-manifold when u moves onto v: 1 yes, 0
+ * no, -1 out of memory. S->ru and S->nu hold u's ring and neighbours (the
+ * same for every move of u tried); v's go into S->rv and S->nv. */
+static int keeps_topology(simp *S, uint32_t u, uint32_t v) {
     const uint32_t *T = S->M->triangles;
     if (!ring(S, v, &S->rv) || !neighbours(S, v, &S->rv, &S->nv)) return -1;
     /* topology: the edge's two triangles and their far vertices */
@@ -461,6 +539,15 @@ static int can_move(simp *S, uint32_t u, uint32_t v, lb_error *err) {
         if (!ring(S, opp[k], &S->tmp)) return -1;
         if (S->tmp.n < 4) return 0;
     }
+    return 1;
+}
+
+/* Whether the triangles of u's ring (S->ru; neighbours S->nu) moved with u
+ * onto v keep their shape and stay within the tolerance of the field: 1
+ * yes, 0 no, -1 out of memory, -2 the evaluator failed. Sees only u's ring
+ * and v's point and normal. */
+static int keeps_shape(simp *S, uint32_t u, uint32_t v, lb_error *err) {
+    const uint32_t *T = S->M->triangles;
     /* shape */
     const double *pv = P(S, v);
     for (size_t i = 0; i < S->ru.n; ++i) {
@@ -522,6 +609,10 @@ static int do_move(simp *S, uint32_t u, uint32_t v) {
     uint32_t *T = S->M->triangles;
     for (size_t i = 0; i < S->ru.n; ++i) {
         uint32_t *t = T + 3 * (size_t)S->ru.a[i];
+        for (int k = 0; k < 3; ++k) { /* its ring changes: its moves are new */
+            S->failed[t[k]] = 0;
+            S->stuck[t[k]] = 0;
+        }
         if (t[0] == v || t[1] == v || t[2] == v)
             S->tdead[S->ru.a[i]] = 1;
         else
@@ -582,6 +673,33 @@ static int cmp_hedge(const void *a, const void *b) {
     return (x->t > y->t) - (x->t < y->t);
 }
 
+/* in[0..n) (in triangle order) into out in order of key, then triangle: a
+ * counting sort by the smaller vertex, which keeps the triangle order, then
+ * each vertex's few edges by the larger one (qsort of all of them was 7 %
+ * of the simplification's instructions on S2 at 128 cells). start: nv + 1
+ * zeros. */
+static void sort_hedges(const hedge *in, hedge *out, size_t n, uint32_t *start, size_t nv) {
+    for (size_t i = 0; i < n; ++i) ++start[(in[i].key >> 32) + 1];
+    for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+    for (size_t i = 0; i < n; ++i) out[start[in[i].key >> 32]++] = in[i];
+    /* start[v] is now the end of v's edges, which begin at start[v - 1] */
+    size_t b = 0;
+    for (size_t v = 0; v < nv; ++v) {
+        const size_t e = start[v];
+        if (e - b > 32) { /* a vertex of many triangles (a merged flat face's fan) */
+            qsort(out + b, e - b, sizeof *out, cmp_hedge);
+        } else {
+            for (size_t i = b + 1; i < e; ++i) {
+                const hedge x = out[i];
+                size_t j = i;
+                for (; j > b && out[j - 1].key > x.key; --j) out[j] = out[j - 1];
+                out[j] = x;
+            }
+        }
+        b = e;
+    }
+}
+
 static void add_sharp(simp *S, uint32_t *count, uint32_t a, uint32_t b) {
     if (count[a] < 2) S->sn[2 * (size_t)a + count[a]] = b;
     ++count[a];
@@ -591,11 +709,12 @@ static void add_sharp(simp *S, uint32_t *count, uint32_t a, uint32_t b) {
 static lb_status setup(simp *S, lb_error *err) {
     const lb_mesh *M = S->M;
     const size_t nv = M->nvertices, nt = M->ntriangles;
-    hedge *E = malloc(3 * nt * sizeof *E);
+    hedge *E = malloc(3 * nt * sizeof *E), *F = malloc(3 * nt * sizeof *F);
     double *un = malloc(3 * nt * sizeof *un); /* unit facings, 0 0 0: degenerate */
-    uint32_t *count = calloc(nv, sizeof *count);
-    if (!E || !un || !count) {
+    uint32_t *count = calloc(nv + 1, sizeof *count);
+    if (!E || !F || !un || !count) {
         free(E);
+        free(F);
         free(un);
         free(count);
         return nomem(err);
@@ -625,7 +744,10 @@ static lb_status setup(simp *S, lb_error *err) {
             E[3 * t + k].t = (uint32_t)t;
         }
     }
-    qsort(E, 3 * nt, sizeof *E, cmp_hedge);
+    sort_hedges(E, F, 3 * nt, count, nv);
+    free(E);
+    E = F;
+    memset(count, 0, nv * sizeof *count);
     for (size_t i = 0; i < 3 * nt;) {
         size_t j = i + 1;
         while (j < 3 * nt && E[j].key == E[i].key) ++j;
@@ -721,9 +843,14 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     S.Q = calloc(10 * nv, sizeof *S.Q);
     S.stamp = calloc(nv, sizeof *S.stamp);
     S.mark = calloc(nv, sizeof *S.mark);
+    S.failed = calloc(nv, sizeof *S.failed);
+    S.stuck = calloc(nv, 1);
+    S.wkey = malloc(WSLOTS * sizeof *S.wkey);
+    S.wplan = calloc(WSLOTS, sizeof *S.wplan);
+    for (size_t k = 0; S.wkey && k < WSLOTS; ++k) S.wkey[k] = UINT64_MAX;
     lb_status s = LB_OK;
     if (!S.next || !S.head || !S.tail || !S.tdead || !S.kind || !S.sn || !S.Q || !S.stamp ||
-        !S.mark)
+        !S.mark || !S.failed || !S.stuck || !S.wkey || !S.wplan)
         s = nomem(err);
     /* without them, lb_evaluator_eval's own (the same values) */
     S.few =
@@ -775,17 +902,33 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
             s = nomem(err);
             break;
         }
-        for (size_t i = 0; i < cand.n; ++i) {
-            const int r = can_move(&S, u, cand.a[i], err);
+        /* in cost order, the first that passes every check is made; a move
+         * that failed its shape or field check before, with u's ring as it
+         * is, is not checked again */
+        int moved = 0, stuck = 1; /* stuck: every move tried failed so */
+        for (size_t i = 0; i < cand.n && !moved; ++i) {
+            size_t bit = 0; /* the move's bit in S.failed[u] (none from 32 on) */
+            while (bit < S.nu.n && S.nu.a[bit] != cand.a[i]) ++bit;
+            const uint32_t mask = bit < 32 ? (uint32_t)1 << bit : 0;
+            if (S.failed[u] & mask) continue;
+            int r = keeps_topology(&S, u, cand.a[i]);
+            if (r == 1) {
+                r = keeps_shape(&S, u, cand.a[i], err);
+                if (r == 0) S.failed[u] |= mask;
+            }
             if (r == -1) s = nomem(err);
             if (r == -2) s = S.est;
-            if (r != 1) {
-                if (s) break;
-                continue;
+            if (s) break;
+            if (r == 1) {
+                if (!do_move(&S, u, cand.a[i])) s = nomem(err);
+                moved = 1;
+            } else if (!(S.failed[u] & mask)) {
+                stuck = 0; /* the topology, which v's ring can change */
             }
-            if (!do_move(&S, u, cand.a[i])) s = nomem(err);
-            break;
         }
+        /* then every move fails whatever u's neighbours do, until u's ring
+         * changes (do_move clears this): u is not queued again till then */
+        if (!s && !moved && stuck) S.stuck[u] = 1;
     }
     if (!s) compact(&S, feat);
     free(cand.a);
@@ -799,6 +942,12 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     free(S.Q);
     free(S.stamp);
     free(S.mark);
+    free(S.failed);
+    free(S.stuck);
+    for (size_t k = 0; S.wkey && k < WSLOTS; ++k)
+        if (S.wkey[k] != UINT64_MAX) lb__cplan_free(&S.wplan[k]);
+    free(S.wkey);
+    free(S.wplan);
     free(S.heap);
     free(S.ru.a);
     free(S.rv.a);
