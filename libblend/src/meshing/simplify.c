@@ -73,6 +73,7 @@
 #define FIXED 2
 #define GONE 3
 #define MAXSTEPS 64     /* lattice steps along a triangle's edge at most */
+#define ROWS 0.8        /* the rows' spacing (triangle_samples), in h */
 #define TURN_COS 0.5    /* a moved triangle's normal turns by at most 60 degrees */
 #define SLIVER 1e-4     /* a moved triangle's area over its longest edge squared, at least */
 #define CHECK_EVERY 256 /* vertices tried between looks at the cancel flag */
@@ -317,21 +318,89 @@ static int samples_room(simp *S, size_t n) {
     return S->s != NULL;
 }
 
-/* Lattice steps along the edges of triangle q: a cell apart, 2 to MAXSTEPS. */
-static int steps_of(const double *const q[3], double h) {
-    double L = 0.0;
-    for (int k = 0; k < 3; ++k) {
-        const double *x = q[k], *y = q[(k + 1) % 3];
-        const double e[3] = {y[0] - x[0], y[1] - x[1], y[2] - x[2]};
-        const double l = norm3(e);
-        if (l > L) L = l;
+/* Steps of length at most h over length l: 2 to maxn (*coarser set when h
+ * apart would need more). */
+static int steps(double l, double h, int maxn, int *coarser) {
+    const double n = ceil(l / h);
+    if (!(n <= maxn)) {
+        *coarser = 1;
+        return maxn;
     }
-    const double n = ceil(L / h);
-    return !(n >= 2.0) ? 2 : n > MAXSTEPS ? MAXSTEPS : (int)n;
+    return n >= 2.0 ? (int)n : 2;
 }
 
-static size_t lattice_size(int n) {
-    return (size_t)(n + 1) * (size_t)(n + 2) / 2 - 3; /* without the corners */
+/* The samples of triangle q: a barycentric lattice of n steps along each
+ * edge, n the longest edge over h (every point of the triangle within
+ * h / sqrt(3) of a sample); or, for a thin triangle (n above 4 and its m
+ * rows fewer than 0.7 n), rows parallel to its longest edge AB, from AB to the
+ * opposite corner C, at most ROWS h apart (C's height over AB divided into
+ * m steps), each divided into steps of at most ROWS h (every point within
+ * ROWS h / sqrt(2) of a sample, no farther than the lattice's): as many
+ * samples as its area needs, where the lattice would take its longest
+ * edge's length squared. At most maxn steps along an edge, rows or along a
+ * row (*coarser set when the layout taken needed more). The corners are
+ * left out (points of the mesh, on the surface). Into x, y, z unless x is
+ * NULL; returns how many. */
+static size_t triangle_samples(const double *const q[3], double h, int maxn, int *coarser,
+                               double *x, double *y, double *z) {
+    int k = 0;
+    double L2 = -1.0;
+    for (int i = 0; i < 3; ++i) {
+        const double *a = q[i], *b = q[(i + 1) % 3];
+        const double e2 = (b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                          (b[2] - a[2]) * (b[2] - a[2]);
+        if (e2 > L2) {
+            L2 = e2;
+            k = i;
+        }
+    }
+    const double *A = q[k], *B = q[(k + 1) % 3], *C = q[(k + 2) % 3];
+    const double L = sqrt(L2), hr = ROWS * h;
+    int lc = 0, rc = 0; /* each layout's coarser */
+    const int n = steps(L, h, maxn, &lc);
+    int m = n; /* thin only when longer than 4 steps */
+    if (n > 4) {
+        double cr[3];
+        lb__facing(A, B, C, cr);
+        m = steps(norm3(cr) / L, hr, maxn, &rc);
+    }
+    size_t c = 0;
+    if (10 * m >= 7 * n) { /* not thin: the lattice */
+        if (lc) *coarser = 1;
+        for (int a = 0; a <= n; ++a)
+            for (int b = 0; a + b <= n; ++b) {
+                if ((a == 0 && b == 0) || a == n || b == n) continue;
+                if (x) {
+                    const double wb = (double)a / n, wc = (double)b / n, wa = 1.0 - wb - wc;
+                    x[c] = wa * q[0][0] + wb * q[1][0] + wc * q[2][0];
+                    y[c] = wa * q[0][1] + wb * q[1][1] + wc * q[2][1];
+                    z[c] = wa * q[0][2] + wb * q[1][2] + wc * q[2][2];
+                }
+                ++c;
+            }
+        return c;
+    }
+    for (int j = 0; j < m; ++j) { /* row m is C alone */
+        const double t = (double)j / m;
+        const int nr = steps((1.0 - t) * L, hr, maxn, &rc);
+        for (int i = 0; i <= nr; ++i) {
+            if (j == 0 && (i == 0 || i == nr)) continue; /* A, B */
+            if (x) {
+                const double s = (double)i / nr;
+                double p[3];
+                for (int d = 0; d < 3; ++d) {
+                    const double l = A[d] + t * (C[d] - A[d]), r = B[d] + t * (C[d] - B[d]);
+                    p[d] = l + s * (r - l);
+                }
+                x[c] = p[0];
+                y[c] = p[1];
+                z[c] = p[2];
+            }
+            ++c;
+        }
+    }
+    if (rc) *coarser = 1;
+    return c;
 }
 
 /* The plan of the window holding the box S->sbox (the moved triangles'),
@@ -371,10 +440,10 @@ static const lb__cplan *window_plan(simp *S, lb_error *err) {
 }
 
 /* The triangles of u's ring (S->ru) that u's move onto v keeps, with v for
- * u: every point of their lattices (but the corners; at most maxn steps
- * along an edge) within the tolerance of the surface, by one evaluation: 1,
- * else 0; -1 when out of memory, -2 when the evaluator fails (err set).
- * *coarser: some triangle had more steps than maxn allowed. */
+ * u: every sample of theirs (triangle_samples, at most maxn steps a row and
+ * rows a triangle) within the tolerance of the surface, by one evaluation:
+ * 1, else 0; -1 when out of memory, -2 when the evaluator fails (err set).
+ * *coarser: some triangle needed more than maxn. */
 static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser, lb_error *err) {
     *coarser = 0;
     const uint32_t *T = S->M->triangles;
@@ -390,13 +459,8 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser,
             if (t[0] == v || t[1] == v || t[2] == v) continue;
             const double *q[3];
             for (int k = 0; k < 3; ++k) q[k] = P(S, t[k] == u ? v : t[k]);
-            int n = steps_of(q, S->h);
-            if (n > maxn) {
-                n = maxn;
-                *coarser = 1;
-            }
             if (pass == 0) {
-                total += lattice_size(n);
+                total += triangle_samples(q, S->h, maxn, coarser, NULL, NULL, NULL);
                 for (int k = 0; k < 3; ++k)
                     for (int d = 0; d < 3; ++d) {
                         S->sbox[d] = fmin(S->sbox[d], q[k][d]);
@@ -405,15 +469,7 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser,
                 continue;
             }
             double *x = S->s, *y = x + S->scap, *z = y + S->scap;
-            for (int a = 0; a <= n; ++a)
-                for (int b = 0; a + b <= n; ++b) {
-                    if ((a == 0 && b == 0) || a == n || b == n) continue;
-                    const double wb = (double)a / n, wc = (double)b / n, wa = 1.0 - wb - wc;
-                    x[m] = wa * q[0][0] + wb * q[1][0] + wc * q[2][0];
-                    y[m] = wa * q[0][1] + wb * q[1][1] + wc * q[2][1];
-                    z[m] = wa * q[0][2] + wb * q[1][2] + wc * q[2][2];
-                    ++m;
-                }
+            m += triangle_samples(q, S->h, maxn, coarser, x + m, y + m, z + m);
         }
         if (pass == 0 && !samples_room(S, total)) return -1;
     }
