@@ -73,7 +73,7 @@
 #define FIXED 2
 #define GONE 3
 #define MAXSTEPS 64     /* lattice steps along a triangle's edge at most */
-#define ROWS 0.8        /* the rows' spacing (triangle_samples), in h */
+#define ROWS 0.5        /* the rows' spacing (triangle_samples), in h */
 #define TURN_COS 0.5    /* a moved triangle's normal turns by at most 60 degrees */
 #define SLIVER 1e-4     /* a moved triangle's area over its longest edge squared, at least */
 #define CHECK_EVERY 256 /* vertices tried between looks at the cancel flag */
@@ -331,16 +331,19 @@ static int steps(double l, double h, int maxn, int *coarser) {
 
 /* The samples of triangle q: a barycentric lattice of n steps along each
  * edge, n the longest edge over h (every point of the triangle within
- * h / sqrt(3) of a sample); or, for a thin triangle (n above 4 and its m
- * rows fewer than 0.7 n), rows parallel to its longest edge AB, from AB to the
- * opposite corner C, at most ROWS h apart (C's height over AB divided into
- * m steps), each divided into steps of at most ROWS h (every point within
- * ROWS h / sqrt(2) of a sample, no farther than the lattice's): as many
- * samples as its area needs, where the lattice would take its longest
- * edge's length squared. At most maxn steps along an edge, rows or along a
- * row (*coarser set when the layout taken needed more). The corners are
- * left out (points of the mesh, on the surface). Into x, y, z unless x is
- * NULL; returns how many. */
+ * h / sqrt(3), 0.58 h, of a sample: its small triangles' sides are at most
+ * h); or, for a thin triangle (its m rows below fewer than half n), rows
+ * parallel to its longest edge AB, from AB towards the opposite corner C,
+ * at most ROWS h apart (C's height over AB divided into m steps), each
+ * divided into steps of at most ROWS h. Angles A and B are acute (AB is
+ * the longest side), so each row lies over the next: every point is at
+ * most ROWS h above a row and ROWS h / 2 along it from a sample, within
+ * 0.56 h, no farther than on the lattice; and a long thin triangle costs
+ * samples in proportion to its area, where the lattice would take its
+ * longest edge's length squared. At most maxn steps along an edge, rows or
+ * along a row (*coarser set when the layout taken needed more). The
+ * corners are left out (points of the mesh, on the surface). Into x, y, z
+ * unless x is NULL; returns how many. */
 static size_t triangle_samples(const double *const q[3], double h, int maxn, int *coarser,
                                double *x, double *y, double *z) {
     int k = 0;
@@ -358,14 +361,14 @@ static size_t triangle_samples(const double *const q[3], double h, int maxn, int
     const double L = sqrt(L2), hr = ROWS * h;
     int lc = 0, rc = 0; /* each layout's coarser */
     const int n = steps(L, h, maxn, &lc);
-    int m = n; /* thin only when longer than 4 steps */
+    int m = n; /* at least 2 rows: never fewer than half of n <= 4 */
     if (n > 4) {
         double cr[3];
         lb__facing(A, B, C, cr);
         m = steps(norm3(cr) / L, hr, maxn, &rc);
     }
     size_t c = 0;
-    if (10 * m >= 7 * n) { /* not thin: the lattice */
+    if (2 * m >= n) { /* not thin: the lattice */
         if (lc) *coarser = 1;
         for (int a = 0; a <= n; ++a)
             for (int b = 0; a + b <= n; ++b) {
