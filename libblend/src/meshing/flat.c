@@ -104,10 +104,8 @@ static int on_plane(const flat *F, uint32_t t, const double *P) {
         const double *n = M->normals + 3 * (size_t)T[k];
         if (!(n[0] * P[0] + n[1] * P[1] + n[2] * P[2] >= NORMAL_COS)) return 0;
     }
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                 w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                         u[0] * w[1] - u[1] * w[0]};
+    double n[3];
+    lb__facing(a, b, c, n);
     return n[0] * P[0] + n[1] * P[1] + n[2] * P[2] > 0.0;
 }
 
@@ -260,11 +258,8 @@ lb_status lb__merge_flat(const lb__grid *g, lb_mesh *M, uint8_t *feat, lb_error 
         if (!(n0[0] * n1[0] + n0[1] * n1[1] + n0[2] * n1[2] >= NORMAL_COS) ||
             !(n0[0] * n2[0] + n0[1] * n2[1] + n0[2] * n2[2] >= NORMAL_COS))
             continue; /* the quick test first: most triangles bend */
-        const double *a = pos(M, U[0]), *b = pos(M, U[1]), *c = pos(M, U[2]);
-        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                     w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                             u[0] * w[1] - u[1] * w[0]};
+        double n[3];
+        lb__facing(pos(M, U[0]), pos(M, U[1]), pos(M, U[2]), n);
         if (!(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] >= 0.04 * h * h * h * h)) continue;
         double P[4];
         nflat += seed_plane(&F, t, P) && on_plane(&F, (uint32_t)t, P);
