@@ -40,10 +40,11 @@
  *      the moved triangles cover exactly the old ones' polygon (same plane,
  *      none turned over), whose points were checked when they were made:
  *      nothing more to check;
- *    - the field: every moved triangle is sampled on a barycentric lattice
- *      at most a cell apart (at most 64 steps along an edge, so a triangle
- *      longer than 64 cells is sampled more coarsely), a coarse lattice of
- *      3 steps first, and each sample's distance estimate
+ *    - the field: every moved triangle is sampled at most a cell apart, on
+ *      a barycentric lattice or, a thin one, in rows along its longest edge
+ *      (triangle_samples; at most 64 steps along an edge or a row and 64
+ *      rows, so a triangle longer than 64 cells is sampled more coarsely),
+ *      a coarse pass of 3 steps first, and each sample's distance estimate
  *      |phi_c| / |grad phi_c| must be within the tolerance; phi_c includes
  *      the region's cap. The samples are evaluated under the plan of a
  *      window (a box of 8 cells a side, one every 4 cells on each axis,
@@ -59,8 +60,8 @@
  *
  * One thread, in a fixed order on the merged mesh, so the output does not
  * depend on the thread count. The cost grows with the number of moves tried
- * times the samples of their triangles: bounded by the 64-step cap per
- * triangle edge. */
+ * times the samples of their triangles: bounded by the 64-step caps per
+ * triangle edge, rows and row. */
 #include "mesh_internal.h"
 
 #include <math.h>
@@ -72,7 +73,7 @@
 #define CREASE 1
 #define FIXED 2
 #define GONE 3
-#define MAXSTEPS 64     /* lattice steps along a triangle's edge at most */
+#define MAXSTEPS 64     /* samples' steps along a triangle's edge, rows or a row at most */
 #define ROWS 0.5        /* the rows' spacing (triangle_samples), in h */
 #define TURN_COS 0.5    /* a moved triangle's normal turns by at most 60 degrees */
 #define SLIVER 1e-4     /* a moved triangle's area over its longest edge squared, at least */
@@ -332,7 +333,7 @@ static int steps(double l, double h, int maxn, int *coarser) {
 /* The samples of triangle q: a barycentric lattice of n steps along each
  * edge, n the longest edge over h (every point of the triangle within
  * h / sqrt(3), 0.58 h, of a sample: its small triangles' sides are at most
- * h); or, for a thin triangle (its m rows below fewer than half n), rows
+ * h); or, for a thin triangle (its m rows fewer than half n), rows
  * parallel to its longest edge AB, from AB towards the opposite corner C,
  * at most ROWS h apart (C's height over AB divided into m steps), each
  * divided into steps of at most ROWS h. Angles A and B are acute (AB is
