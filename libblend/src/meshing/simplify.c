@@ -136,7 +136,9 @@ typedef struct simp {
      * field; kept while its ring is unchanged, since those checks see
      * nothing else: tried again, they would fail again */
     uint32_t *failed;
-    uint8_t *stuck; /* per vertex: every move failed so (not queued again) */
+    uint8_t *stuck;  /* per vertex: every move failed so (not queued again) */
+    uint8_t *queued; /* per vertex: it has an entry in the heap (of cost qcost) */
+    double *qcost;
     /* window plans: slot k holds the window wkey[k] (UINT64_MAX: none) */
     uint64_t *wkey;
     lb__cplan *wplan;
@@ -302,10 +304,18 @@ static int moves(simp *S, uint32_t u, vec32 *t, double *best) {
 }
 
 static int requeue(simp *S, uint32_t u) {
-    ++S->stamp[u];
-    if (S->stuck[u]) return 1;
     double c;
-    if (!moves(S, u, &S->tmp, &c)) return 1;
+    if (S->stuck[u] || !moves(S, u, &S->tmp, &c)) {
+        ++S->stamp[u]; /* its entry goes */
+        S->queued[u] = 0;
+        return 1;
+    }
+    /* an entry of the same cost stands: the same place in the heap's order
+     * as a new one would take */
+    if (S->queued[u] && S->qcost[u] == c) return 1;
+    ++S->stamp[u];
+    S->queued[u] = 1;
+    S->qcost[u] = c;
     return hpush(S, c, u);
 }
 
@@ -905,12 +915,14 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     S.mark = calloc(nv, sizeof *S.mark);
     S.failed = calloc(nv, sizeof *S.failed);
     S.stuck = calloc(nv, 1);
+    S.queued = calloc(nv, 1);
+    S.qcost = malloc(nv * sizeof *S.qcost);
     S.wkey = malloc(WSLOTS * sizeof *S.wkey);
     S.wplan = calloc(WSLOTS, sizeof *S.wplan);
     for (size_t k = 0; S.wkey && k < WSLOTS; ++k) S.wkey[k] = UINT64_MAX;
     lb_status s = LB_OK;
     if (!S.next || !S.head || !S.tail || !S.tdead || !S.kind || !S.sn || !S.Q || !S.stamp ||
-        !S.mark || !S.failed || !S.stuck || !S.wkey || !S.wplan)
+        !S.mark || !S.failed || !S.stuck || !S.queued || !S.qcost || !S.wkey || !S.wplan)
         s = nomem(err);
     /* without them, lb_evaluator_eval's own (the same values) */
     S.few =
@@ -927,6 +939,7 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
         const hent e = hpop(&S);
         const uint32_t u = e.v;
         if (e.stamp != S.stamp[u] || S.kind[u] == GONE) continue;
+        S.queued[u] = 0;
         if (++tried % CHECK_EVERY == 0) {
             const double f = (double)tried / (double)(tried + S.nh);
             if (f > shown) shown = f;
@@ -935,17 +948,30 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
                 break;
             }
         }
-        double best;
-        if (!moves(&S, u, &cand, &best)) continue;
-        /* the moves in order of cost (stable: ties in ring order) */
-        if (cand.n > ccap) {
+        if (S.kind[u] != SMOOTH && S.kind[u] != CREASE) continue;
+        /* u's ring and neighbours, once for its moves and their checks */
+        if (!ring(&S, u, &S.ru) || !neighbours(&S, u, &S.ru, &S.nu)) {
+            s = nomem(err);
+            break;
+        }
+        /* its moves (as moves() finds them) in order of cost, each cost
+         * computed once (stable: ties in ring order) */
+        cand.n = 0;
+        int room = 1;
+        if (S.kind[u] == CREASE)
+            room = push32(&cand, S.sn[2 * (size_t)u]) && push32(&cand, S.sn[2 * (size_t)u + 1]);
+        else
+            for (size_t i = 0; room && i < S.nu.n; ++i) room = push32(&cand, S.nu.a[i]);
+        if (room && cand.n > ccap) {
             free(cost);
             ccap = cand.cap;
-            if (!(cost = malloc(ccap * sizeof *cost))) {
-                s = nomem(err);
-                break;
-            }
+            room = (cost = malloc(ccap * sizeof *cost)) != NULL;
         }
+        if (!room) {
+            s = nomem(err);
+            break;
+        }
+        if (!cand.n) continue;
         for (size_t i = 0; i < cand.n; ++i) {
             const uint32_t x = cand.a[i];
             const double c = move_cost(&S, u, x);
@@ -956,11 +982,6 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
             }
             cost[j] = c;
             cand.a[j] = x;
-        }
-        /* u's ring and neighbours, once for all its moves (can_move) */
-        if (!ring(&S, u, &S.ru) || !neighbours(&S, u, &S.ru, &S.nu)) {
-            s = nomem(err);
-            break;
         }
         /* in cost order, the first that passes every check is made; a move
          * that failed its shape or field check before, with u's ring as it
@@ -1004,6 +1025,8 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     free(S.mark);
     free(S.failed);
     free(S.stuck);
+    free(S.queued);
+    free(S.qcost);
     for (size_t k = 0; S.wkey && k < WSLOTS; ++k)
         if (S.wkey[k] != UINT64_MAX) lb__cplan_free(&S.wplan[k]);
     free(S.wkey);
