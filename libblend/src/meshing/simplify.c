@@ -81,10 +81,11 @@
 /* bytes the pass needs at most per triangle (corner lists, the edges before
  * and after sorting and the facings of the setup) and per vertex (lists'
  * ends, kind, crease neighbours, quadric, stamps, failed moves, the sort's
- * counts, and its heap entries: one, then about ten per move nearby), for
- * the memory cap (and WSLOTS window plans, each at most the tape's size) */
+ * counts, its heap entry's cost, and its heap entries: one, then about ten
+ * per move nearby), for the memory cap (and WSLOTS window plans, each at
+ * most the tape's size) */
 #define TRI_BYTES 144
-#define VERTEX_BYTES 297
+#define VERTEX_BYTES 305
 #define FLAT 1e-6 /* cells: a ring this close to one plane is flat */
 #define TIE 1e-4  /* the edge length's weight in a move's cost (h^2 len^2) */
 /* The plans of windows: boxes of 2 WSTEP cells a side, WSTEP cells apart on
@@ -136,9 +137,8 @@ typedef struct simp {
      * field; kept while its ring is unchanged, since those checks see
      * nothing else: tried again, they would fail again */
     uint32_t *failed;
-    uint8_t *stuck;  /* per vertex: every move failed so (not queued again) */
-    uint8_t *queued; /* per vertex: it has an entry in the heap (of cost qcost) */
-    double *qcost;
+    uint8_t *stuck; /* per vertex: every move failed so (not queued again) */
+    double *hcost;  /* per vertex: the cost of its entry in the heap (NAN: none) */
     /* window plans: slot k holds the window wkey[k] (UINT64_MAX: none) */
     uint64_t *wkey;
     lb__cplan *wplan;
@@ -307,15 +307,14 @@ static int requeue(simp *S, uint32_t u) {
     double c;
     if (S->stuck[u] || !moves(S, u, &S->tmp, &c)) {
         ++S->stamp[u]; /* its entry goes */
-        S->queued[u] = 0;
+        S->hcost[u] = NAN;
         return 1;
     }
     /* an entry of the same cost stands: the same place in the heap's order
      * as a new one would take */
-    if (S->queued[u] && S->qcost[u] == c) return 1;
+    if (S->hcost[u] == c) return 1;
     ++S->stamp[u];
-    S->queued[u] = 1;
-    S->qcost[u] = c;
+    S->hcost[u] = c;
     return hpush(S, c, u);
 }
 
@@ -915,14 +914,14 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     S.mark = calloc(nv, sizeof *S.mark);
     S.failed = calloc(nv, sizeof *S.failed);
     S.stuck = calloc(nv, 1);
-    S.queued = calloc(nv, 1);
-    S.qcost = malloc(nv * sizeof *S.qcost);
+    S.hcost = malloc(nv * sizeof *S.hcost);
+    for (size_t v = 0; S.hcost && v < nv; ++v) S.hcost[v] = NAN;
     S.wkey = malloc(WSLOTS * sizeof *S.wkey);
     S.wplan = calloc(WSLOTS, sizeof *S.wplan);
     for (size_t k = 0; S.wkey && k < WSLOTS; ++k) S.wkey[k] = UINT64_MAX;
     lb_status s = LB_OK;
     if (!S.next || !S.head || !S.tail || !S.tdead || !S.kind || !S.sn || !S.Q || !S.stamp ||
-        !S.mark || !S.failed || !S.stuck || !S.queued || !S.qcost || !S.wkey || !S.wplan)
+        !S.mark || !S.failed || !S.stuck || !S.hcost || !S.wkey || !S.wplan)
         s = nomem(err);
     /* without them, lb_evaluator_eval's own (the same values) */
     S.few =
@@ -939,7 +938,7 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
         const hent e = hpop(&S);
         const uint32_t u = e.v;
         if (e.stamp != S.stamp[u] || S.kind[u] == GONE) continue;
-        S.queued[u] = 0;
+        S.hcost[u] = NAN;
         if (++tried % CHECK_EVERY == 0) {
             const double f = (double)tried / (double)(tried + S.nh);
             if (f > shown) shown = f;
@@ -1025,8 +1024,7 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     free(S.mark);
     free(S.failed);
     free(S.stuck);
-    free(S.queued);
-    free(S.qcost);
+    free(S.hcost);
     for (size_t k = 0; S.wkey && k < WSLOTS; ++k)
         if (S.wkey[k] != UINT64_MAX) lb__cplan_free(&S.wplan[k]);
     free(S.wkey);
