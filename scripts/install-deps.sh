@@ -22,6 +22,7 @@ PACKAGES=(
   parallel                   # tests: batch task lists through GNU parallel
   time                       # tests: GNU time measures blendtool's peak memory (input limits)
   valgrind                   # bench: instruction counts (callgrind) beside the timings (run_features_bench.sh)
+  libmeshoptimizer-dev       # bench: meshoptimizer's collapses, the floor of any collapse simplifier (run_simplify_bench.sh)
   gcc-mingw-w64-x86-64       # the Windows DLL, cross-compiled (cmake/mingw-w64-x86_64.cmake)
   wine64                     # tests: the Windows build's test programs (scripts/wine-run.sh)
   libopenvdb-dev             # blendtool vdb: narrow-band level sets written by OpenVDB (tools/vdb, C++)

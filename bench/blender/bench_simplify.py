@@ -8,7 +8,15 @@ the bounded-blending paper (with Sharp Features) and S2 (64 spheres), at 64
 and 128 cells: the synchronous update (live.update_now: mesh, then the
 Blender mesh data, Blender's own normals) plain, with Merge Flat, and with
 Simplify 0.1 cells, alternating, 7 rounds; medians, and of each the libblend and Blender parts.
-Prints one "BENCH {json}" line per configuration, then a table."""
+Then the floor of any edge-collapse simplifier: meshoptimizer's
+meshopt_simplify (Debian's libmeshoptimizer-dev, through ctypes; a
+benchmark dependency only) on the plain mesh Blender holds, to 0.1 cells
+of its quadric error and with no field to check, best of 7 in this
+process, against what Blender saves on the triangles it removes (its own
+intake time per triangle in this run). Prints one "BENCH {json}" line per
+configuration, then a table."""
+import ctypes
+import ctypes.util
 import json
 import os
 import statistics
@@ -17,6 +25,7 @@ import time
 
 import bpy
 import addon_utils
+import numpy as np
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 ADDON_PARENT, SRC = argv[:2]
@@ -33,6 +42,40 @@ SCENES = (("two boxes (CSG)", os.path.join(SRC, "tests", "data", "features", "tw
           ("stool", os.path.join(SRC, "scenes", "hsu-bounded-fig7-stool.json"), True),
           ("S2", os.path.join(SRC, "scenes", "bench-s2-64-spheres.json"), False))
 CONFIGS = (("plain", 0.0, False), ("merge_flat", 0.0, True), ("simplified", 0.1, False))
+_so = ctypes.util.find_library("meshoptimizer")
+MESHOPT = ctypes.CDLL(_so) if _so else None
+if MESHOPT is None:
+    print("meshoptimizer not found (apt-get install libmeshoptimizer-dev): its floor is left out")
+else:
+    MESHOPT.meshopt_simplify.restype = ctypes.c_size_t
+    MESHOPT.meshopt_simplify.argtypes = (
+        ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p, ctypes.c_size_t,
+        ctypes.c_size_t, ctypes.c_size_t, ctypes.c_float, ctypes.c_uint,
+        ctypes.POINTER(ctypes.c_float))
+    MESHOPT.meshopt_simplifyScale.restype = ctypes.c_float
+    MESHOPT.meshopt_simplifyScale.argtypes = (ctypes.c_void_p, ctypes.c_size_t, ctypes.c_size_t)
+
+
+def meshopt_floor(out, res, tol=0.1):
+    """meshopt_simplify on the mesh Blender holds: (best seconds, triangles)."""
+    me = out.data
+    pos = np.empty(3 * len(me.vertices), np.float32)
+    me.vertices.foreach_get("co", pos)
+    idx = np.empty(3 * len(me.polygons), np.uint32)
+    me.polygons.foreach_get("vertices", idx)  # triangles only: the add-on makes no others
+    bmin, bmax = live.region_of(out)
+    h = max(b - a for a, b in zip(bmin, bmax)) / res
+    nv = len(me.vertices)
+    scale = MESHOPT.meshopt_simplifyScale(pos.ctypes.data, nv, 12)
+    dst = np.empty_like(idx)
+    err = ctypes.c_float()
+    best, n = 1e30, 0
+    for _ in range(ROUNDS):
+        t0 = time.perf_counter()
+        n = MESHOPT.meshopt_simplify(dst.ctypes.data, idx.ctypes.data, idx.size, pos.ctypes.data,
+                                     nv, 12, 0, tol * h / scale, 0, ctypes.byref(err))
+        best = min(best, time.perf_counter() - t0)
+    return best, n // 3
 rows = []
 for name, path, feat in SCENES:
     bpy.ops.libblend.import_scene(filepath=path, with_render=False)
@@ -60,6 +103,14 @@ for name, path, feat in SCENES:
             r[k] = {"ms": 1000 * statistics.median(t[k]), "triangles": tris[k],
                     "libblend_ms": 1000 * statistics.median(p["mesh"] for p in parts[k]),
                     "blender_ms": 1000 * statistics.median(p["apply"] for p in parts[k])}
+        if MESHOPT is not None:
+            out.libblend.simplify, out.libblend.merge_flat = 0.0, False
+            ok, msg = live.update_now(out)
+            assert ok, msg
+            secs, n = meshopt_floor(out, res)
+            a = r["plain"]
+            r["meshopt"] = {"ms": 1000 * secs, "triangles": n,
+                            "blender_saves_ms": a["blender_ms"] * (1 - n / a["triangles"])}
         print("BENCH " + json.dumps(r), flush=True)
         rows.append(r)
 
@@ -74,3 +125,12 @@ for r in rows:
           (r["scene"], r["cells"], a["ms"], a["libblend_ms"], a["blender_ms"], m["ms"],
            m["libblend_ms"], m["blender_ms"], b["ms"], b["libblend_ms"], b["blender_ms"],
            a["triangles"], m["triangles"], b["triangles"], m["ms"] / a["ms"], b["ms"] / a["ms"]))
+if MESHOPT is not None:
+    print("\n| scene | cells | triangles | meshoptimizer, 0.1 cells, no field check | "
+          "triangles left | Blender saves on them | floor / saving |")
+    print("|---|---|---|---|---|---|---|")
+    for r in rows:
+        o = r["meshopt"]
+        print("| %s | %d | %d | %.1f ms | %d | %.1f ms | %.1fx |" %
+              (r["scene"], r["cells"], r["plain"]["triangles"], o["ms"], o["triangles"],
+               o["blender_saves_ms"], o["ms"] / o["blender_saves_ms"]))
