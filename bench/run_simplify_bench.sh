@@ -3,8 +3,9 @@
 # (bench/mesh/run_simplify_bench.py), then the add-on's live update with and
 # without it in headless Blender (bench/blender/bench_simplify.py), each
 # beside meshoptimizer's collapses on the same mesh (bench_meshopt; in
-# Blender through ctypes): what any collapse simplifier costs at least;
-# docs/meshing.md, Adaptive simplification.
+# Blender through ctypes): what any collapse simplifier costs at least; and
+# the triangles each leaves at a given error against the field
+# (bench/mesh/run_meshopt_error.py); docs/meshing.md, Adaptive simplification.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -18,6 +19,15 @@ for scene in scenes/bench-s1-three-spheres.json scenes/bench-s2-64-spheres.json;
     echo "$scene $(build-release/bench/bench_meshopt "$scene" "$res" 0.1 5)"
   done
 done
+echo
+echo "triangles at a given error against the field (libblend against meshoptimizer):"
+for res in 128 256; do
+  PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 bench/mesh/run_meshopt_error.py \
+    build-release/blender_addon/libblend_blender scenes/bench-s1-three-spheres.json "$res" 0.1 \
+    0.1,0.05,0.03
+done
+PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 bench/mesh/run_meshopt_error.py \
+  build-release/blender_addon/libblend_blender scenes/bench-s2-64-spheres.json 128 0.1 0.1,0.05
 echo
 PYTHONDONTWRITEBYTECODE=1 blender -b --factory-startup --python-exit-code 1 \
   --python bench/blender/bench_simplify.py -- build-release/blender_addon "$PWD" 2>&1 |
