@@ -161,6 +161,10 @@ static int push32(vec32 *v, uint32_t x) {
     return 1;
 }
 
+static double dot3(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
 static double norm3(const double *a) {
     return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
 }
@@ -360,8 +364,7 @@ static size_t triangle_samples(const double *const q[3], double h, int maxn, int
     double L2 = -1.0;
     for (int i = 0; i < 3; ++i) {
         const double *a = q[i], *b = q[(i + 1) % 3];
-        const double e2 = (b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
-                          (b[2] - a[2]) * (b[2] - a[2]);
+        const double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2 = dot3(e, e);
         if (e2 > L2) {
             L2 = e2;
             k = i;
@@ -510,10 +513,6 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser,
         if (!isfinite(ph) || !(gl > 0.0) || !isfinite(gl) || !(fabs(ph) <= S->tol * gl)) return 0;
     }
     return 1;
-}
-
-static double dot3(const double *a, const double *b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
 /* The squared distance from x to triangle (a, b, c): the nearest point by
