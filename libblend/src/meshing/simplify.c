@@ -81,11 +81,11 @@
 /* bytes the pass needs at most per triangle (corner lists, the edges before
  * and after sorting and the facings of the setup) and per vertex (lists'
  * ends, kind, crease neighbours, quadric, stamps, failed moves, the sort's
- * counts, its heap entry's cost, and its heap entries: one, then about ten
+ * counts, its heap entry's cost and target, and its heap entries: one, then about ten
  * per move nearby), for the memory cap (and WSLOTS window plans, each at
  * most the tape's size) */
 #define TRI_BYTES 144
-#define VERTEX_BYTES 305
+#define VERTEX_BYTES 309
 #define FLAT 1e-6 /* cells: a ring this close to one plane is flat */
 #define TIE 1e-4  /* the edge length's weight in a move's cost (h^2 len^2) */
 /* The plans of windows: boxes of 2 WSTEP cells a side, WSTEP cells apart on
@@ -139,6 +139,7 @@ typedef struct simp {
     uint32_t *failed;
     uint8_t *stuck; /* per vertex: every move failed so (not queued again) */
     double *hcost;  /* per vertex: the cost of its entry in the heap (NAN: none) */
+    uint32_t *htgt; /* per vertex with an entry: a move of that cost (its target) */
     /* window plans: slot k holds the window wkey[k] (UINT64_MAX: none) */
     uint64_t *wkey;
     lb__cplan *wplan;
@@ -289,8 +290,9 @@ static double move_cost(const simp *S, uint32_t u, uint32_t v) {
 }
 
 /* u's moves (its crease neighbours, or every neighbour of a smooth vertex)
- * into t, and the cheapest one's cost; 0 when u cannot move (or memory). */
-static int moves(simp *S, uint32_t u, vec32 *t, double *best) {
+ * into t, the cheapest one's cost and target (the first of that cost); 0
+ * when u cannot move (or memory). */
+static int moves(simp *S, uint32_t u, vec32 *t, double *best, uint32_t *target) {
     t->n = 0;
     if (S->kind[u] == CREASE) {
         if (!push32(t, S->sn[2 * (size_t)u]) || !push32(t, S->sn[2 * (size_t)u + 1])) return 0;
@@ -302,24 +304,54 @@ static int moves(simp *S, uint32_t u, vec32 *t, double *best) {
     *best = INFINITY;
     for (size_t i = 0; i < t->n; ++i) {
         const double c = move_cost(S, u, t->a[i]);
-        if (c < *best) *best = c;
+        if (c < *best) {
+            *best = c;
+            *target = t->a[i];
+        }
     }
     return t->n > 0;
 }
 
-static int requeue(simp *S, uint32_t u) {
-    double c;
-    if (S->stuck[u] || !moves(S, u, &S->tmp, &c)) {
-        ++S->stamp[u]; /* its entry goes */
-        S->hcost[u] = NAN;
-        return 1;
-    }
-    /* an entry of the same cost stands: the same place in the heap's order
-     * as a new one would take */
+/* u's heap entry at cost c (target x): an entry of the same cost stands
+ * (the same place in the heap's order as a new one would take). */
+static int enqueue(simp *S, uint32_t u, double c, uint32_t x) {
+    S->htgt[u] = x;
     if (S->hcost[u] == c) return 1;
     ++S->stamp[u];
     S->hcost[u] = c;
     return hpush(S, c, u);
+}
+
+static int requeue(simp *S, uint32_t u) {
+    double c;
+    uint32_t x = NONE;
+    if (S->stuck[u] || !moves(S, u, &S->tmp, &c, &x)) {
+        ++S->stamp[u]; /* its entry goes */
+        S->hcost[u] = NAN;
+        return 1;
+    }
+    return enqueue(S, u, c, x);
+}
+
+/* w's entry after u moved onto v, w a neighbour of either: of w's moves
+ * only the one onto u went and the one onto v is new or costs more (v's
+ * quadric took u's); the others cost what they did (their quadrics and
+ * points are unchanged). So when w's entry stands and its move is onto
+ * neither, its cheapest move is that one or the one onto v: the same
+ * minimum as requeue() finds walking w's ring. Otherwise requeue(). */
+static int requeue_near(simp *S, uint32_t w, uint32_t u, uint32_t v) {
+    if (S->stuck[w] || isnan(S->hcost[w]) || S->htgt[w] == u || S->htgt[w] == v)
+        return requeue(S, w);
+    if (S->kind[w] == CREASE) { /* moves along the crease only */
+        const uint32_t *s = S->sn + 2 * (size_t)w;
+        if (s[0] != v && s[1] != v) return 1; /* neither changed */
+    } else if (S->kind[w] != SMOOTH) {
+        return requeue(S, w);
+    }
+    /* a smooth w is a neighbour of v now: it shares a live triangle with v
+     * (a triangle of u's that had no v, or one of v's that had no u) */
+    const double c = move_cost(S, w, v);
+    return c < S->hcost[w] ? enqueue(S, w, c, v) : 1;
 }
 
 /* ---- checks */
@@ -723,7 +755,8 @@ static int do_move(simp *S, uint32_t u, uint32_t v) {
     const uint32_t m = mark_all(S, &S->nu);
     for (size_t i = 0; ok && i < S->nv.n; ++i)
         if (S->nv.a[i] != u && S->mark[S->nv.a[i]] != m) ok = push32(&around, S->nv.a[i]);
-    for (size_t i = 0; ok && i < around.n; ++i) ok = requeue(S, around.a[i]);
+    for (size_t i = 0; ok && i < around.n; ++i)
+        ok = i == 0 ? requeue(S, v) : requeue_near(S, around.a[i], u, v);
     free(around.a);
     return ok;
 }
@@ -914,13 +947,14 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     S.failed = calloc(nv, sizeof *S.failed);
     S.stuck = calloc(nv, 1);
     S.hcost = malloc(nv * sizeof *S.hcost);
+    S.htgt = malloc(nv * sizeof *S.htgt);
     for (size_t v = 0; S.hcost && v < nv; ++v) S.hcost[v] = NAN;
     S.wkey = malloc(WSLOTS * sizeof *S.wkey);
     S.wplan = calloc(WSLOTS, sizeof *S.wplan);
     for (size_t k = 0; S.wkey && k < WSLOTS; ++k) S.wkey[k] = UINT64_MAX;
     lb_status s = LB_OK;
     if (!S.next || !S.head || !S.tail || !S.tdead || !S.kind || !S.sn || !S.Q || !S.stamp ||
-        !S.mark || !S.failed || !S.stuck || !S.hcost || !S.wkey || !S.wplan)
+        !S.mark || !S.failed || !S.stuck || !S.hcost || !S.htgt || !S.wkey || !S.wplan)
         s = nomem(err);
     /* without them, lb_evaluator_eval's own (the same values) */
     S.few =
@@ -1024,6 +1058,7 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     free(S.failed);
     free(S.stuck);
     free(S.hcost);
+    free(S.htgt);
     for (size_t k = 0; S.wkey && k < WSLOTS; ++k)
         if (S.wkey[k] != UINT64_MAX) lb__cplan_free(&S.wplan[k]);
     free(S.wkey);
