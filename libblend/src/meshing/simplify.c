@@ -509,10 +509,10 @@ static int near_surface(simp *S, uint32_t u, uint32_t v, int maxn, int *coarser,
             for (int k = 0; k < 3; ++k) q[k] = P(S, t[k] == u ? v : t[k]);
             if (pass == 0) {
                 total += triangle_samples(q, S->h, maxn, coarser, NULL, NULL, NULL);
-                for (int k = 0; k < 3; ++k)
+                for (int k = 0; k < 3; ++k) /* points are finite: no fmin's NaN rule, a call */
                     for (int d = 0; d < 3; ++d) {
-                        S->sbox[d] = fmin(S->sbox[d], q[k][d]);
-                        S->sbox[3 + d] = fmax(S->sbox[3 + d], q[k][d]);
+                        if (q[k][d] < S->sbox[d]) S->sbox[d] = q[k][d];
+                        if (q[k][d] > S->sbox[3 + d]) S->sbox[3 + d] = q[k][d];
                     }
                 continue;
             }
