@@ -4,17 +4,23 @@
  * field-checked simplification of the same mesh, in the same process with
  * the runs alternating (docs/meshing.md, Adaptive simplification): the
  * floor any collapse simplifier sits on, to weigh against what Blender
- * saves on the triangles removed. Not a test; meshoptimizer is a benchmark
+ * saves on the triangles removed. And the floor of any simplification
+ * checked against the field, collapses or not: one evaluation of the field
+ * (lb_evaluator_eval, one thread and two) at points a cell apart over the
+ * simplified mesh's triangles (each triangle's barycentric lattice of n
+ * steps, n its longest edge in cells rounded up, its corners left out:
+ * the simplifier's own lattice). Not a test; meshoptimizer is a benchmark
  * dependency only (Debian's libmeshoptimizer-dev).
  *
  * Usage: bench_meshopt SCENE RESOLUTION TOLERANCE [ROUNDS]
  * (one thread; TOLERANCE in cells; prints one JSON line: best-of-ROUNDS
- * seconds of each, triangle counts, and meshoptimizer's own error in
- * cells) */
+ * seconds of each, triangle counts, meshoptimizer's own error in cells,
+ * and the check's points and seconds on one thread and on two) */
 #define _POSIX_C_SOURCE 200809L
 #include <libblend/libblend.h>
 #include <meshoptimizer.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
@@ -23,6 +29,35 @@ static double now(void) {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Points a cell apart over m's triangles into x, y, z (NULL: count only). */
+static size_t lattice(const lb_mesh *m, double h, double *x, double *y, double *z) {
+    size_t c = 0;
+    for (size_t t = 0; t < m->ntriangles; ++t) {
+        const double *q[3];
+        double L = 0.0;
+        for (int k = 0; k < 3; ++k) q[k] = m->positions + 3 * (size_t)m->triangles[3 * t + k];
+        for (int k = 0; k < 3; ++k) {
+            const double *a = q[k], *b = q[(k + 1) % 3];
+            const double d = sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                                  (b[2] - a[2]) * (b[2] - a[2]));
+            if (d > L) L = d;
+        }
+        const int n = (int)fmax(1.0, ceil(L / h));
+        for (int a = 0; a <= n; ++a)
+            for (int b = 0; a + b <= n; ++b) {
+                if ((a == 0 && b == 0) || a == n || b == n) continue;
+                if (x) {
+                    const double wb = (double)a / n, wc = (double)b / n, wa = 1.0 - wb - wc;
+                    x[c] = wa * q[0][0] + wb * q[1][0] + wc * q[2][0];
+                    y[c] = wa * q[0][1] + wb * q[1][1] + wc * q[2][1];
+                    z[c] = wa * q[0][2] + wb * q[1][2] + wc * q[2][2];
+                }
+                ++c;
+            }
+    }
+    return c;
 }
 
 static lb_mesh *mesh(lb_evaluator *ev, const lb_mesh_options *o, double *best) {
@@ -91,11 +126,29 @@ int main(int argc, char **argv) {
         const double t = now() - t0;
         if (t < t_opt) t_opt = t;
     }
+    /* the field once at the simplified mesh's points, as a check of it would */
+    const size_t np = lattice(ms, h, NULL, NULL, NULL);
+    double *buf = malloc(sizeof *buf * 7 * (np ? np : 1)), t_check[2] = {1e30, 1e30};
+    if (!buf) return 1;
+    lattice(ms, h, buf, buf + np, buf + 2 * np);
+    for (int r = 0; r < rounds; ++r)
+        for (int th = 1; th <= 2; ++th) {
+            const double t0 = now();
+            if (lb_evaluator_eval(ev, np, buf, buf + np, buf + 2 * np, buf + 3 * np, buf + 4 * np,
+                                  buf + 5 * np, buf + 6 * np, th, &e)) {
+                fprintf(stderr, "bench_meshopt: %s\n", e.message);
+                return 1;
+            }
+            const double t = now() - t0;
+            if (t < t_check[th - 1]) t_check[th - 1] = t;
+        }
+    free(buf);
     printf("{\"resolution\": %u, \"tolerance_cells\": %g, \"triangles\": %zu, "
            "\"mesh_s\": %.6f, \"libblend_simplify_s\": %.6f, \"libblend_triangles\": %zu, "
-           "\"meshopt_s\": %.6f, \"meshopt_triangles\": %zu, \"meshopt_error_cells\": %.4f}\n",
+           "\"meshopt_s\": %.6f, \"meshopt_triangles\": %zu, \"meshopt_error_cells\": %.4f, "
+           "\"check_points\": %zu, \"check_s\": %.6f, \"check_2_threads_s\": %.6f}\n",
            o.resolution, tol, m->ntriangles, t_mesh, t_simp - t_mesh, ms->ntriangles, t_opt,
-           nout / 3, opt_err * scale / h);
+           nout / 3, opt_err * scale / h, np, t_check[0], t_check[1]);
     free(pos);
     free(idx);
     free(out);
