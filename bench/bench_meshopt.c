@@ -80,6 +80,10 @@ int main(int argc, char **argv) {
     }
     const double tol = atof(argv[3]);
     const int rounds = argc == 5 ? atoi(argv[4]) : 5;
+    if (rounds < 1) {
+        fprintf(stderr, "bench_meshopt: ROUNDS %s: allowed: 1 or more\n", argv[4]);
+        return 2;
+    }
     lb_error e = {LB_OK, ""};
     lb_scene *sc = NULL;
     lb_evaluator *ev = NULL;
