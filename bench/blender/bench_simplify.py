@@ -18,8 +18,6 @@ simplification checked against the field: one evaluation of the field at
 points a cell apart over the simplified mesh's triangles (the simplifier's
 own lattice, corners left out), on the add-on's threads, best of 7.
 Prints one "BENCH {json}" line per configuration, then a table."""
-import ctypes
-import ctypes.util
 import json
 import os
 import statistics
@@ -45,22 +43,16 @@ SCENES = (("two boxes (CSG)", os.path.join(SRC, "tests", "data", "features", "tw
           ("stool", os.path.join(SRC, "scenes", "hsu-bounded-fig7-stool.json"), True),
           ("S2", os.path.join(SRC, "scenes", "bench-s2-64-spheres.json"), False))
 CONFIGS = (("plain", 0.0, False), ("merge_flat", 0.0, True), ("simplified", 0.1, False))
-_so = ctypes.util.find_library("meshoptimizer")
-MESHOPT = ctypes.CDLL(_so) if _so else None
+sys.path.insert(0, os.path.join(SRC, "bench", "mesh"))
+import meshopt_floor  # noqa: E402
+
+MESHOPT = meshopt_floor.load()
 if MESHOPT is None:
     print("meshoptimizer not found (apt-get install libmeshoptimizer-dev): its floor is left out")
-else:
-    MESHOPT.meshopt_simplify.restype = ctypes.c_size_t
-    MESHOPT.meshopt_simplify.argtypes = (
-        ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p, ctypes.c_size_t,
-        ctypes.c_size_t, ctypes.c_size_t, ctypes.c_float, ctypes.c_uint,
-        ctypes.POINTER(ctypes.c_float))
-    MESHOPT.meshopt_simplifyScale.restype = ctypes.c_float
-    MESHOPT.meshopt_simplifyScale.argtypes = (ctypes.c_void_p, ctypes.c_size_t, ctypes.c_size_t)
 
 
-def meshopt_floor(out, res, tol=0.1):
-    """meshopt_simplify on the mesh Blender holds: (best seconds, triangles)."""
+def meshopt_floor_ms(out, res, tol=0.1):
+    """meshopt_simplify on the mesh Blender holds: (best milliseconds, triangles)."""
     me = out.data
     pos = np.empty(3 * len(me.vertices), np.float32)
     me.vertices.foreach_get("co", pos)
@@ -68,20 +60,15 @@ def meshopt_floor(out, res, tol=0.1):
     me.polygons.foreach_get("vertices", idx)  # triangles only: the add-on makes no others
     bmin, bmax = live.region_of(out)
     h = max(b - a for a, b in zip(bmin, bmax)) / res
-    nv = len(me.vertices)
-    scale = MESHOPT.meshopt_simplifyScale(pos.ctypes.data, nv, 12)
-    dst = np.empty_like(idx)
-    err = ctypes.c_float()
-    best, n = 1e30, 0
-    for _ in range(ROUNDS):
-        t0 = time.perf_counter()
-        n = MESHOPT.meshopt_simplify(dst.ctypes.data, idx.ctypes.data, idx.size, pos.ctypes.data,
-                                     nv, 12, 0, tol * h / scale, 0, ctypes.byref(err))
-        best = min(best, time.perf_counter() - t0)
-    return best, n // 3
+    F, _own, secs = meshopt_floor.simplify(MESHOPT, pos.reshape(-1, 3), idx.reshape(-1, 3),
+                                           tol * h, ROUNDS)
+    return 1000 * secs, len(F)
+
+
 def check_floor(path, res, feat, tol=0.1):
-    """(best seconds, points): the field once at points a cell apart over
-    the simplified mesh's triangles, as a check of that mesh would need"""
+    """(best milliseconds, points): the field once at points a cell apart
+    over the simplified mesh's triangles, corners left out, as a check of
+    that mesh would need"""
     sc = libhandle.library().load_scene(path)
     with sc:
         with sc.compile() as ev:
@@ -89,16 +76,7 @@ def check_floor(path, res, feat, tol=0.1):
             h = max(b - a for a, b in zip(lo, hi)) / res
             m = ev.mesh(lo, hi, resolution=res, threads=libhandle.threads(), features=feat,
                         simplify=tol)
-            Q = m.positions[m.triangles.astype(np.int64)]
-            k = np.ceil(np.linalg.norm(Q[:, [1, 2, 0]] - Q, axis=2).max(1) / h).clip(1)
-            pts = [np.zeros((0, 3))]
-            for n in np.unique(k).astype(int):  # each triangle's points together, as
-                R = Q[k == n]                   # in mesh order: a check's locality
-                w = np.array([(i, j, n - i - j) for i in range(n + 1) for j in range(n + 1 - i)
-                              if not (i == 0 and j == 0) and i != n and j != n], float) / n
-                if len(w):
-                    pts.append(np.einsum("pk,tkd->tpd", w, R).reshape(-1, 3))
-            P = np.concatenate(pts)
+            P = meshopt_floor.lattice(m.positions, m.triangles, h, corners=False)
             best = 1e30
             for _ in range(ROUNDS):
                 t0 = time.perf_counter()
@@ -138,9 +116,9 @@ for name, path, feat in SCENES:
             out.libblend.simplify, out.libblend.merge_flat = 0.0, False
             ok, msg = live.update_now(out)
             assert ok, msg
-            secs, n = meshopt_floor(out, res)
+            ms, n = meshopt_floor_ms(out, res)
             a = r["plain"]
-            r["meshopt"] = {"ms": 1000 * secs, "triangles": n,
+            r["meshopt"] = {"ms": ms, "triangles": n,
                             "blender_saves_ms": a["blender_ms"] * (1 - n / a["triangles"])}
         r["check"] = check_floor(path, res, feat)
         print("BENCH " + json.dumps(r), flush=True)

@@ -9,14 +9,13 @@ threads), simplified by libblend at TOL cells, and the unsimplified mesh is
 handed to meshoptimizer (Debian's libmeshoptimizer-dev, through ctypes; a
 benchmark dependency only) at each of TARGETS (comma-separated, cells of
 its own quadric error). Every triangle is sampled at most a quarter cell
-apart; each sample is moved onto the surface by Newton steps along the
+apart (bench/mesh/meshopt_floor.py); each sample is moved onto the surface by Newton steps along the
 field's gradient, and the distance moved (in cells; at least the distance
 to the surface, so an upper bound on each sample's error) gives the
 largest, 99th and 50th percentile errors. Samples where the steps do not
 reach the surface are counted and left out. Run by bench/run_simplify_bench.sh;
 not a test."""
-import ctypes
-import ctypes.util
+import os
 import sys
 
 import numpy as np
@@ -24,35 +23,17 @@ import numpy as np
 ADDON, SCENE, RES, TOL, TARGETS = sys.argv[1:6]
 RES, TOL = int(RES), float(TOL)
 sys.path.insert(0, ADDON)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import binding  # noqa: E402
+import meshopt_floor  # noqa: E402
 
-so = ctypes.util.find_library("meshoptimizer")
-if not so:
+mo = meshopt_floor.load()
+if mo is None:
     sys.exit("meshoptimizer not found: apt-get install libmeshoptimizer-dev")
-mo = ctypes.CDLL(so)
-mo.meshopt_simplify.restype = ctypes.c_size_t
-mo.meshopt_simplify.argtypes = (ctypes.c_void_p, ctypes.c_void_p, ctypes.c_size_t,
-                                ctypes.c_void_p, ctypes.c_size_t, ctypes.c_size_t,
-                                ctypes.c_size_t, ctypes.c_float, ctypes.c_uint,
-                                ctypes.POINTER(ctypes.c_float))
-mo.meshopt_simplifyScale.restype = ctypes.c_float
-mo.meshopt_simplifyScale.argtypes = (ctypes.c_void_p, ctypes.c_size_t, ctypes.c_size_t)
-
-
-def samples(V, F, h, spacing=0.25):
-    """points over every triangle, a barycentric lattice at most spacing * h apart"""
-    P = V[F]
-    k = np.ceil(np.linalg.norm(P[:, [1, 2, 0]] - P, axis=2).max(1) / (spacing * h)).clip(1)
-    out = []
-    for n in np.unique(k).astype(int):
-        Q = P[k == n]
-        out += [(i * Q[:, 0] + j * Q[:, 1] + (n - i - j) * Q[:, 2]) / n
-                for i in range(n + 1) for j in range(n + 1 - i)]
-    return np.concatenate(out)
 
 
 def errors(ev, V, F, h):
-    S = samples(V, F, h)
+    S = meshopt_floor.lattice(V, F, 0.25 * h)
     X = S.copy()
     for _ in range(6):
         v, g = ev.eval(X)
@@ -76,14 +57,7 @@ print("  unsimplified: %d triangles, %s" % (len(m.triangles), errors(ev, m.posit
                                                                      m.triangles, h)))
 print("  libblend, %g cells: %d triangles, %s" % (TOL, len(ms.triangles),
                                                   errors(ev, ms.positions, ms.triangles, h)))
-pos = np.ascontiguousarray(m.positions, dtype=np.float32)
-idx = np.ascontiguousarray(m.triangles, dtype=np.uint32)
-scale = mo.meshopt_simplifyScale(pos.ctypes.data, len(pos), 12)
-dst = np.empty_like(idx)
-own = ctypes.c_float()
 for t in (float(x) for x in TARGETS.split(",")):
-    n = mo.meshopt_simplify(dst.ctypes.data, idx.ctypes.data, idx.size, pos.ctypes.data,
-                            len(pos), 12, 0, t * h / scale, 0, ctypes.byref(own))
-    F = dst.ravel()[:n].reshape(-1, 3).astype(np.int64)
+    F, own, _ = meshopt_floor.simplify(mo, m.positions, m.triangles, t * h)
     print("  meshoptimizer, %g cells (its own error %.3f): %d triangles, %s" % (
-        t, own.value * scale / h, n // 3, errors(ev, m.positions, F, h)))
+        t, own / h, len(F), errors(ev, m.positions, F, h)))
