@@ -81,9 +81,9 @@
 /* bytes the pass needs at most per triangle (corner lists, the edges before
  * and after sorting and the facings of the setup) and per vertex (lists'
  * ends, kind, crease neighbours, quadric, stamps, failed moves, the sort's
- * counts, its heap entry's cost and target, and its heap entries: one, then about ten
- * per move nearby), for the memory cap (and WSLOTS window plans, each at
- * most the tape's size) */
+ * counts, its heap entry's cost and target, and its heap entries: one, then
+ * about ten per move nearby), for the memory cap (and WSLOTS window plans,
+ * each at most the tape's size) */
 #define TRI_BYTES 144
 #define VERTEX_BYTES 309
 #define FLAT 1e-6 /* cells: a ring this close to one plane is flat */
