@@ -17,7 +17,12 @@ intake time per triangle in this run). And the floor of any
 simplification checked against the field: one evaluation of the field at
 points a cell apart over the simplified mesh's triangles (the simplifier's
 own lattice, corners left out), on the add-on's threads, best of 7.
-Prints one "BENCH {json}" line per configuration, then a table."""
+And the floor of a coarse-first adaptive mesher (bench/mesh/coarse_floor.py:
+the uniform mesher at half the resolution, the field once a cell apart
+over its triangles, the fine mesher only where a coarse cell fails the
+tolerance, seams free), at 0.1, 0.25 and 0.5 cells, with Blender's intake
+per triangle of this run. Prints one "BENCH {json}" line per
+configuration, then tables."""
 import json
 import os
 import statistics
@@ -44,6 +49,7 @@ SCENES = (("two boxes (CSG)", os.path.join(SRC, "tests", "data", "features", "tw
           ("S2", os.path.join(SRC, "scenes", "bench-s2-64-spheres.json"), False))
 CONFIGS = (("plain", 0.0, False), ("merge_flat", 0.0, True), ("simplified", 0.1, False))
 sys.path.insert(0, os.path.join(SRC, "bench", "mesh"))
+import coarse_floor  # noqa: E402
 import meshopt_floor  # noqa: E402
 
 MESHOPT = meshopt_floor.load()
@@ -85,6 +91,28 @@ def check_floor(path, res, feat, tol=0.1):
     return {"ms": 1000 * best, "points": len(P)}
 
 
+COARSE_TOLERANCES = (0.1, 0.25, 0.5)
+
+
+def coarse_first_floor(path, res, feat, plain):
+    """coarse_floor.measure on the add-on's threads, and for each tolerance
+    the modelled update: that floor's libblend part plus Blender's intake of
+    its triangles at this run's rate, against the uniform mesher's time plus
+    Blender's intake of the plain mesh"""
+    sc = libhandle.library().load_scene(path)
+    with sc:
+        with sc.compile() as ev:
+            lo, hi = sc.bounds
+            r = coarse_floor.measure(ev, lo, hi, res, COARSE_TOLERANCES,
+                                     threads=libhandle.threads(), features=feat, rounds=ROUNDS)
+    per_tri = plain["blender_ms"] / plain["triangles"]
+    r["uniform_update_ms"] = r["fine_ms"] + plain["blender_ms"]
+    for t in r["tolerances"].values():
+        t["update_ms"] = (r["coarse_ms"] + r["check_ms"] + (1 - t["skipped"]) * r["fine_ms"]
+                          + per_tri * t["triangles"])
+    return r
+
+
 rows = []
 for name, path, feat in SCENES:
     bpy.ops.libblend.import_scene(filepath=path, with_render=False)
@@ -121,6 +149,7 @@ for name, path, feat in SCENES:
             r["meshopt"] = {"ms": ms, "triangles": n,
                             "blender_saves_ms": a["blender_ms"] * (1 - n / a["triangles"])}
         r["check"] = check_floor(path, res, feat)
+        r["coarse_first"] = coarse_first_floor(path, res, feat, r["plain"])
         print("BENCH " + json.dumps(r), flush=True)
         rows.append(r)
 
@@ -153,3 +182,15 @@ for r in rows:
     print("| %s | %d | %d | %.1f ms | %.1f ms (%d) | %s |" %
           (r["scene"], r["cells"], b["triangles"], saves, c["ms"], c["points"],
            "%.1fx" % (c["ms"] / saves) if saves > 0 else "-"))
+print("\n| scene | cells | uniform mesher / half resolution / check (points) | Blender, plain "
+      "| uniform update | " + " | ".join("coarse-first floor, %g cells: triangles, update, "
+                                        "/ uniform" % t for t in COARSE_TOLERANCES) + " |")
+print("|---|---|---|---|---|" + "---|" * len(COARSE_TOLERANCES))
+for r in rows:
+    c = r["coarse_first"]
+    print("| %s | %d | %.1f / %.1f / %.1f ms (%d) | %.1f ms | %.1f ms | " % (
+        r["scene"], r["cells"], c["fine_ms"], c["coarse_ms"], c["check_ms"], c["check_points"],
+        r["plain"]["blender_ms"], c["uniform_update_ms"]) + " | ".join(
+        "%d, %.1f ms, %.2fx" % (t["triangles"], t["update_ms"],
+                                t["update_ms"] / c["uniform_update_ms"])
+        for t in (c["tolerances"][k] for k in COARSE_TOLERANCES)) + " |")

@@ -1,5 +1,5 @@
 """What the simplification benchmarks share (bench/mesh/run_meshopt_error.py,
-bench/blender/bench_simplify.py): meshoptimizer's meshopt_simplify through
+bench/blender/bench_simplify.py, bench/mesh/coarse_floor.py): meshoptimizer's meshopt_simplify through
 ctypes (Debian's libmeshoptimizer-dev, a benchmark dependency only), and
 points over triangles on a barycentric lattice, each triangle's points
 together (mesh order, so an evaluation of them keeps its locality)."""
@@ -45,16 +45,19 @@ def simplify(lib, positions, triangles, error, rounds=1):
     return dst.ravel()[:n].reshape(-1, 3).astype(np.int64), own.value * scale, best
 
 
-def lattice(V, F, step, corners=True):
+def lattice(V, F, step, corners=True, index=False):
     """Points over every triangle F (n, 3) of V: n steps along each edge, n
     its longest edge over step rounded up (at least 1); without corners,
-    the triangle's three corners left out (as the simplifier samples)."""
+    the triangle's three corners left out (as the simplifier samples).
+    With index, also the triangle of each point."""
     Q = V[np.asarray(F, dtype=np.int64)]
     k = np.ceil(np.linalg.norm(Q[:, [1, 2, 0]] - Q, axis=2).max(1) / step).clip(1)
-    pts = [np.zeros((0, 3))]
+    pts, tri = [np.zeros((0, 3))], [np.zeros(0, np.int64)]
     for n in np.unique(k).astype(int):
         w = np.array([(i, j, n - i - j) for i in range(n + 1) for j in range(n + 1 - i)
                       if corners or not (i + j == 0 or i == n or j == n)], float) / n
         if len(w):
-            pts.append(np.einsum("pk,tkd->tpd", w, Q[k == n]).reshape(-1, 3))
-    return np.concatenate(pts)
+            sel = np.nonzero(k == n)[0]
+            pts.append(np.einsum("pk,tkd->tpd", w, Q[sel]).reshape(-1, 3))
+            tri.append(np.repeat(sel, len(w)))
+    return (np.concatenate(pts), np.concatenate(tri)) if index else np.concatenate(pts)

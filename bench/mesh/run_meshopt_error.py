@@ -9,12 +9,12 @@ threads), simplified by libblend at TOL cells, and the unsimplified mesh is
 handed to meshoptimizer (Debian's libmeshoptimizer-dev, through ctypes; a
 benchmark dependency only) at each of TARGETS (comma-separated, cells of
 its own quadric error). Every triangle is sampled at most a quarter cell
-apart (bench/mesh/meshopt_floor.py); each sample is moved onto the surface by Newton steps along the
-field's gradient, and the distance moved (in cells; at least the distance
-to the surface, so an upper bound on each sample's error) gives the
-largest, 99th and 50th percentile errors. Samples where the steps do not
-reach the surface are counted and left out. Run by bench/run_simplify_bench.sh;
-not a test."""
+apart (bench/mesh/meshopt_floor.py); each sample is moved onto the surface
+by Newton steps along the field's gradient (bench/mesh/coarse_floor.py),
+and the distance moved (in cells; at least the distance to the surface, so
+an upper bound on each sample's error) gives the largest, 99th and 50th
+percentile errors. Samples where the steps do not reach the surface are
+counted and left out. Run by bench/run_simplify_bench.sh; not a test."""
 import os
 import sys
 
@@ -25,6 +25,7 @@ RES, TOL = int(RES), float(TOL)
 sys.path.insert(0, ADDON)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import binding  # noqa: E402
+import coarse_floor  # noqa: E402
 import meshopt_floor  # noqa: E402
 
 mo = meshopt_floor.load()
@@ -33,16 +34,10 @@ if mo is None:
 
 
 def errors(ev, V, F, h):
-    S = meshopt_floor.lattice(V, F, 0.25 * h)
-    X = S.copy()
-    for _ in range(6):
-        v, g = ev.eval(X)
-        X = X - (v / np.maximum(np.einsum("ij,ij->i", g, g), 1e-300))[:, None] * g
-    v, g = ev.eval(X)
-    off = np.abs(v) / np.maximum(np.linalg.norm(g, axis=1), 1e-300) > 1e-3 * h
-    d = np.linalg.norm(X - S, axis=1)[~off] / h
+    d, _tri, off = coarse_floor.sample_errors(ev, V, F, h)
+    d = d[~off]
     return "%.3f / %.3f / %.3f cells (%d of %d samples not on the surface after 6 steps)" % (
-        d.max(), np.percentile(d, 99), np.percentile(d, 50), off.sum(), len(S))
+        d.max(), np.percentile(d, 99), np.percentile(d, 50), off.sum(), len(off))
 
 
 lib = binding.load()
