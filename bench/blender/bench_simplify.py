@@ -91,7 +91,7 @@ def check_floor(path, res, feat, tol=0.1):
     return {"ms": 1000 * best, "points": len(P)}
 
 
-COARSE_TOLERANCES = (0.1, 0.25, 0.5)
+COARSE_TOLERANCES = (0.1, 0.25, 0.5, 1.0)
 
 
 def coarse_first_floor(path, res, feat, plain):
