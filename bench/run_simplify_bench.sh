@@ -3,9 +3,11 @@
 # (bench/mesh/run_simplify_bench.py), then the add-on's live update with and
 # without it in headless Blender (bench/blender/bench_simplify.py), each
 # beside meshoptimizer's collapses on the same mesh (bench_meshopt; in
-# Blender through ctypes): what any collapse simplifier costs at least; and
-# the triangles each leaves at a given error against the field
-# (bench/mesh/run_meshopt_error.py); docs/meshing.md, Adaptive simplification.
+# Blender through ctypes): what any collapse simplifier costs at least; the
+# floor of a coarse-first mesher in the same Blender runs
+# (bench/mesh/coarse_floor.py); and the triangles each leaves at a given
+# error against the field (bench/mesh/run_meshopt_error.py); docs/meshing.md,
+# Adaptive simplification.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh

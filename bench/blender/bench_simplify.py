@@ -20,7 +20,7 @@ own lattice, corners left out), on the add-on's threads, best of 7.
 And the floor of a coarse-first adaptive mesher (bench/mesh/coarse_floor.py:
 the uniform mesher at half the resolution, the field once a cell apart
 over its triangles, the fine mesher only where a coarse cell fails the
-tolerance, seams free), at 0.1, 0.25 and 0.5 cells, with Blender's intake
+tolerance, seams free), at 0.1, 0.25, 0.5 and 1 cells, with Blender's intake
 per triangle of this run. Prints one "BENCH {json}" line per
 configuration, then tables."""
 import json
