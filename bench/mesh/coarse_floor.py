@@ -20,8 +20,6 @@ Errors are measured as in run_meshopt_error.py: points at most a quarter
 cell apart over every triangle, moved onto the surface by Newton steps
 along the gradient; the distance moved bounds a point's error from above.
 """
-import time
-
 import numpy as np
 
 import meshopt_floor
@@ -53,19 +51,11 @@ def triangle_errors(ev, V, F, h, threads=0):
 
 
 def _cells(m, origin, cell):
-    """the coarse cell (one integer key) of each triangle's centroid"""
+    """the coarse cell (one integer key) of each triangle's centroid; cell:
+    the coarse grid's cell size per axis"""
     c = np.floor((m.positions[m.triangles.astype(np.int64)].mean(1) - origin) / cell)
     c = c.astype(np.int64)
     return (c[:, 0] * 1_000_003 + c[:, 1]) * 1_000_003 + c[:, 2]
-
-
-def _best_ms(f, rounds):
-    best = 1e30
-    for _ in range(rounds):
-        t0 = time.perf_counter()
-        f()
-        best = min(best, time.perf_counter() - t0)
-    return 1000 * best
 
 
 def measure(ev, lo, hi, res, tolerances, threads=0, features=False, rounds=7):
@@ -82,15 +72,17 @@ def measure(ev, lo, hi, res, tolerances, threads=0, features=False, rounds=7):
     pts = meshopt_floor.lattice(coarse.positions, coarse.triangles, h, corners=False)
     fine_ms = coarse_ms = check_ms = 1e30
     for _ in range(rounds):  # alternated, so the machine's load falls on all three
-        fine_ms = min(fine_ms, _best_ms(lambda: ev.mesh(lo, hi, resolution=res, **kw), 1))
-        coarse_ms = min(coarse_ms,
-                        _best_ms(lambda: ev.mesh(lo, hi, resolution=res // 2, **kw), 1))
-        check_ms = min(check_ms, _best_ms(lambda: ev.eval(pts, threads=threads), 1))
+        fine_ms = min(fine_ms, meshopt_floor.best_ms(lambda: ev.mesh(lo, hi, resolution=res,
+                                                                      **kw))[0])
+        coarse_ms = min(coarse_ms, meshopt_floor.best_ms(
+            lambda: ev.mesh(lo, hi, resolution=res // 2, **kw))[0])
+        check_ms = min(check_ms, meshopt_floor.best_ms(lambda: ev.eval(pts, threads=threads))[0])
     ef = triangle_errors(ev, fine.positions, fine.triangles, h, threads)
     ec = triangle_errors(ev, coarse.positions, coarse.triangles, h, threads)
     origin = np.asarray(coarse.origin, float)
-    kf = _cells(fine, origin, coarse.cell[0])
-    kc = _cells(coarse, origin, coarse.cell[0])
+    cell = np.asarray(coarse.cell, float)
+    kf = _cells(fine, origin, cell)
+    kc = _cells(coarse, origin, cell)
     fine_err = {}
     for k, e in zip(kf.tolist(), ef.tolist()):
         fine_err[k] = max(fine_err.get(k, 0.0), e)

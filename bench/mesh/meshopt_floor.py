@@ -26,23 +26,30 @@ def load():
     return lib
 
 
+def best_ms(f, rounds=1):
+    """(the best of rounds calls of f in milliseconds, the last call's result)"""
+    best, out = float("inf"), None
+    for _ in range(rounds):
+        t0 = time.perf_counter()
+        out = f()
+        best = min(best, time.perf_counter() - t0)
+    return 1000 * best, out
+
+
 def simplify(lib, positions, triangles, error, rounds=1):
     """meshopt_simplify of triangles (n, 3) over positions (m, 3) down to
     error (in the positions' units, meshoptimizer's own quadric error), as
     far as that allows: (triangles (k, 3), meshoptimizer's error in those
-    units, the best of rounds calls in seconds)."""
+    units, the best of rounds calls in milliseconds)."""
     pos = np.ascontiguousarray(positions, dtype=np.float32)
     idx = np.ascontiguousarray(triangles, dtype=np.uint32)
     scale = lib.meshopt_simplifyScale(pos.ctypes.data, len(pos), 12)
     dst = np.empty_like(idx)
     own = ctypes.c_float()
-    best, n = 1e30, 0
-    for _ in range(rounds):
-        t0 = time.perf_counter()
-        n = lib.meshopt_simplify(dst.ctypes.data, idx.ctypes.data, idx.size, pos.ctypes.data,
-                                 len(pos), 12, 0, error / scale, 0, ctypes.byref(own))
-        best = min(best, time.perf_counter() - t0)
-    return dst.ravel()[:n].reshape(-1, 3).astype(np.int64), own.value * scale, best
+    ms, n = best_ms(lambda: lib.meshopt_simplify(dst.ctypes.data, idx.ctypes.data, idx.size,
+                                                 pos.ctypes.data, len(pos), 12, 0,
+                                                 error / scale, 0, ctypes.byref(own)), rounds)
+    return dst.ravel()[:n].reshape(-1, 3).astype(np.int64), own.value * scale, ms
 
 
 def lattice(V, F, step, corners=True, index=False):
