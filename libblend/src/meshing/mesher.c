@@ -1275,7 +1275,9 @@ static void work(run *R, size_t t, progress *P) {
     const double all = (double)(R->nblocks ? R->nblocks : 1);
     while (!stopped(R)) {
         if (P && P->fn) {
-            const double f = P->base + P->weight * (double)atomic_load(&R->done) / all;
+            /* the fraction first: weight * 1.0 is weight, so the last report
+             * is the base the next stage starts from, not an ulp above it */
+            const double f = P->base + P->weight * ((double)atomic_load(&R->done) / all);
             if (P->fn(f, P->user)) {
                 P->cancelled = 1;
                 atomic_store(&R->stop, 1);
@@ -1664,8 +1666,8 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         M->ntriangles) /* flat.c */
         s = lb__merge_flat(&g, M, feat, err);
     if (!s && !P.cancelled && opt->simplify > 0.0 && M->ntriangles) /* simplify.c */
-        s = lb__simplify(ev, &g, M, feat, opt->simplify, max_memory, opt->cancel, P.fn, P.user,
-                         P.base, 0.95 - P.base, err);
+        s = lb__simplify(ev, &g, M, feat, opt->simplify, max_memory, (int)nt, opt->cancel, P.fn,
+                         P.user, P.base, 0.95 - P.base, err);
     if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
         M->positions = malloc(3 * sizeof *M->positions);
         M->normals = malloc(3 * sizeof *M->normals);
