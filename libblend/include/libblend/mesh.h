@@ -113,8 +113,9 @@ typedef struct lb_mesh_options {
      * triangles' normals differ by more than 26 degrees: with
      * LB_MESH_FEATURES, the kept creases), so corners stay. Still closed,
      * 2-manifold and independent of the thread count; every vertex stays a
-     * vertex of the unsimplified mesh (on the surface). One thread, after
-     * the meshing; costs several times the meshing (docs/meshing.md,
+     * vertex of the unsimplified mesh (on the surface). After the meshing,
+     * on the same threads (regions of the grid in parallel, the seams
+     * between them last); costs several times the meshing (docs/meshing.md,
      * Adaptive simplification). 0 = off; at most LB_MESH_MAX_SIMPLIFY. */
     double simplify;
 } lb_mesh_options;

@@ -443,12 +443,14 @@ LB_INTERNAL lb_status lb__corner_normals(const lb_evaluator *ev, const lb__grid 
 /* Adaptive simplification (simplify.c): half-edge collapses wherever every
  * moved triangle stays within tolerance cells (of the smallest cell side)
  * of phi_c, never across a crease; closed and manifold kept; feat (may be
- * NULL) is compacted with the vertices. Fails before allocating when its
- * scratch would exceed max_memory; checks *cancel (may be NULL) and calls
- * progress (may be NULL; non-zero cancels) with fractions rising from base
- * by at most weight. */
+ * NULL) is compacted with the vertices. On up to threads threads (the
+ * calling one among them), the same result for every count. Fails before
+ * allocating when its scratch would exceed max_memory; checks *cancel (may
+ * be NULL) and calls progress (may be NULL; non-zero cancels; on the
+ * calling thread only) with fractions rising from base by at most
+ * weight. */
 LB_INTERNAL lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M,
-                                   uint8_t *feat, double tolerance, size_t max_memory,
+                                   uint8_t *feat, double tolerance, size_t max_memory, int threads,
                                    const volatile int *cancel, lb_mesh_progress_fn progress,
                                    void *user, double base, double weight, lb_error *err);
 

@@ -18,7 +18,8 @@
  * 2. Order. Each movable vertex's cheapest move by the quadric error of
  *    Garland and Heckbert (the summed squared distances to the planes of the
  *    triangles merged into the two vertices, area weighted) is kept in a
- *    heap; the cheapest move is tried first, ties broken by vertex index.
+ *    heap (one per region in a parallel pass: passes below); the cheapest
+ *    move is tried first, ties broken by vertex index.
  *    On a flat face every move costs nothing: a small weight on the edge's
  *    squared length makes the short edges go first there, so triangles grow
  *    evenly and each part of a face is sampled a few times, not once per
@@ -58,13 +59,17 @@
  *    a point of the original mesh, on the surface) and their order; the
  *    triangles keep theirs.
  *
- * One thread, in a fixed order on the merged mesh, so the output does not
- * depend on the thread count. The cost grows with the number of moves tried
- * times the samples of their triangles: bounded by the 64-step caps per
- * triangle edge, rows and row. */
+ * On up to the caller's thread count, in passes over regions of the grid
+ * that depend on the grid alone (passes below), each region's moves in a
+ * fixed order, so the output does not depend on the thread count. The cost
+ * grows with the number of moves tried times the samples of their
+ * triangles: bounded by the 64-step caps per triangle edge, rows and
+ * row. */
 #include "mesh_internal.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -80,12 +85,13 @@
 #define CHECK_EVERY 256 /* vertices tried between looks at the cancel flag */
 /* bytes the pass needs at most per triangle (corner lists, the edges before
  * and after sorting and the facings of the setup) and per vertex (lists'
- * ends, kind, crease neighbours, quadric, stamps, failed moves, the sort's
- * counts, its heap entry's cost and target, and its heap entries: one, then
- * about ten per move nearby), for the memory cap (and WSLOTS window plans,
+ * ends, kind, crease neighbours, quadric, stamps, marks, failed moves, the
+ * sort's counts, its heap entry's cost and target, its region, lock and
+ * place in a pass's lists, and its heap entries: one, then about ten per
+ * move nearby), for the memory cap (and per worker WSLOTS window plans,
  * each at most the tape's size) */
 #define TRI_BYTES 144
-#define VERTEX_BYTES 309
+#define VERTEX_BYTES 322
 #define FLAT 1e-6 /* cells: a ring this close to one plane is flat */
 #define TIE 1e-4  /* the edge length's weight in a move's cost (h^2 len^2) */
 /* The plans of windows: boxes of 2 WSTEP cells a side, WSTEP cells apart on
@@ -130,8 +136,17 @@ typedef struct simp {
     lb__boxeval E;
     lb__plan outer;
     int few;
-    uint32_t *mark; /* per vertex (fresh) */
-    uint32_t tok;
+    uint64_t *mark; /* per vertex (fresh) */
+    uint64_t tok;   /* 64 bits: never wraps */
+    /* a parallel pass (passes below): the region of each vertex, whether a
+     * vertex has a neighbour in another region (locked), the region this
+     * worker is on; region NULL: the whole mesh, one thread */
+    const uint32_t *region;
+    const uint8_t *lock;
+    uint32_t own;
+    vec32 cand;   /* the moves of the vertex tried, in order of cost */
+    double *cost; /* and their costs */
+    size_t ccap;
     /* per vertex: the moves onto its neighbours (bit i: the i-th of its
      * ring's neighbours, in ring order) that failed a check of shape or
      * field; kept while its ring is unchanged, since those checks see
@@ -239,32 +254,50 @@ static int ring(simp *S, uint32_t u, vec32 *r) {
 }
 
 /* A fresh mark: vertices w with mark[w] == the result are marked. */
-static uint32_t fresh(simp *S) {
-    if (++S->tok == 0) { /* wrapped: clear */
-        memset(S->mark, 0, S->M->nvertices * sizeof *S->mark);
-        S->tok = 1;
-    }
-    return S->tok;
+static uint64_t fresh(simp *S) {
+    return ++S->tok;
+}
+
+/* Whether w is this worker's to read and write (its region's, in a
+ * parallel pass): what other workers touch is never read, so a pass's
+ * result does not depend on their progress. */
+static int mine(const simp *S, uint32_t w) {
+    return !S->region || S->region[w] == S->own;
+}
+
+/* Whether w may move in this pass: its own and every neighbour in its
+ * region. */
+static int movable_here(const simp *S, uint32_t w) {
+    return !S->region || (S->region[w] == S->own && !S->lock[w]);
 }
 
 /* The distinct vertices other than u of the triangles r, in ring order. */
 static int neighbours(simp *S, uint32_t u, const vec32 *r, vec32 *n) {
     n->n = 0;
-    const uint32_t m = fresh(S);
+    const uint64_t m = fresh(S);
     for (size_t i = 0; i < r->n; ++i)
         for (int k = 0; k < 3; ++k) {
             const uint32_t w = S->M->triangles[3 * (size_t)r->a[i] + k];
-            if (w == u || S->mark[w] == m) continue;
-            S->mark[w] = m;
+            if (w == u) continue;
+            if (mine(S, w)) {
+                if (S->mark[w] == m) continue;
+                S->mark[w] = m;
+            } else { /* another region's (a locked vertex's few): by search */
+                size_t j = 0;
+                while (j < n->n && n->a[j] != w) ++j;
+                if (j < n->n) continue;
+            }
             if (!push32(n, w)) return 0;
         }
     return 1;
 }
 
-/* Mark the vertices of n (with a fresh mark, returned). */
-static uint32_t mark_all(simp *S, const vec32 *n) {
-    const uint32_t m = fresh(S);
-    for (size_t i = 0; i < n->n; ++i) S->mark[n->a[i]] = m;
+/* Mark the vertices of n that are this worker's (with a fresh mark,
+ * returned): only those are ever looked up. */
+static uint64_t mark_all(simp *S, const vec32 *n) {
+    const uint64_t m = fresh(S);
+    for (size_t i = 0; i < n->n; ++i)
+        if (mine(S, n->a[i])) S->mark[n->a[i]] = m;
     return m;
 }
 
@@ -325,7 +358,7 @@ static int enqueue(simp *S, uint32_t u, double c, uint32_t x) {
 static int requeue(simp *S, uint32_t u) {
     double c;
     uint32_t x = NONE;
-    if (S->stuck[u] || !moves(S, u, &S->tmp, &c, &x)) {
+    if (!movable_here(S, u) || S->stuck[u] || !moves(S, u, &S->tmp, &c, &x)) {
         ++S->stamp[u]; /* its entry goes */
         S->hcost[u] = NAN;
         return 1;
@@ -340,7 +373,8 @@ static int requeue(simp *S, uint32_t u) {
  * neither, its cheapest move is that one or the one onto v: the same
  * minimum as requeue() finds walking w's ring. Otherwise requeue(). */
 static int requeue_near(simp *S, uint32_t w, uint32_t u, uint32_t v) {
-    if (S->stuck[w] || isnan(S->hcost[w]) || S->htgt[w] == u || S->htgt[w] == v)
+    if (!movable_here(S, w) || S->stuck[w] || isnan(S->hcost[w]) || S->htgt[w] == u ||
+        S->htgt[w] == v)
         return requeue(S, w);
     if (S->kind[w] == CREASE) { /* moves along the crease only */
         const uint32_t *s = S->sn + 2 * (size_t)w;
@@ -630,7 +664,7 @@ static int keeps_topology(simp *S, uint32_t u, uint32_t v) {
     }
     if (no != 2 || opp[0] == opp[1]) return 0;
     size_t common = 0;
-    const uint32_t m = mark_all(S, &S->nv);
+    const uint64_t m = mark_all(S, &S->nv); /* u's neighbours and opp are this worker's */
     for (size_t i = 0; i < S->nu.n; ++i)
         if (S->mark[S->nu.a[i]] == m) ++common;
     if (common != 2 || S->mark[opp[0]] != m || S->mark[opp[1]] != m) return 0;
@@ -752,9 +786,10 @@ static int do_move(simp *S, uint32_t u, uint32_t v) {
     int ok = push32(&around, v);
     for (size_t i = 0; ok && i < S->nu.n; ++i)
         if (S->nu.a[i] != v) ok = push32(&around, S->nu.a[i]);
-    const uint32_t m = mark_all(S, &S->nu);
-    for (size_t i = 0; ok && i < S->nv.n; ++i)
-        if (S->nv.a[i] != u && S->mark[S->nv.a[i]] != m) ok = push32(&around, S->nv.a[i]);
+    const uint64_t m = mark_all(S, &S->nu);
+    for (size_t i = 0; ok && i < S->nv.n; ++i) /* another region's: left to a later pass */
+        if (S->nv.a[i] != u && mine(S, S->nv.a[i]) && S->mark[S->nv.a[i]] != m)
+            ok = push32(&around, S->nv.a[i]);
     for (size_t i = 0; ok && i < around.n; ++i)
         ok = i == 0 ? requeue(S, v) : requeue_near(S, around.a[i], u, v);
     free(around.a);
@@ -914,8 +949,360 @@ static void compact(simp *S, uint8_t *feat) {
     M->ntriangles = m;
 }
 
+/* ---- collapses, cheapest first */
+
+/* What a run of collapses looks up from its work: the caller's cancel
+ * flag, a pass's stop flag (a worker failed or saw the cancel), and on the
+ * calling thread only the progress callback. */
+typedef struct watch {
+    const volatile int *cancel;
+    atomic_int *stop;             /* NULL: no pass */
+    lb_mesh_progress_fn progress; /* NULL on other threads */
+    void *user;
+    double base, weight, shown; /* the fraction reported: base + weight * shown */
+    atomic_size_t *done;        /* a pass: regions done of nreg, the fraction shown */
+    size_t nreg;
+} watch;
+
+static int stopped(watch *wt, size_t tried, size_t left) {
+    if (wt->stop && atomic_load_explicit(wt->stop, memory_order_relaxed)) return 1;
+    if (wt->cancel && *wt->cancel) return 1;
+    if (!wt->progress) return 0;
+    const double f = wt->done ? (double)atomic_load(wt->done) / (double)wt->nreg
+                              : (double)tried / (double)(tried + left);
+    if (f > wt->shown) wt->shown = f;
+    return wt->progress(wt->base + wt->weight * wt->shown, wt->user) != 0;
+}
+
+/* The moves of verts[0..n) (every vertex when verts is NULL) and, after
+ * each move made, of the vertices around it, cheapest first, until none is
+ * left. */
+static lb_status collapse(simp *S, const uint32_t *verts, size_t n, watch *wt, lb_error *err) {
+    S->nh = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (!requeue(S, verts ? verts[i] : (uint32_t)i)) return nomem(err);
+    lb_status s = LB_OK;
+    size_t tried = 0;
+    while (!s && S->nh) {
+        const hent e = hpop(S);
+        const uint32_t u = e.v;
+        if (e.stamp != S->stamp[u] || S->kind[u] == GONE) continue;
+        S->hcost[u] = NAN;
+        if (++tried % CHECK_EVERY == 0 && stopped(wt, tried, S->nh)) {
+            s = lb__fail(err, LB_ERR_CANCELLED, "lb_mesh_create: cancelled by the caller");
+            break;
+        }
+        if (S->kind[u] != SMOOTH && S->kind[u] != CREASE) continue;
+        /* u's ring and neighbours, once for its moves and their checks */
+        if (!ring(S, u, &S->ru) || !neighbours(S, u, &S->ru, &S->nu)) {
+            s = nomem(err);
+            break;
+        }
+        /* its moves (as moves() finds them) in order of cost, each cost
+         * computed once (stable: ties in ring order) */
+        vec32 *cand = &S->cand;
+        cand->n = 0;
+        int room = 1;
+        if (S->kind[u] == CREASE)
+            room = push32(cand, S->sn[2 * (size_t)u]) && push32(cand, S->sn[2 * (size_t)u + 1]);
+        else
+            for (size_t i = 0; room && i < S->nu.n; ++i) room = push32(cand, S->nu.a[i]);
+        if (room && cand->n > S->ccap) {
+            free(S->cost);
+            S->ccap = cand->cap;
+            room = (S->cost = malloc(S->ccap * sizeof *S->cost)) != NULL;
+        }
+        if (!room) {
+            s = nomem(err);
+            break;
+        }
+        if (!cand->n) continue;
+        double *cost = S->cost;
+        for (size_t i = 0; i < cand->n; ++i) {
+            const uint32_t x = cand->a[i];
+            const double c = move_cost(S, u, x);
+            size_t j = i;
+            for (; j > 0 && c < cost[j - 1]; --j) {
+                cost[j] = cost[j - 1];
+                cand->a[j] = cand->a[j - 1];
+            }
+            cost[j] = c;
+            cand->a[j] = x;
+        }
+        /* in cost order, the first that passes every check is made; a move
+         * that failed its shape or field check before, with u's ring as it
+         * is, is not checked again */
+        int moved = 0, stuck = 1; /* stuck: every move tried failed so */
+        for (size_t i = 0; i < cand->n && !moved; ++i) {
+            size_t bit = 0; /* the move's bit in S->failed[u] (none from 32 on) */
+            while (bit < S->nu.n && S->nu.a[bit] != cand->a[i]) ++bit;
+            const uint32_t mask = bit < 32 ? (uint32_t)1 << bit : 0;
+            if (S->failed[u] & mask) continue;
+            int r = keeps_topology(S, u, cand->a[i]);
+            if (r == 1) {
+                r = keeps_shape(S, u, cand->a[i], err);
+                if (r == 0) S->failed[u] |= mask;
+            }
+            if (r == -1) s = nomem(err);
+            if (r == -2) s = S->est;
+            if (s) break;
+            if (r == 1) {
+                if (!do_move(S, u, cand->a[i])) s = nomem(err);
+                moved = 1;
+            } else if (!(S->failed[u] & mask)) {
+                stuck = 0; /* the topology, which v's ring can change */
+            }
+        }
+        /* then every move fails whatever u's neighbours do, until u's ring
+         * changes (do_move clears this): u is not queued again till then */
+        if (!s && !moved && stuck) S->stuck[u] = 1;
+    }
+    return s;
+}
+
+/* ---- parallel passes
+ *
+ * The grid is cut into regions, cubes of RMIN cells a side or more (at
+ * most RMAXN along an axis: the regions depend on the grid alone, never on
+ * the thread count). In a pass each region's vertices whose neighbours all
+ * lie in the region move as in one thread, the regions on as many threads
+ * as the caller allows. Such a move changes only the region's vertices
+ * (their lists, quadrics, kinds, triangles) and reads, of others, only
+ * what no other worker changes: triangles of a locked vertex (one with a
+ * neighbour in another region), which no move of another region touches,
+ * since a vertex moves only when all its neighbours are its region's. A
+ * locked vertex therefore stays locked through the pass, and a region's
+ * result does not depend on the others' progress or on which thread takes
+ * it. The second pass shifts the regions by half a side, so the vertices
+ * locked in the first lie inside its regions; a last pass on one thread
+ * takes every vertex that can still move (the few locked in both, and
+ * those whose neighbours moved). Every pass applies the same checks to
+ * every move, so the guarantees are those of one thread. */
+#define RMIN 32
+#define RMAXN 16
+
+typedef struct pass {
+    simp *W; /* the workers' (W[0]: the calling thread's) */
+    const uint32_t *verts, *ids;
+    const size_t *start;   /* region ids[r]'s movable vertices: verts[start[r] .. start[r + 1]) */
+    const uint32_t *order; /* the r taken k-th: the most vertices first (the last ones taken
+                            * are short, so the threads finish together) */
+    size_t nreg;
+    atomic_size_t next, done;
+    atomic_int stop;
+    watch w0; /* the calling thread's */
+    lb_status *st;
+    lb_error *errs;
+} pass;
+
+typedef struct pworker {
+    pass *P;
+    size_t t;
+} pworker;
+
+static void pass_work(pass *P, size_t t) {
+    simp *W = &P->W[t];
+    watch other = {P->w0.cancel, &P->stop, NULL, NULL, 0.0, 0.0, 0.0, NULL, 0};
+    watch *wt = t == 0 ? &P->w0 : &other;
+    for (;;) {
+        /* a cancel, another worker's failure, and the progress between regions */
+        if (stopped(wt, 0, 0)) {
+            P->st[t] =
+                lb__fail(&P->errs[t], LB_ERR_CANCELLED, "lb_mesh_create: cancelled by the caller");
+            atomic_store(&P->stop, 1);
+            break;
+        }
+        const size_t k = atomic_fetch_add(&P->next, 1);
+        if (k >= P->nreg) break;
+        const size_t r = P->order[k];
+        W->own = P->ids[r];
+        const lb_status s =
+            collapse(W, P->verts + P->start[r], P->start[r + 1] - P->start[r], wt, &P->errs[t]);
+        if (s) {
+            P->st[t] = s;
+            atomic_store(&P->stop, 1);
+            break;
+        }
+        atomic_fetch_add(&P->done, 1);
+    }
+}
+
+/* The most vertices first, then by region. */
+static int cmp_load(const void *a, const void *b) {
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void *pass_thread(void *a) {
+    const pworker *pw = a;
+    pass_work(pw->P, pw->t);
+    return NULL;
+}
+
+/* One pass on nw workers W (their tok the same on entry, and on return the
+ * largest), regions shifted by half a side when shift; rg and lock: a
+ * vertex's room. */
+static lb_status run_pass(simp *W, size_t nw, int shift, uint32_t *rg, uint8_t *lock, watch *w0,
+                          lb_error *err) {
+    const lb_mesh *M = W->M;
+    const lb__grid *g = W->g;
+    const size_t nv = M->nvertices, ntri = M->ntriangles;
+    uint32_t longest = 0;
+    for (int d = 0; d < 3; ++d)
+        if (g->cells[d] > longest) longest = g->cells[d];
+    const uint32_t side = longest > RMIN * RMAXN ? (longest + RMAXN - 1) / RMAXN : RMIN;
+    size_t nr[3], nall = 1;
+    for (int d = 0; d < 3; ++d) nall *= nr[d] = g->cells[d] / side + 3;
+    for (size_t v = 0; v < nv; ++v) {
+        size_t id = 0;
+        for (int d = 0; d < 3; ++d) {
+            double c = floor((M->positions[3 * v + d] - g->origin[d]) / (side * g->h[d]) +
+                             (shift ? 0.5 : 0.0)) +
+                       1.0;
+            if (!(c >= 0.0)) c = 0.0; /* NaN too */
+            if (c > (double)(nr[d] - 1)) c = (double)(nr[d] - 1);
+            id = id * nr[d] + (size_t)c;
+        }
+        rg[v] = (uint32_t)id;
+    }
+    memset(lock, 0, nv);
+    for (size_t t = 0; t < ntri; ++t) {
+        if (W->tdead[t]) continue;
+        const uint32_t *tv = M->triangles + 3 * t;
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t a = tv[k], b = tv[(k + 1) % 3];
+            if (rg[a] != rg[b]) lock[a] = lock[b] = 1;
+        }
+    }
+    size_t *pos = calloc(nall, sizeof *pos), *start = malloc((nall + 1) * sizeof *start);
+    uint32_t *ids = malloc(nall * sizeof *ids), *verts = malloc(nv * sizeof *verts);
+    uint32_t *order = malloc(nall * sizeof *order);
+    uint64_t *load = malloc(nall * sizeof *load);
+    lb_status *st = calloc(nw, sizeof *st);
+    lb_error *errs = calloc(nw, sizeof *errs);
+    pthread_t *tid = malloc(nw * sizeof *tid);
+    pworker *pw = malloc(nw * sizeof *pw);
+    pass *P = malloc(sizeof *P);
+    lb_status s = LB_OK;
+    if (!pos || !start || !ids || !verts || !order || !load || !st || !errs || !tid || !pw || !P)
+        s = nomem(err);
+    size_t nids = 0;
+    if (!s) {
+#define ELIGIBLE(v) ((W->kind[v] == SMOOTH || W->kind[v] == CREASE) && !lock[v] && !W->stuck[v])
+        for (size_t v = 0; v < nv; ++v)
+            if (ELIGIBLE(v)) ++pos[rg[v]];
+        size_t total = 0;
+        for (size_t r = 0; r < nall; ++r) {
+            if (!pos[r]) continue;
+            ids[nids] = (uint32_t)r;
+            start[nids++] = total;
+            total += pos[r];
+            pos[r] = start[nids - 1];
+        }
+        start[nids] = total;
+        for (size_t v = 0; v < nv; ++v)
+            if (ELIGIBLE(v)) verts[pos[rg[v]]++] = (uint32_t)v;
+#undef ELIGIBLE
+        /* key: the vertices' complement (most first), then the index */
+        for (size_t r = 0; r < nids; ++r)
+            load[r] = (uint64_t)(UINT32_MAX - (start[r + 1] - start[r])) << 32 | r;
+        qsort(load, nids, sizeof *load, cmp_load);
+        for (size_t r = 0; r < nids; ++r) order[r] = (uint32_t)load[r];
+        for (size_t v = 0; v < nv; ++v) W->hcost[v] = NAN;
+        P->W = W;
+        P->verts = verts;
+        P->ids = ids;
+        P->start = start;
+        P->order = order;
+        P->nreg = nids;
+        atomic_init(&P->next, 0);
+        atomic_init(&P->done, 0);
+        atomic_init(&P->stop, 0);
+        P->w0 = *w0;
+        P->w0.stop = &P->stop;
+        P->w0.done = &P->done;
+        P->w0.nreg = nids ? nids : 1;
+        P->w0.shown = 0.0;
+        P->st = st;
+        P->errs = errs;
+        for (size_t t = 0; t < nw; ++t) {
+            W[t].region = rg;
+            W[t].lock = lock;
+        }
+        size_t nthr = 0; /* the other threads started (fewer when refused: the same result) */
+        for (size_t t = 1; t < nw && t < nids; ++t) {
+            pw[t].P = P;
+            pw[t].t = t;
+            if (pthread_create(&tid[t], NULL, pass_thread, &pw[t]) != 0) break;
+            ++nthr;
+        }
+        pass_work(P, 0);
+        for (size_t t = 1; t <= nthr; ++t) pthread_join(tid[t], NULL);
+        uint64_t tok = 0;
+        for (size_t t = 0; t < nw; ++t) {
+            if (W[t].tok > tok) tok = W[t].tok;
+            W[t].region = NULL;
+            W[t].lock = NULL;
+        }
+        for (size_t t = 0; t < nw; ++t) W[t].tok = tok;
+        size_t who = nw; /* a failure first, else a cancel */
+        for (size_t t = 0; t < nw && who == nw; ++t)
+            if (st[t] && st[t] != LB_ERR_CANCELLED) who = t;
+        for (size_t t = 0; t < nw && who == nw; ++t)
+            if (st[t]) who = t;
+        if (who < nw) {
+            s = st[who];
+            if (err) *err = errs[who];
+        }
+    }
+    free(pos);
+    free(start);
+    free(ids);
+    free(verts);
+    free(order);
+    free(load);
+    free(st);
+    free(errs);
+    free(tid);
+    free(pw);
+    free(P);
+    return s;
+}
+
+/* A worker: the shared arrays of S, its own scratch (1: allocated). */
+static int worker_init(simp *W, const simp *S) {
+    *W = *S;
+    W->wkey = malloc(WSLOTS * sizeof *W->wkey);
+    W->wplan = calloc(WSLOTS, sizeof *W->wplan);
+    for (size_t k = 0; W->wkey && k < WSLOTS; ++k) W->wkey[k] = UINT64_MAX;
+    /* without them, lb_evaluator_eval's own (the same values) */
+    W->few = lb__boxeval_alloc(W->ev, &W->E, NULL) == LB_OK &&
+             lb__plan_alloc(W->ev, &W->outer, NULL) == LB_OK;
+    return W->wkey && W->wplan;
+}
+
+static void worker_free(simp *W) {
+    for (size_t k = 0; W->wkey && k < WSLOTS; ++k)
+        if (W->wkey[k] != UINT64_MAX) lb__cplan_free(&W->wplan[k]);
+    free(W->wkey);
+    free(W->wplan);
+    free(W->heap);
+    free(W->ru.a);
+    free(W->rv.a);
+    free(W->nu.a);
+    free(W->nv.a);
+    free(W->tmp.a);
+    free(W->cand.a);
+    free(W->cost);
+    free(W->s);
+    lb__boxeval_free(&W->E);
+    lb__plan_free(&W->outer);
+}
+
+#define MAXWORKERS 64
+
 lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, uint8_t *feat,
-                       double tolerance, size_t max_memory, const volatile int *cancel,
+                       double tolerance, size_t max_memory, int threads, const volatile int *cancel,
                        lb_mesh_progress_fn progress, void *user, double base, double weight,
                        lb_error *err) {
     const size_t nv = M->nvertices, nt = M->ntriangles;
@@ -927,6 +1314,7 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
                         "memory cap of %zu MiB; allowed: a lower resolution or a larger "
                         "max_memory",
                         nt, need / 1048576.0, max_memory >> 20);
+    const size_t nw = threads < 1 ? 1 : threads > MAXWORKERS ? MAXWORKERS : (size_t)threads;
     simp S;
     memset(&S, 0, sizeof S);
     S.ev = ev;
@@ -949,103 +1337,33 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     S.hcost = malloc(nv * sizeof *S.hcost);
     S.htgt = malloc(nv * sizeof *S.htgt);
     for (size_t v = 0; S.hcost && v < nv; ++v) S.hcost[v] = NAN;
-    S.wkey = malloc(WSLOTS * sizeof *S.wkey);
-    S.wplan = calloc(WSLOTS, sizeof *S.wplan);
-    for (size_t k = 0; S.wkey && k < WSLOTS; ++k) S.wkey[k] = UINT64_MAX;
+    uint32_t *rg = malloc(nv * sizeof *rg);
+    uint8_t *lock = malloc(nv);
+    simp *W = calloc(nw, sizeof *W);
     lb_status s = LB_OK;
     if (!S.next || !S.head || !S.tail || !S.tdead || !S.kind || !S.sn || !S.Q || !S.stamp ||
-        !S.mark || !S.failed || !S.stuck || !S.hcost || !S.htgt || !S.wkey || !S.wplan)
+        !S.mark || !S.failed || !S.stuck || !S.hcost || !S.htgt || !rg || !lock || !W)
         s = nomem(err);
-    /* without them, lb_evaluator_eval's own (the same values) */
-    S.few =
-        lb__boxeval_alloc(ev, &S.E, NULL) == LB_OK && lb__plan_alloc(ev, &S.outer, NULL) == LB_OK;
     if (!s) s = setup(&S, err);
-    vec32 cand = {NULL, 0, 0};
-    double *cost = NULL; /* the moves' costs */
-    size_t ccap = 0;
-    for (size_t v = 0; !s && v < nv; ++v)
-        if (!requeue(&S, (uint32_t)v)) s = nomem(err);
-    size_t tried = 0;
-    double shown = 0.0; /* the fraction last reported: tried over tried and the heap left */
-    while (!s && S.nh) {
-        const hent e = hpop(&S);
-        const uint32_t u = e.v;
-        if (e.stamp != S.stamp[u] || S.kind[u] == GONE) continue;
-        S.hcost[u] = NAN;
-        if (++tried % CHECK_EVERY == 0) {
-            const double f = (double)tried / (double)(tried + S.nh);
-            if (f > shown) shown = f;
-            if ((cancel && *cancel) || (progress && progress(base + weight * shown, user))) {
-                s = lb__fail(err, LB_ERR_CANCELLED, "lb_mesh_create: cancelled by the caller");
-                break;
-            }
-        }
-        if (S.kind[u] != SMOOTH && S.kind[u] != CREASE) continue;
-        /* u's ring and neighbours, once for its moves and their checks */
-        if (!ring(&S, u, &S.ru) || !neighbours(&S, u, &S.ru, &S.nu)) {
-            s = nomem(err);
-            break;
-        }
-        /* its moves (as moves() finds them) in order of cost, each cost
-         * computed once (stable: ties in ring order) */
-        cand.n = 0;
-        int room = 1;
-        if (S.kind[u] == CREASE)
-            room = push32(&cand, S.sn[2 * (size_t)u]) && push32(&cand, S.sn[2 * (size_t)u + 1]);
-        else
-            for (size_t i = 0; room && i < S.nu.n; ++i) room = push32(&cand, S.nu.a[i]);
-        if (room && cand.n > ccap) {
-            free(cost);
-            ccap = cand.cap;
-            room = (cost = malloc(ccap * sizeof *cost)) != NULL;
-        }
-        if (!room) {
-            s = nomem(err);
-            break;
-        }
-        if (!cand.n) continue;
-        for (size_t i = 0; i < cand.n; ++i) {
-            const uint32_t x = cand.a[i];
-            const double c = move_cost(&S, u, x);
-            size_t j = i;
-            for (; j > 0 && c < cost[j - 1]; --j) {
-                cost[j] = cost[j - 1];
-                cand.a[j] = cand.a[j - 1];
-            }
-            cost[j] = c;
-            cand.a[j] = x;
-        }
-        /* in cost order, the first that passes every check is made; a move
-         * that failed its shape or field check before, with u's ring as it
-         * is, is not checked again */
-        int moved = 0, stuck = 1; /* stuck: every move tried failed so */
-        for (size_t i = 0; i < cand.n && !moved; ++i) {
-            size_t bit = 0; /* the move's bit in S.failed[u] (none from 32 on) */
-            while (bit < S.nu.n && S.nu.a[bit] != cand.a[i]) ++bit;
-            const uint32_t mask = bit < 32 ? (uint32_t)1 << bit : 0;
-            if (S.failed[u] & mask) continue;
-            int r = keeps_topology(&S, u, cand.a[i]);
-            if (r == 1) {
-                r = keeps_shape(&S, u, cand.a[i], err);
-                if (r == 0) S.failed[u] |= mask;
-            }
-            if (r == -1) s = nomem(err);
-            if (r == -2) s = S.est;
-            if (s) break;
-            if (r == 1) {
-                if (!do_move(&S, u, cand.a[i])) s = nomem(err);
-                moved = 1;
-            } else if (!(S.failed[u] & mask)) {
-                stuck = 0; /* the topology, which v's ring can change */
-            }
-        }
-        /* then every move fails whatever u's neighbours do, until u's ring
-         * changes (do_move clears this): u is not queued again till then */
-        if (!s && !moved && stuck) S.stuck[u] = 1;
+    size_t nwi = 0;               /* workers initialised */
+    for (; !s && nwi < nw; ++nwi) /* a failed one is freed with the others */
+        if (!worker_init(&W[nwi], &S)) s = nomem(err);
+    /* two parallel passes (two fifths of the bar each), then one thread */
+    watch w0 = {cancel, NULL, progress, user, base, 0.4 * weight, 0.0, NULL, 0};
+    if (!s) s = run_pass(W, nw, 0, rg, lock, &w0, err);
+    w0.base = base + 0.4 * weight;
+    if (!s) s = run_pass(W, nw, 1, rg, lock, &w0, err);
+    if (!s) {
+        for (size_t v = 0; v < nv; ++v) S.hcost[v] = NAN;
+        w0.base = base + 0.8 * weight;
+        w0.weight = 0.2 * weight;
+        s = collapse(&W[0], NULL, nv, &w0, err);
     }
     if (!s) compact(&S, feat);
-    free(cand.a);
-    free(cost);
+    for (size_t t = 0; t < nwi; ++t) worker_free(&W[t]);
+    free(W);
+    free(rg);
+    free(lock);
     free(S.next);
     free(S.head);
     free(S.tail);
@@ -1059,18 +1377,5 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     free(S.stuck);
     free(S.hcost);
     free(S.htgt);
-    for (size_t k = 0; S.wkey && k < WSLOTS; ++k)
-        if (S.wkey[k] != UINT64_MAX) lb__cplan_free(&S.wplan[k]);
-    free(S.wkey);
-    free(S.wplan);
-    free(S.heap);
-    free(S.ru.a);
-    free(S.rv.a);
-    free(S.nu.a);
-    free(S.nv.a);
-    free(S.tmp.a);
-    free(S.s);
-    lb__boxeval_free(&S.E);
-    lb__plan_free(&S.outer);
     return s;
 }
