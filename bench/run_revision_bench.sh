@@ -2,7 +2,9 @@
 # This tree's speed against revision REV's (default HEAD), in one run on
 # this machine: bench_operators, bench_eval and bench_mesh built from both
 # (REV from a temporary `git worktree`), run in alternation ROUNDS times
-# (default 3); each figure keeps its best round. Prints, per benchmark, the
+# (default 3); each figure keeps its best round. bench_mesh meshes S2, and
+# simplifies S1, S2 and the stool (0.1 cells) on one thread and on every
+# CPU. Prints, per benchmark, the
 # ratio of this tree's time to REV's (1.00: the same; below 1: faster now)
 # for every row and their geometric mean. For a restructuring that must not
 # cost speed (docs/design.md).
@@ -22,6 +24,9 @@ build() { # SRC BUILD
 build "$tmp/tree" "$tmp/old"
 build . build-revision-bench
 S2=$PWD/scenes/bench-s2-64-spheres.json
+S1=$PWD/scenes/bench-s1-three-spheres.json
+STOOL=$PWD/scenes/hsu-bounded-fig7-stool.json
+NT=$(nproc)
 for ((r = 1; r <= ROUNDS; r++)); do
   for side in old new; do
     b=$tmp/old/bench
@@ -29,6 +34,15 @@ for ((r = 1; r <= ROUNDS; r++)); do
     "$b/bench_operators" --quick >"$tmp/$side.ops.$r"
     "$b/bench_eval" "$PWD/scenes" >"$tmp/$side.eval.$r"
     for res in 256 384 512; do "$b/bench_mesh" "$S2" "$res" 1; done >"$tmp/$side.mesh.$r"
+    for th in 1 "$NT"; do
+      for run in "S1 128:$S1 128" "S1 256:$S1 256" "S2 128:$S2 128" "S2 256:$S2 256" \
+        "stool 128 features:$STOOL 128 --features"; do
+        # shellcheck disable=SC2086
+        set -- ${run#*:}
+        echo "${run%%:*} simplified, $th threads $("$b/bench_mesh" "$1" "$2" "$th" "${@:3}" \
+          --simplify 0.1)"
+      done
+    done >"$tmp/$side.simp.$r"
   done
 done
 /usr/bin/python3 - "$tmp" "$ROUNDS" "$REV" <<'PY'
@@ -54,13 +68,16 @@ def best(side, kind):
             elif line.startswith("{"):
                 d = json.loads(line)
                 rows.append(("S2 mesh %d cells" % d["resolution"], d["seconds"]))
+            elif kind == "simp" and "{" in line:
+                i = line.index("{")
+                rows.append((line[:i].strip(), json.loads(line[i:])["seconds"]))
             for k, v in rows:
                 out[k] = min(out.get(k, 1e30), v)
     return out
 
 
 for kind, title in (("ops", "bench_operators"), ("eval", "bench_eval (1 thread)"),
-                    ("mesh", "bench_mesh")):
+                    ("mesh", "bench_mesh"), ("simp", "bench_mesh --simplify 0.1 (meshing included)")):
     o, n = best("old", kind), best("new", kind)
     keys = [k for k in o if k in n]
     ratios = [n[k] / o[k] for k in keys]
