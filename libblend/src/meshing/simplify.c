@@ -1084,9 +1084,10 @@ static lb_status collapse(simp *S, const uint32_t *verts, size_t n, watch *wt, l
 typedef struct pass {
     simp *W; /* the workers' (W[0]: the calling thread's) */
     const uint32_t *verts, *ids;
-    const size_t *start;   /* region ids[r]'s movable vertices: verts[start[r] .. start[r + 1]) */
-    const uint32_t *order; /* the r taken k-th: the most vertices first (the last ones taken
-                            * are short, so the threads finish together) */
+    const size_t *start; /* region ids[r]'s movable vertices: verts[start[r] .. start[r + 1]) */
+    /* the regions in the order taken, most vertices first (the last ones
+     * taken are short, so the threads finish together): r in the low 32 bits */
+    const uint64_t *load;
     size_t nreg;
     atomic_size_t next, done;
     atomic_int stop;
@@ -1114,7 +1115,7 @@ static void pass_work(pass *P, size_t t) {
         }
         const size_t k = atomic_fetch_add(&P->next, 1);
         if (k >= P->nreg) break;
-        const size_t r = P->order[k];
+        const size_t r = (uint32_t)P->load[k];
         W->own = P->ids[r];
         const lb_status s =
             collapse(W, P->verts + P->start[r], P->start[r + 1] - P->start[r], wt, &P->errs[t]);
@@ -1176,7 +1177,6 @@ static lb_status run_pass(simp *W, size_t nw, int shift, uint32_t *rg, uint8_t *
     }
     size_t *pos = calloc(nall, sizeof *pos), *start = malloc((nall + 1) * sizeof *start);
     uint32_t *ids = malloc(nall * sizeof *ids), *verts = malloc(nv * sizeof *verts);
-    uint32_t *order = malloc(nall * sizeof *order);
     uint64_t *load = malloc(nall * sizeof *load);
     lb_status *st = calloc(nw, sizeof *st);
     lb_error *errs = calloc(nw, sizeof *errs);
@@ -1184,7 +1184,7 @@ static lb_status run_pass(simp *W, size_t nw, int shift, uint32_t *rg, uint8_t *
     pworker *pw = malloc(nw * sizeof *pw);
     pass *P = malloc(sizeof *P);
     lb_status s = LB_OK;
-    if (!pos || !start || !ids || !verts || !order || !load || !st || !errs || !tid || !pw || !P)
+    if (!pos || !start || !ids || !verts || !load || !st || !errs || !tid || !pw || !P)
         s = nomem(err);
     size_t nids = 0;
     if (!s) {
@@ -1207,13 +1207,12 @@ static lb_status run_pass(simp *W, size_t nw, int shift, uint32_t *rg, uint8_t *
         for (size_t r = 0; r < nids; ++r)
             load[r] = (uint64_t)(UINT32_MAX - (start[r + 1] - start[r])) << 32 | r;
         qsort(load, nids, sizeof *load, cmp_load);
-        for (size_t r = 0; r < nids; ++r) order[r] = (uint32_t)load[r];
         for (size_t v = 0; v < nv; ++v) W->hcost[v] = NAN;
         P->W = W;
         P->verts = verts;
         P->ids = ids;
         P->start = start;
-        P->order = order;
+        P->load = load;
         P->nreg = nids;
         atomic_init(&P->next, 0);
         atomic_init(&P->done, 0);
@@ -1259,7 +1258,6 @@ static lb_status run_pass(simp *W, size_t nw, int shift, uint32_t *rg, uint8_t *
     free(start);
     free(ids);
     free(verts);
-    free(order);
     free(load);
     free(st);
     free(errs);
@@ -1335,8 +1333,7 @@ lb_status lb__simplify(const lb_evaluator *ev, const lb__grid *g, lb_mesh *M, ui
     S.failed = calloc(nv, sizeof *S.failed);
     S.stuck = calloc(nv, 1);
     S.hcost = malloc(nv * sizeof *S.hcost);
-    S.htgt = malloc(nv * sizeof *S.htgt);
-    for (size_t v = 0; S.hcost && v < nv; ++v) S.hcost[v] = NAN;
+    S.htgt = malloc(nv * sizeof *S.htgt); /* hcost: NAN set by each pass */
     uint32_t *rg = malloc(nv * sizeof *rg);
     uint8_t *lock = malloc(nv);
     simp *W = calloc(nw, sizeof *W);
