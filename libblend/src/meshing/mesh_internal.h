@@ -487,4 +487,34 @@ LB_INTERNAL void lb__cube_edge(int e, int *p, int *q);
  * cubes.c needs it), else 0. */
 LB_INTERNAL int lb__mctable_check(const lb__mctable *t);
 
+/* ---- two-level cells (transition.c): a cell of twice the grid's cell
+ * size whose edges may be split at their midpoints and whose faces may be
+ * quartered, for a mesher that meshes coarse first. Its samples are the
+ * 3 x 3 x 3 fine-grid nodes in it, lattice node x + 3 y + 9 z (x, y, z in
+ * 0..2; the body centre, 13, is never read). */
+#define LB__TNODES 27
+/* most crossing sub-edges of one cell: 24 edge halves, 24 in the faces */
+#define LB__TMAX 48
+typedef struct lb__tcell {
+    uint16_t split;  /* bit e: cube edge e (cubes.c's numbering) split */
+    uint8_t quarter; /* bit f: face f (cubes.c's order) quartered; its four edges must be split */
+    uint32_t inside; /* bit n: lattice node n inside (phi < 0) */
+} lb__tcell;
+/* The cell's surface polygons: loops of crossing sub-edges (lattice nodes
+ * a < b, as a * LB__TNODES + b), counter-clockwise seen from outside, one
+ * after the other in sub (LB__TMAX room), len[l] each (LB__TMAX / 3 room),
+ * *nloop of them; loops of two sub-edges are left out (no area). Returns
+ * the sub-edges written, or -1 for a quartered face with an edge not
+ * split (or, which the rule rules out, a walk that does not close).
+ * Two cells sharing a face draw the same segments on it whatever their
+ * levels (transition.c says why). Face f (cubes.c's order) lies at
+ * coordinate f % 2 of axis f / 2. */
+LB_INTERNAL int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop);
+/* The n - 2 triangles of loop s[0..n-1] (3..LB__TMAX sub-edges of one
+ * cell) along diagonals whose two sub-edges lie on no common face plane of
+ * the cell, as loop positions, 3 per triangle in the loop's turn, into tri
+ * (3 * (LB__TMAX - 2) room); 0 when there is no such triangulation (the
+ * loop then needs a fan around a point inside the cell). */
+LB_INTERNAL int lb__tloop_triangles(const uint16_t *s, int n, uint8_t *tri);
+
 #endif

@@ -1,0 +1,188 @@
+/* Two-level cells: the polygons of a cell twice the grid's cell size whose
+ * edges may be split at their midpoints and whose faces may be cut into
+ * quarters. This is the cell a coarse-first mesher needs where a coarse cell
+ * meets fine ones (docs/meshing.md, Adaptive simplification): a coarse edge
+ * is split where any cell around it is fine, a coarse face is quartered
+ * where the cell across it is fine, and the samples at midpoints and face
+ * centres are the fine grid's nodes.
+ *
+ * The rule is cubes.c's, applied to the subdivided faces on the fly: each
+ * face, or each quarter of a quartered face, is walked counter-clockwise as
+ * seen from outside the cell through its corners and the midpoints of its
+ * split edges; along the walk a crossing sub-edge (two neighbouring samples
+ * on opposite sides) is an entry (outside -> inside) or an exit, and each
+ * entry is joined to the next crossing, an exit. The segments chain into
+ * loops: every crossing sub-edge lies on exactly two of the cell's (quarter)
+ * faces, which walk it in opposite directions, so it is the entry of one and
+ * the exit of the other.
+ *
+ * Why two cells sharing a face draw the same segments on it, whatever their
+ * levels: the face's subdivision is the same from both sides (a split edge
+ * is split for all four cells around it; a quartered face is each fine
+ * cell's whole face on the other side), and walking a face backwards
+ * reverses the entries and exits, so "each entry to the next crossing" read
+ * from the other side joins the same pairs, in the opposite direction. The
+ * closed, oriented 2-manifold argument of cubes.c then carries over; the
+ * tests assemble random two-level grids and check it
+ * (tests/test_transition.c).
+ *
+ * A loop of two sub-edges (the two halves of a split edge crossing, their
+ * midpoint on the other side of both ends) has no area: it is dropped, and
+ * the cells across the two faces holding the edge share the segment. A loop
+ * is cut into triangles only along diagonals whose two sub-edges lie on no
+ * common face plane of the cell (such a diagonal could be a segment another
+ * cell draws on that face); where there is no such triangulation the caller
+ * fans the loop around a point inside the cell. Nodes with phi exactly 0
+ * count as outside, as everywhere in the mesher. */
+#include "mesh_internal.h"
+
+#include <string.h>
+
+/* the corners of the faces counter-clockwise seen from outside (cubes.c's
+ * order); corner o is lattice node (2 (o & 1), 2 (o >> 1 & 1), 2 (o >> 2)) */
+static const uint8_t FACE[6][4] = {{4, 6, 2, 0}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                   {6, 7, 3, 2}, {2, 3, 1, 0}, {4, 5, 7, 6}};
+
+static int corner_node(int o) {
+    return 2 * (o & 1) + 6 * ((o >> 1) & 1) + 18 * ((o >> 2) & 1);
+}
+
+/* the cube edge (cubes.c's numbering) between corners p and q */
+static int cube_edge_of(int p, int q) {
+    for (int e = 0; e < 12; ++e) {
+        int a, b;
+        lb__cube_edge(e, &a, &b);
+        if ((a == p && b == q) || (a == q && b == p)) return e;
+    }
+    return -1;
+}
+
+static uint16_t sub_key(int a, int b) {
+    return (uint16_t)(a < b ? a * LB__TNODES + b : b * LB__TNODES + a);
+}
+
+/* One (quarter) face walked through nodes w[0..n-1]: next[] of its entries. */
+static void walk(const uint8_t *w, int n, uint32_t inside, int16_t *next) {
+    uint16_t cross[8];
+    uint8_t entry[8];
+    int m = 0;
+    for (int q = 0; q < n; ++q) {
+        const int p = w[q], r = w[(q + 1) % n];
+        const int pin = (inside >> p) & 1, rin = (inside >> r) & 1;
+        if (pin == rin) continue;
+        cross[m] = sub_key(p, r);
+        entry[m++] = (uint8_t)!pin;
+    }
+    for (int q = 0; q < m; ++q)
+        if (entry[q]) next[cross[q]] = (int16_t)cross[(q + 1) % m];
+}
+
+int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop) {
+    int16_t next[LB__TNODES * LB__TNODES];
+    memset(next, 0xff, sizeof next);
+    *nloop = 0;
+    for (int f = 0; f < 6; ++f) {
+        uint8_t mid[4];
+        for (int q = 0; q < 4; ++q) {
+            const int p = FACE[f][q], r = FACE[f][(q + 1) & 3];
+            mid[q] = (uint8_t)((corner_node(p) + corner_node(r)) / 2);
+            if (!((c->split >> cube_edge_of(p, r)) & 1)) mid[q] = 0xff;
+        }
+        if ((c->quarter >> f) & 1) {
+            const int centre = (corner_node(FACE[f][0]) + corner_node(FACE[f][2])) / 2;
+            for (int q = 0; q < 4; ++q)
+                if (mid[q] == 0xff) return -1; /* a quartered face needs its edges split */
+            for (int q = 0; q < 4; ++q) {
+                const uint8_t w[4] = {(uint8_t)corner_node(FACE[f][q]), mid[q], (uint8_t)centre,
+                                      mid[(q + 3) & 3]};
+                walk(w, 4, c->inside, next);
+            }
+        } else {
+            uint8_t w[8];
+            int n = 0;
+            for (int q = 0; q < 4; ++q) {
+                w[n++] = (uint8_t)corner_node(FACE[f][q]);
+                if (mid[q] != 0xff) w[n++] = mid[q];
+            }
+            walk(w, n, c->inside, next);
+        }
+    }
+    /* chain in ascending key order, so a cell's loops come out the same way
+     * every time */
+    uint8_t used[LB__TNODES * LB__TNODES];
+    memset(used, 0, sizeof used);
+    int total = 0;
+    for (int s0 = 0; s0 < LB__TNODES * LB__TNODES; ++s0) {
+        if (next[s0] < 0 || used[s0]) continue;
+        int n = 0;
+        for (int s = s0; !used[s]; s = next[s]) {
+            if (next[s] < 0 || total + n >= LB__TMAX) return -1; /* cannot happen: checked */
+            used[s] = 1;
+            sub[total + n++] = (uint16_t)s;
+        }
+        if (n < 3) continue; /* two halves of a split edge: no area */
+        len[(*nloop)++] = (uint8_t)n;
+        total += n;
+    }
+    return total;
+}
+
+/* bit 2 d + side: sub-edge s lies on the face plane of axis d at 0 (side 0)
+ * or at 2 (side 1) */
+static unsigned planes(uint16_t s) {
+    const int a = s / LB__TNODES, b = s % LB__TNODES;
+    unsigned m = 0;
+    for (int d = 0, div = 1; d < 3; ++d, div *= 3) {
+        const int ca = a / div % 3, cb = b / div % 3;
+        if (ca == cb && ca != 1) m |= 1u << (2 * d + (ca == 2));
+    }
+    return m;
+}
+
+int lb__tloop_triangles(const uint16_t *s, int n, uint8_t *tri) {
+    if (n < 3 || n > LB__TMAX) return 0;
+    unsigned pl[LB__TMAX];
+    for (int i = 0; i < n; ++i) pl[i] = planes(s[i]);
+    /* ok[a][b]: the sub-polygon a..b has a triangulation (a side or an
+     * allowed diagonal closing it); at[a][b]: its apex */
+    static const uint8_t NONE = 0xff;
+    uint8_t at[LB__TMAX][LB__TMAX];
+    memset(at, NONE, sizeof at);
+    for (int len = 2; len < n; ++len)
+        for (int a = 0; a + len < n; ++a) {
+            const int b = a + len;
+            const int side = a == 0 && b == n - 1;
+            if (!side && (pl[a] & pl[b])) continue;
+            for (int k = a + 1; k < b; ++k) {
+                const int left = k == a + 1 || at[a][k] != NONE;
+                const int right = k == b - 1 || at[k][b] != NONE;
+                if (left && right) {
+                    at[a][b] = (uint8_t)k;
+                    break;
+                }
+            }
+        }
+    if (at[0][n - 1] == NONE) return 0;
+    /* the sub-polygons, depth first (at most n - 2 on the stack) */
+    uint8_t stack[2 * LB__TMAX];
+    int sp = 0, nt = 0;
+    stack[sp++] = 0;
+    stack[sp++] = (uint8_t)(n - 1);
+    while (sp) {
+        const int b = stack[--sp], a = stack[--sp];
+        const int k = at[a][b];
+        tri[3 * nt] = (uint8_t)a;
+        tri[3 * nt + 1] = (uint8_t)k;
+        tri[3 * nt + 2] = (uint8_t)b;
+        ++nt;
+        if (k > a + 1) {
+            stack[sp++] = (uint8_t)a;
+            stack[sp++] = (uint8_t)k;
+        }
+        if (b > k + 1) {
+            stack[sp++] = (uint8_t)k;
+            stack[sp++] = (uint8_t)b;
+        }
+    }
+    return nt;
+}
