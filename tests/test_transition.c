@@ -27,7 +27,7 @@ typedef struct grid {
     unsigned *vstamp, stamp;
     double (*pos)[3];
     int nv, capv;
-    int (*tri)[3];
+    uint32_t (*tri)[3];
     int nt, capt;
     /* what was exercised */
     long quartered, split, fans, library_tris, loops;
@@ -73,9 +73,9 @@ static void add_tri(grid *g, int a, int b, int c) {
         g->tri = realloc(g->tri, sizeof *g->tri * (size_t)g->capt);
         assert_non_null(g->tri);
     }
-    g->tri[g->nt][0] = a;
-    g->tri[g->nt][1] = b;
-    g->tri[g->nt][2] = c;
+    g->tri[g->nt][0] = (uint32_t)a;
+    g->tri[g->nt][1] = (uint32_t)b;
+    g->tri[g->nt][2] = (uint32_t)c;
     ++g->nt;
 }
 
@@ -179,13 +179,17 @@ static void coarse_cell(grid *g, int cx, int cy, int cz) {
         for (int i = 0; i < n; ++i)
             v[i] = vertex(g, lattice_node(cx, cy, cz, sub[off + i] / LB__TNODES),
                           lattice_node(cx, cy, cz, sub[off + i] % LB__TNODES));
-        const int nt = lb__tloop_triangles(sub + off, n, tri);
+        double lp[3 * LB__TMAX];
+        for (int i = 0; i < n; ++i)
+            for (int d = 0; d < 3; ++d) lp[3 * i + d] = g->pos[v[i]][d];
+        const int nt = lb__tloop_triangles(sub + off, lp, n, tri);
         if (nt == 0) {
             ++g->fans;
             fan(g, v, n);
             continue;
         }
         assert_int_equal(nt, n - 2);
+        const int first = g->nt;
         for (int i = 0; i < nt; ++i) {
             for (int k = 0; k < 3; ++k) {
                 const int s = tri[3 * i + k], t = tri[3 * i + (k + 1) % 3];
@@ -200,6 +204,10 @@ static void coarse_cell(grid *g, int cx, int cy, int cz) {
             add_tri(g, v[tri[3 * i]], v[tri[3 * i + 1]], v[tri[3 * i + 2]]);
         }
         g->library_tris += nt;
+        /* no two triangles of the loop cross (a fold of the triangulation) */
+        for (int i = first; i < g->nt; ++i)
+            for (int j = i + 1; j < g->nt; ++j)
+                assert_false(tris_cross(&g->pos[0][0], g->tri[i], g->tri[j]));
     }
 }
 
@@ -221,7 +229,7 @@ static void check_mesh(const grid *g, int outward) {
     assert_true(de && next);
     for (int t = 0; t < g->nt; ++t)
         for (int k = 0; k < 3; ++k) {
-            const int a = g->tri[t][k], b = g->tri[t][(k + 1) % 3];
+            const uint32_t a = g->tri[t][k], b = g->tri[t][(k + 1) % 3];
             assert_true(a != b);
             de[3 * t + k] = (uint64_t)a << 32 | (uint64_t)b;
         }
@@ -248,7 +256,7 @@ static void check_mesh(const grid *g, int outward) {
     }
     qsort(pairs, ne, 2 * sizeof *pairs, cmp_u64); /* by the first word: the edge */
     for (size_t i = 0; i < ne; ++i) {
-        const int a = g->tri[i / 3][i % 3], c = g->tri[i / 3][(i + 2) % 3];
+        const uint32_t a = g->tri[i / 3][i % 3], c = g->tri[i / 3][(i + 2) % 3];
         const uint64_t want = (uint64_t)a << 32 | (uint64_t)c;
         size_t lo = 0, hi = ne;
         while (lo < hi) {
@@ -281,7 +289,7 @@ static void check_mesh(const grid *g, int outward) {
         assert_true(p && vol);
         for (int v = 0; v < g->nv; ++v) p[v] = v;
         for (int t = 0; t < g->nt; ++t)
-            for (int k = 1; k < 3; ++k) p[find(p, g->tri[t][k])] = find(p, g->tri[t][0]);
+            for (int k = 1; k < 3; ++k) p[find(p, (int)g->tri[t][k])] = find(p, (int)g->tri[t][0]);
         for (int t = 0; t < g->nt; ++t) {
             const double *a = g->pos[g->tri[t][0]], *b = g->pos[g->tri[t][1]],
                          *c = g->pos[g->tri[t][2]];
@@ -299,6 +307,29 @@ static void check_mesh(const grid *g, int outward) {
     free(next);
     free(count);
     free(first);
+}
+
+/* no two triangles of the mesh cross (bounding boxes first) */
+static void check_crossings(const grid *g) {
+    for (int i = 0; i < g->nt; ++i) {
+        double lo[3], hi[3];
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = hi[d] = g->pos[g->tri[i][0]][d];
+            for (int k = 1; k < 3; ++k) {
+                lo[d] = fmin(lo[d], g->pos[g->tri[i][k]][d]);
+                hi[d] = fmax(hi[d], g->pos[g->tri[i][k]][d]);
+            }
+        }
+        for (int j = i + 1; j < g->nt; ++j) {
+            int apart = 0;
+            for (int d = 0; d < 3 && !apart; ++d) {
+                const double a = g->pos[g->tri[j][0]][d], b = g->pos[g->tri[j][1]][d],
+                             c = g->pos[g->tri[j][2]][d];
+                apart = fmax(a, fmax(b, c)) < lo[d] || fmin(a, fmin(b, c)) > hi[d];
+            }
+            if (!apart) assert_false(tris_cross(&g->pos[0][0], g->tri[i], g->tri[j]));
+        }
+    }
 }
 
 static void fill(grid *g, lb__splitmix *r, int balls) {
@@ -360,6 +391,7 @@ static void test_transition_cells(void **state) {
                                   2 * cz + ((o >> 2) & 1));
                 }
         check_mesh(g, balls);
+        if (balls) check_crossings(g); /* random signs can cross loops of one cell */
         tris += g->nt;
     }
     /* the cases that matter were met, many times over */

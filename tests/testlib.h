@@ -173,6 +173,53 @@ static inline long double ld_bisect(ldfn_t T, const void *ctx, long double lo, l
     return 0.5L * (lo + hi);
 }
 
+/* ---- self-intersections (test_mesh.c, test_transition.c) ---- */
+
+static inline int seg_tri(const double *p, const double *q, const double *a, const double *b,
+                          const double *c) {
+    /* proper intersection of segment pq with triangle abc (Moller-Trumbore) */
+    const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double d[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]};
+    const double h[3] = {d[1] * e2[2] - d[2] * e2[1], d[2] * e2[0] - d[0] * e2[2],
+                         d[0] * e2[1] - d[1] * e2[0]};
+    const double det = e1[0] * h[0] + e1[1] * h[1] + e1[2] * h[2];
+    const double scale = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]) *
+                         sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]) *
+                         sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (fabs(det) <= 1e-12 * scale) return 0; /* parallel: not a proper crossing */
+    const double inv = 1.0 / det;
+    const double s[3] = {p[0] - a[0], p[1] - a[1], p[2] - a[2]};
+    const double u = (s[0] * h[0] + s[1] * h[1] + s[2] * h[2]) * inv;
+    const double qv[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2],
+                          s[0] * e1[1] - s[1] * e1[0]};
+    const double v = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) * inv;
+    const double t = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) * inv;
+    const double eps = 1e-9;
+    return u > eps && v > eps && u + v < 1.0 - eps && t > eps && t < 1.0 - eps;
+}
+
+/* Whether triangles A and B (vertex indices into P, 3 doubles per vertex)
+ * cross: an edge of one properly through the other; neighbours across an
+ * edge never do, and at a shared vertex only the edges away from it count. */
+static inline int tris_cross(const double *P, const uint32_t *A, const uint32_t *B) {
+    int shared = 0;
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) shared += A[a] == B[b];
+    if (shared >= 2) return 0; /* neighbours across an edge */
+    for (int k = 0; k < 3; ++k) {
+        const uint32_t p = A[k], q = A[(k + 1) % 3];
+        if (shared && (p == B[0] || p == B[1] || p == B[2] || q == B[0] || q == B[1] || q == B[2]))
+            continue; /* an edge through the shared vertex touches there */
+        if (seg_tri(P + 3 * p, P + 3 * q, P + 3 * B[0], P + 3 * B[1], P + 3 * B[2])) return 1;
+        const uint32_t r = B[k], s = B[(k + 1) % 3];
+        if (shared && (r == A[0] || r == A[1] || r == A[2] || s == A[0] || s == A[1] || s == A[2]))
+            continue;
+        if (seg_tri(P + 3 * r, P + 3 * s, P + 3 * A[0], P + 3 * A[1], P + 3 * A[2])) return 1;
+    }
+    return 0;
+}
+
 static inline int all_finite(size_t n, const double *v) {
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(v[i])) return 0;

@@ -511,10 +511,13 @@ typedef struct lb__tcell {
  * coordinate f % 2 of axis f / 2. */
 LB_INTERNAL int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop);
 /* The n - 2 triangles of loop s[0..n-1] (3..LB__TMAX sub-edges of one
- * cell) along diagonals whose two sub-edges lie on no common face plane of
- * the cell, as loop positions, 3 per triangle in the loop's turn, into tri
- * (3 * (LB__TMAX - 2) room); 0 when there is no such triangulation (the
- * loop then needs a fan around a point inside the cell). */
-LB_INTERNAL int lb__tloop_triangles(const uint16_t *s, int n, uint8_t *tri);
+ * cell; pos: their vertices, 3 doubles each) along diagonals whose two
+ * sub-edges lie on no common face plane of the cell, as loop positions, 3
+ * per triangle in the loop's turn, into tri (3 * (LB__TMAX - 2) room): of
+ * those triangulations, the one whose worst triangle is closest to facing
+ * along the loop's mean normal. 0 when there is none, or when even the best
+ * has a triangle facing against that normal (a fold): the loop then needs
+ * a fan around a point inside the cell. */
+LB_INTERNAL int lb__tloop_triangles(const uint16_t *s, const double *pos, int n, uint8_t *tri);
 
 #endif

@@ -36,6 +36,7 @@
  * count as outside, as everywhere in the mesher. */
 #include "mesh_internal.h"
 
+#include <math.h>
 #include <string.h>
 
 /* the corners of the faces counter-clockwise seen from outside (cubes.c's
@@ -139,30 +140,53 @@ static unsigned planes(uint16_t s) {
     return m;
 }
 
-int lb__tloop_triangles(const uint16_t *s, int n, uint8_t *tri) {
+int lb__tloop_triangles(const uint16_t *s, const double *pos, int n, uint8_t *tri) {
     if (n < 3 || n > LB__TMAX) return 0;
     unsigned pl[LB__TMAX];
     for (int i = 0; i < n; ++i) pl[i] = planes(s[i]);
-    /* ok[a][b]: the sub-polygon a..b has a triangulation (a side or an
-     * allowed diagonal closing it); at[a][b]: its apex */
+    /* the loop's mean normal (Newell's sum: twice the vector area) */
+    double N[3] = {0, 0, 0};
+    for (int i = 0; i < n; ++i) {
+        const double *p = pos + 3 * i, *q = pos + 3 * ((i + 1) % n);
+        N[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        N[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        N[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+    const double nl = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+    if (!(nl > 0)) return 0;
+    /* best[a][b]: over the triangulations of the sub-polygon a..b whose
+     * diagonals keep off the faces, the largest smallest cosine between a
+     * triangle's normal and N (2: a side, nothing to cut); at[a][b]: the
+     * apex of the triangle on a-b in the best one */
     static const uint8_t NONE = 0xff;
+    float best[LB__TMAX][LB__TMAX];
     uint8_t at[LB__TMAX][LB__TMAX];
     memset(at, NONE, sizeof at);
+    for (int a = 0; a + 1 < n; ++a) best[a][a + 1] = 2.0f;
     for (int len = 2; len < n; ++len)
         for (int a = 0; a + len < n; ++a) {
             const int b = a + len;
+            best[a][b] = -2.0f;
             const int side = a == 0 && b == n - 1;
             if (!side && (pl[a] & pl[b])) continue;
+            const double *A = pos + 3 * a, *B = pos + 3 * b;
             for (int k = a + 1; k < b; ++k) {
-                const int left = k == a + 1 || at[a][k] != NONE;
-                const int right = k == b - 1 || at[k][b] != NONE;
-                if (left && right) {
+                if (best[a][k] < -1.5f || best[k][b] < -1.5f) continue;
+                double t[3];
+                lb__facing(A, pos + 3 * k, B, t);
+                const double tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+                float c =
+                    tl > 0 ? (float)((t[0] * N[0] + t[1] * N[1] + t[2] * N[2]) / (tl * nl)) : -1.0f;
+                if (best[a][k] < c) c = best[a][k];
+                if (best[k][b] < c) c = best[k][b];
+                if (c > best[a][b]) {
+                    best[a][b] = c;
                     at[a][b] = (uint8_t)k;
-                    break;
                 }
             }
         }
-    if (at[0][n - 1] == NONE) return 0;
+    /* none, or one with a triangle facing against the loop: a fan instead */
+    if (at[0][n - 1] == NONE || !(best[0][n - 1] > 0)) return 0;
     /* the sub-polygons, depth first (at most n - 2 on the stack) */
     uint8_t stack[2 * LB__TMAX];
     int sp = 0, nt = 0;
