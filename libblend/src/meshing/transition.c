@@ -115,13 +115,14 @@ int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop)
     int total = 0;
     for (int s0 = 0; s0 < LB__TNODES * LB__TNODES; ++s0) {
         if (next[s0] < 0 || used[s0]) continue;
-        int n = 0;
-        for (int s = s0; !used[s]; s = next[s]) {
-            if (next[s] < 0 || total + n >= LB__TMAX) return -1; /* cannot happen: checked */
+        int n = 0, s = s0;
+        for (; !used[s]; s = next[s]) {
+            if (next[s] < 0 || total + n >= LB__TMAX) return -1; /* cannot happen: tested */
             used[s] = 1;
             sub[total + n++] = (uint16_t)s;
         }
-        if (n < 3) continue; /* two halves of a split edge: no area */
+        if (s != s0) return -1; /* nor this: each crossing is one entry's next */
+        if (n < 3) continue;    /* two halves of a split edge: no area */
         len[(*nloop)++] = (uint8_t)n;
         total += n;
     }
