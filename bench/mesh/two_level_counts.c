@@ -486,9 +486,11 @@ int main(int argc, char **argv) {
            "sign change: %zu\n",
            quiet, unclear, 19 * unclear, hidden);
     /* the cells whose interval is not clear of the surface: every coarse
-     * cell, and the fine cells inside the coarse ones that are not; the
-     * uniform mesher evaluates the corners of such fine cells (mesher.c's
-     * mark, with the block plans' tighter intervals: an upper bound) */
+     * cell, and the fine cells inside the coarse ones that are not. The
+     * uniform mesher's mark (mesher.c) stops at boxes of two cells a side,
+     * the coarse cells: it evaluates the 27 nodes of each such box (under
+     * the block plans' intervals, which may be tighter than the whole
+     * field's here); the corners of the fine cells alone would be fewer */
     const unsigned F[3] = {2 * R.C[0], 2 * R.C[1], 2 * R.C[2]};
     uint8_t *cstr = calloc(ncc, 1), *fstr = calloc((size_t)F[0] * F[1] * F[2], 1),
             *need = calloc(nn, 1);
@@ -515,10 +517,17 @@ int main(int argc, char **argv) {
                 need[nid(&R, x + (k & 1), y + ((k >> 1) & 1), z + ((k >> 2) & 1))] = 1;
         }
     }
-    size_t unodes = 0;
+    size_t unodes = 0, mnodes = 0;
     for (size_t n = 0; n < nn; ++n) unodes += need[n];
-    printf("  the uniform mesher: %zu vertices (roots), at most %zu nodes evaluated\n",
-           m->nvertices, unodes);
+    for (size_t c = 0; c < ncc; ++c)
+        if (cstr[c])
+            for (int l = 0; l < LB__TNODES; ++l)
+                need[lat(&R, (unsigned)(c % R.C[0]), (unsigned)(c / R.C[0] % R.C[1]),
+                         (unsigned)(c / ((size_t)R.C[0] * R.C[1])), l)] = 1;
+    for (size_t n = 0; n < nn; ++n) mnodes += need[n];
+    printf("  the uniform mesher: %zu vertices (roots), %zu nodes evaluated (boxes of two cells; "
+           "%zu at the fine cells' corners)\n",
+           m->nvertices, mnodes, unodes);
     size_t kcap = 1 << 16, nk = 0;
     uint64_t *keys = malloc(sizeof *keys * kcap);
     if (!keys) return 1;
@@ -594,10 +603,9 @@ int main(int argc, char **argv) {
                                         PUSH(KEY(a, b));
                                     }
                                 }
-                                if (fstr[((size_t)z * F[1] + y) * F[0] + x])
-                                    for (int k = 0; k < 8; ++k)
-                                        need[nid(&R, x + (k & 1), y + ((k >> 1) & 1),
-                                                 z + ((k >> 2) & 1))] = 1;
+                                if (cstr[((size_t)cz * R.C[1] + cy) * R.C[0] + cx])
+                                    for (int l = 0; l < LB__TNODES; ++l)
+                                        need[lat(&R, cx, cy, cz, l)] = 1;
                             }
                             continue;
                         }
