@@ -274,8 +274,6 @@ int main(int argc, char **argv) {
     typedef struct pending {
         size_t cell, v0;
         int n;
-        uint8_t tri[3 * LB__TMAX];
-        int nt;
     } pending;
     size_t pcap = 1024, np = 0;
     pending *P = malloc(sizeof *P * pcap);
@@ -423,12 +421,11 @@ int main(int argc, char **argv) {
     /* a check from the vertices' normals alone (no evaluation beyond the
      * roots' own): a triangle's edge of length L whose end normals turn by
      * an angle a bows out of it by about L a / 8 (a circular arc) */
-    double *VN = malloc(sizeof *VN * 3 * (nv ? nv : 1)), *vvv = malloc(sizeof *vvv * (nv ? nv : 1));
     double *nerr = calloc(nct ? nct : 1, sizeof *nerr);
-    if (!VN || !vvv || !nerr || phi_many(&R, nv, V, vvv, VN)) return 1;
+    if (!nerr) return 1;
     {
-        /* triangles hold positions only: find their vertices' normals by
-         * evaluating at the triangle corners again (the mesher has them) */
+        /* the triangles hold positions only: their corners' normals by
+         * evaluating there (the mesher has them from the roots) */
         double *CP = malloc(sizeof *CP * 9 * (nct ? nct : 1)),
                *cv = malloc(sizeof *cv * 3 * (nct ? nct : 1)),
                *cg = malloc(sizeof *cg * 9 * (nct ? nct : 1));
@@ -698,8 +695,6 @@ int main(int argc, char **argv) {
     free(fstr);
     free(need);
     free(terr);
-    free(VN);
-    free(vvv);
     free(nerr);
     free(S);
     free(sv);

@@ -31,9 +31,12 @@
  * the cells across the two faces holding the edge share the segment. A loop
  * is cut into triangles only along diagonals whose two sub-edges lie on no
  * common face plane of the cell (such a diagonal could be a segment another
- * cell draws on that face); where there is no such triangulation the caller
- * fans the loop around a point inside the cell. Nodes with phi exactly 0
- * count as outside, as everywhere in the mesher. */
+ * cell draws on that face), and of those triangulations the one whose worst
+ * triangle faces closest to the loop's mean normal (the first one found
+ * folded loops over unions of balls); where there is none, or the best one
+ * still has a triangle facing backwards, the caller fans the loop around a
+ * point inside the cell. Nodes with phi exactly 0 count as outside, as
+ * everywhere in the mesher. */
 #include "mesh_internal.h"
 
 #include <math.h>
