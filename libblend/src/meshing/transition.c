@@ -65,8 +65,16 @@ static uint16_t sub_key(int a, int b) {
     return (uint16_t)(a < b ? a * LB__TNODES + b : b * LB__TNODES + a);
 }
 
-/* One (quarter) face walked through nodes w[0..n-1]: next[] of its entries. */
-static void walk(const uint8_t *w, int n, uint32_t inside, int16_t *next) {
+/* The segments found so far: entry sub-edge ein[i] joined to exit eout[i]
+ * (every crossing sub-edge is the entry of exactly one (quarter) face). */
+typedef struct segs {
+    uint16_t ein[LB__TMAX], eout[LB__TMAX];
+    int n;
+} segs;
+
+/* One (quarter) face walked through nodes w[0..n-1]: its segments. 0 when
+ * there are more than a cell can have (cannot happen). */
+static int walk(const uint8_t *w, int n, uint32_t inside, segs *S) {
     uint16_t cross[8];
     uint8_t entry[8];
     int m = 0;
@@ -78,12 +86,17 @@ static void walk(const uint8_t *w, int n, uint32_t inside, int16_t *next) {
         entry[m++] = (uint8_t)!pin;
     }
     for (int q = 0; q < m; ++q)
-        if (entry[q]) next[cross[q]] = (int16_t)cross[(q + 1) % m];
+        if (entry[q]) {
+            if (S->n == LB__TMAX) return 0;
+            S->ein[S->n] = cross[q];
+            S->eout[S->n++] = cross[(q + 1) % m];
+        }
+    return 1;
 }
 
 int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop) {
-    int16_t next[LB__TNODES * LB__TNODES];
-    memset(next, 0xff, sizeof next);
+    segs S;
+    S.n = 0;
     *nloop = 0;
     for (int f = 0; f < 6; ++f) {
         uint8_t mid[4];
@@ -99,7 +112,7 @@ int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop)
             for (int q = 0; q < 4; ++q) {
                 const uint8_t w[4] = {(uint8_t)corner_node(FACE[f][q]), mid[q], (uint8_t)centre,
                                       mid[(q + 3) & 3]};
-                walk(w, 4, c->inside, next);
+                if (!walk(w, 4, c->inside, &S)) return -1;
             }
         } else {
             uint8_t w[8];
@@ -108,24 +121,43 @@ int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop)
                 w[n++] = (uint8_t)corner_node(FACE[f][q]);
                 if (mid[q] != 0xff) w[n++] = mid[q];
             }
-            walk(w, n, c->inside, next);
+            if (!walk(w, n, c->inside, &S)) return -1;
         }
     }
-    /* chain in ascending key order, so a cell's loops come out the same way
-     * every time */
-    uint8_t used[LB__TNODES * LB__TNODES];
-    memset(used, 0, sizeof used);
-    int total = 0;
-    for (int s0 = 0; s0 < LB__TNODES * LB__TNODES; ++s0) {
-        if (next[s0] < 0 || used[s0]) continue;
-        int n = 0, s = s0;
-        for (; !used[s]; s = next[s]) {
-            if (next[s] < 0 || total + n >= LB__TMAX) return -1; /* cannot happen: tested */
-            used[s] = 1;
-            sub[total + n++] = (uint16_t)s;
+    /* the segments by entry, ascending (insertion sort: at most 48), so a
+     * cell's loops come out the same way every time and each exit's own
+     * segment is found by bisection */
+    for (int i = 1; i < S.n; ++i)
+        for (int j = i; j > 0 && S.ein[j - 1] > S.ein[j]; --j) {
+            const uint16_t a = S.ein[j], b = S.eout[j];
+            S.ein[j] = S.ein[j - 1];
+            S.eout[j] = S.eout[j - 1];
+            S.ein[j - 1] = a;
+            S.eout[j - 1] = b;
         }
-        if (s != s0) return -1; /* nor this: each crossing is one entry's next */
-        if (n < 3) continue;    /* two halves of a split edge: no area */
+    uint8_t used[LB__TMAX] = {0};
+    int total = 0;
+    for (int i0 = 0; i0 < S.n; ++i0) {
+        if (used[i0]) continue;
+        int n = 0, i = i0;
+        for (;;) {
+            if (used[i] || total + n >= LB__TMAX) return -1; /* cannot happen: tested */
+            used[i] = 1;
+            sub[total + n++] = S.ein[i];
+            const uint16_t next = S.eout[i];
+            if (next == S.ein[i0]) break;
+            int lo = 0, hi = S.n; /* the segment whose entry is next */
+            while (lo < hi) {
+                const int m = (lo + hi) / 2;
+                if (S.ein[m] < next)
+                    lo = m + 1;
+                else
+                    hi = m;
+            }
+            if (lo == S.n || S.ein[lo] != next) return -1; /* nor this: every exit enters */
+            i = lo;
+        }
+        if (n < 3) continue; /* two halves of a split edge: no area */
         len[(*nloop)++] = (uint8_t)n;
         total += n;
     }
@@ -165,7 +197,7 @@ int lb__tloop_triangles(const uint16_t *s, const double *pos, int n, uint8_t *tr
     static const uint8_t NONE = 0xff;
     float best[LB__TMAX][LB__TMAX];
     uint8_t at[LB__TMAX][LB__TMAX];
-    memset(at, NONE, sizeof at);
+    for (int a = 0; a < n; ++a) memset(at[a], NONE, (size_t)n);
     for (int a = 0; a + 1 < n; ++a) best[a][a + 1] = 2.0f;
     for (int len = 2; len < n; ++len)
         for (int a = 0; a + len < n; ++a) {
