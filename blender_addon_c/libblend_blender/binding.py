@@ -38,6 +38,7 @@ MESH_OPEN_BOUNDARY = 1
 MESH_FEATURES = 4  # LB_MESH_FEATURES: keep sharp creases and corners
 MESH_CORNER_NORMALS = 8  # LB_MESH_CORNER_NORMALS: a normal per side of each crease
 MESH_MERGE_FLAT = 16  # LB_MESH_MERGE_FLAT: flat regions as few triangles, exact
+MESH_COARSE_FIRST = 32  # LB_MESH_COARSE_FIRST: simplify by meshing coarse first
 
 
 class LibblendError(Exception):
@@ -515,7 +516,7 @@ class Evaluator(_Handle):
 
     def mesh(self, bmin, bmax, resolution=128, cell_size=0.0, open_boundary=False, threads=0,
              max_memory=0, cancel=None, edges=False, features=False, corner_normals=True,
-             simplify=0.0, cache=None, recycle=False, merge_flat=False):
+             simplify=0.0, cache=None, recycle=False, merge_flat=False, coarse_first=False):
         """Mesh the field over the box [bmin, bmax] (docs/meshing.md). Returns a
         Mesh holding numpy copies. Raises Cancelled if cancel.cancel() was called.
         edges=True also fills Mesh.edges and Mesh.corner_edges (lb_mesh_edges);
@@ -525,7 +526,10 @@ class Evaluator(_Handle):
         simplify > 0 (cells, at most 1) merges triangles wherever the surface
         stays within that tolerance of the field (lb_mesh_options.simplify);
         merge_flat=True makes each flat face a triangulation of its outline,
-        the surface unchanged (LB_MESH_MERGE_FLAT);
+        the surface unchanged (LB_MESH_MERGE_FLAT); coarse_first=True (with
+        simplify) meets simplify's tolerance by meshing cells of twice the
+        size where they are close enough, instead of by collapses
+        (LB_MESH_COARSE_FIRST);
         cache (a MeshCache) remeshes only the blocks that changed since the
         last mesh made through it (lb_mesh_create_cached), byte-identical;
         recycle=True (with a cache) gives the C mesh's arrays back to the
@@ -541,7 +545,7 @@ class Evaluator(_Handle):
         o.cell_size = float(cell_size)
         o.flags = (MESH_OPEN_BOUNDARY if open_boundary else 0) | (MESH_FEATURES if features else 0) \
             | (MESH_CORNER_NORMALS if features and corner_normals else 0) \
-            | (MESH_MERGE_FLAT if merge_flat else 0)
+            | (MESH_MERGE_FLAT if merge_flat else 0) | (MESH_COARSE_FIRST if coarse_first else 0)
         o.threads = int(threads)
         o.max_memory = int(max_memory)
         o.simplify = float(simplify)

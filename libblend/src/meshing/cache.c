@@ -64,6 +64,7 @@ struct lb_mesh_cache {
     double origin[3], h[3], bmin[3], bmax[3];
     uint32_t cells[3];
     int closed, soft, tetrahedra, features, conv, cullable;
+    double coarse; /* the grid's coarse-first tolerance (0: off) */
     /* the records of the evaluator last meshed (with and without
      * arguments), a table over the full ones */
     size_t nins;
@@ -582,7 +583,7 @@ static int set_places(lb__cmatch *M, lb__cblock *E, uint32_t *scratch) {
 int lb__cache_usable(const lb_mesh_cache *C, const lb_evaluator *ev, const lb__grid *g) {
     if (!C || !C->valid || C->conv != (int)ev->conv || C->cullable != ev->cullable) return 0;
     if (C->closed != g->closed || C->soft != g->soft || C->tetrahedra != g->tetrahedra ||
-        C->features != g->features)
+        C->features != g->features || C->coarse != g->coarse)
         return 0;
     for (int d = 0; d < 3; ++d)
         if (C->origin[d] != g->origin[d] || C->h[d] != g->h[d] || C->cells[d] != g->cells[d] ||
@@ -718,6 +719,7 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     C->soft = g->soft;
     C->tetrahedra = g->tetrahedra;
     C->features = g->features;
+    C->coarse = g->coarse;
     C->conv = (int)ev->conv;
     C->cullable = ev->cullable;
     size_t bytes = sizeof *C + C->full.off[C->nins] + C->self.off[C->nins] +

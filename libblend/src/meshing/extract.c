@@ -83,8 +83,14 @@ struct lb__bctx {
     face *faces;
     size_t nf; /* polygons so far (< FACE_MAX) */
     lb__mscratch S;
+    struct tlscratch *tl; /* two-level blocks' scratch, made on first use */
 };
 typedef lb__bctx bctx;
+
+/* eloc's flag for a whole edge of a two-level block's coarse cell: never on
+ * a block face, so never published */
+#define COARSE_EDGE (1u << 15)
+static void tl_free(struct tlscratch *T);
 
 static inline int corner_in(const double *c, int o) {
     return c[o] < 0.0;
@@ -384,6 +390,7 @@ void lb__bctx_free(lb__bctx *C) {
     free(C->cw);
     free(C->perm);
     free(C->faces);
+    tl_free(C->tl);
     lb__mscratch *S = &C->S;
     lb__boxeval_free(&S->E);
     lb__plan_free(&S->outer);
@@ -435,6 +442,7 @@ static void publish(lb__bctx *C) {
     const size_t np = C->ne - C->norph;
     for (size_t e = 0; e < np; ++e) {
         const uint32_t w = C->eloc[e];
+        if (w & COARSE_EDGE) continue; /* inside the block (two-level blocks) */
         const uint32_t l[3] = {w & 15, (w >> 4) & 15, (w >> 8) & 15};
         const int mask = (int)(w >> 12);
         for (int d = 0; d < 3; ++d) {
@@ -1029,6 +1037,535 @@ static lb_status place_features(const lb_evaluator *ev, const lb__grid *g, lb__b
     return LB_OK;
 }
 
+/* One cell (i, j, k) of block B whose corner values are final: its
+ * polygons by the grid's cell method. 0 when out of memory. */
+static inline int cut_cell(bctx *C, const lb__grid *g, const lb__block *B, uint32_t i, uint32_t j,
+                           uint32_t k) {
+    const uint32_t D0 = C->h.D0, D1 = C->h.D1;
+    double c[8];
+    int cfg = 0; /* bit o: corner o inside */
+    for (int o = 0; o < 8; ++o) {
+        const size_t idx =
+            ((size_t)(k + ((o >> 2) & 1)) * D1 + (j + ((o >> 1) & 1))) * D0 + (i + (o & 1));
+        c[o] = B->vals[idx];
+        cfg |= (c[o] < 0.0) << o;
+    }
+    if (cfg == 0 || cfg == 255) return 1;
+    C->cell = i | j << 4 | k << 8;
+    return (g->tetrahedra ? lb__tetra_cell : lb__cube_cell)(C, i, j, k, c, cfg);
+}
+
+/* ---- two-level blocks (LB_MESH_COARSE_FIRST; docs/meshing.md, "How it
+ * fits the block mesher") ----
+ * The block's 4^3 coarse cells (mark()'s smallest boxes: a coarse cell is
+ * marked whole or not at all) are decided in rounds. A round takes every
+ * marked coarse cell not yet decided, or decided coarse but whose pattern
+ * (lb__tcell: its edges split on the block's boundary planes and where a
+ * fine cell is around them, its faces quartered on those planes and where
+ * the cell across is fine) has changed, evaluates the samples its pattern
+ * reads, and makes it fine when
+ * - its samples show no crossing but one of its other nodes is on the other
+ *   side (the corners miss a part of the surface that mark()'s interval
+ *   did not rule out), or
+ * - a loop has no triangulation that keeps off its faces and does not fold
+ *   (lb__tloop_triangles), or
+ * - a triangle bows out by more than the tolerance: its centroid's or an
+ *   edge midpoint's |phi| / |grad phi|, or an edge of length L whose end
+ *   normals turn by an angle a (a circular arc: L a / 8), over the
+ *   tolerance in cells of the smallest side.
+ * Cells only ever turn fine, so the rounds end (at most one per cell); the
+ * result depends on the block's node values and plan alone. Then the fine
+ * cells' nodes are evaluated and their cells cut by the cube cases, and the
+ * coarse cells' loops give triangles through the block's own vertex
+ * sharing: every sub-edge of a coarse cell that is a grid edge is one
+ * (lb__cell_edge: shared with the fine cells and, on the block's faces,
+ * with the next blocks as now); a whole coarse edge, never on a boundary
+ * plane, is the block's own (tl_coarse_edge). The decisions solve their
+ * vertices in a batch of their own; the refinement after the cells solves
+ * them again with the rest (the same inputs, the same positions). */
+#define TL_SIDE (LB__MB / 2)
+#define TL_CELLS (TL_SIDE * TL_SIDE * TL_SIDE)
+#define TL_EDGES ((size_t)TL_CELLS * LB__TMAX)
+#define TL_POINTS                                                                                  \
+    ((size_t)TL_CELLS * LB__TMAX * 4) /* < LB__TMAX triangles a cell, 4 points each                \
+                                       */
+#define TL_NODES ((size_t)TL_CELLS * LB__TNODES)
+
+enum { TL_OFF, TL_TODO, TL_OK, TL_FINE };
+
+typedef struct tlcell {
+    lb__tcell t; /* the pattern it was decided with */
+    uint16_t sub[LB__TMAX];
+    uint8_t len[LB__TMAX / 3];
+    uint8_t tri[3 * LB__TMAX]; /* the loops' triangles, as positions in sub */
+    uint8_t nloop, ntri, state;
+    uint16_t e0; /* its first sub-edge in the round's batch */
+} tlcell;
+
+struct tlscratch {
+    tlcell cell[TL_CELLS];
+    size_t *q;                                       /* nodes to evaluate (TL_NODES) */
+    double *ea, *eb, *pa, *pb, *ga, *gb, *pos, *nrm; /* the round's sub-edges (TL_EDGES) */
+    double *x, *y, *z, *v, *gx, *gy, *gz;            /* points to evaluate (TL_POINTS) */
+    uint8_t *pcell;                                  /* a check point's cell */
+};
+typedef struct tlscratch tlscratch;
+
+static void tl_free(tlscratch *T) {
+    if (!T) return;
+    free(T->q);
+    free(T->ea);
+    free(T->x);
+    free(T->pcell);
+    free(T);
+}
+
+static tlscratch *tl_new(void) {
+    tlscratch *T = calloc(1, sizeof *T);
+    if (!T) return NULL;
+    T->q = malloc(TL_NODES * sizeof *T->q);
+    T->ea = malloc(20 * TL_EDGES * sizeof *T->ea);
+    T->x = malloc(7 * TL_POINTS * sizeof *T->x);
+    T->pcell = malloc(TL_POINTS * sizeof *T->pcell);
+    if (!T->q || !T->ea || !T->x || !T->pcell) {
+        tl_free(T);
+        return NULL;
+    }
+    T->eb = T->ea + 3 * TL_EDGES;
+    T->ga = T->eb + 3 * TL_EDGES;
+    T->gb = T->ga + 3 * TL_EDGES;
+    T->pos = T->gb + 3 * TL_EDGES;
+    T->nrm = T->pos + 3 * TL_EDGES;
+    T->pa = T->nrm + 3 * TL_EDGES;
+    T->pb = T->pa + TL_EDGES;
+    T->y = T->x + TL_POINTS;
+    T->z = T->y + TL_POINTS;
+    T->v = T->z + TL_POINTS;
+    T->gx = T->v + TL_POINTS;
+    T->gy = T->gx + TL_POINTS;
+    T->gz = T->gy + TL_POINTS;
+    return T;
+}
+
+/* lattice node l (x + 3 y + 9 z, 0..2 each) of coarse cell c, as a local node */
+static inline size_t tl_lat(const lb__block *B, const int c[3], int l) {
+    const size_t i = (size_t)(2 * c[0] + l % 3), j = (size_t)(2 * c[1] + l / 3 % 3),
+                 k = (size_t)(2 * c[2] + l / 9);
+    return (k * (B->nc[1] + 1) + j) * (B->nc[0] + 1) + i;
+}
+
+static inline int tl_corner(int o) {
+    return 2 * (o & 1) + 6 * ((o >> 1) & 1) + 18 * ((o >> 2) & 1);
+}
+
+static inline int tl_is_fine(const tlscratch *T, int x, int y, int z) {
+    if (x < 0 || y < 0 || z < 0 || x >= TL_SIDE || y >= TL_SIDE || z >= TL_SIDE) return 0;
+    return T->cell[(z * TL_SIDE + y) * TL_SIDE + x].state == TL_FINE;
+}
+
+/* coarse cell c's splits: on the block's boundary planes, and where a fine
+ * cell is around an edge or across a face */
+static void tl_pattern(const tlscratch *T, const int c[3], lb__tcell *t) {
+    t->split = 0;
+    t->quarter = 0;
+    for (int e = 0; e < 12; ++e) {
+        int p, q;
+        lb__cube_edge(e, &p, &q);
+        const int a = p ^ q;
+        int on_plane = 0, any = 0;
+        for (int d = 0; d < 3; ++d) {
+            if ((1 << d) == a) continue;
+            const int at = c[d] + ((p >> d) & 1);
+            on_plane |= at == 0 || at == TL_SIDE;
+        }
+        for (int k = 0; k < 4 && !on_plane && !any; ++k) { /* the four cells around it */
+            int n[3], j = 0;
+            for (int d = 0; d < 3; ++d) {
+                n[d] = c[d];
+                if ((1 << d) != a) n[d] += ((p >> d) & 1) - ((k >> j++) & 1);
+            }
+            any = tl_is_fine(T, n[0], n[1], n[2]);
+        }
+        if (on_plane || any) t->split |= (uint16_t)(1u << e);
+    }
+    for (int f = 0; f < 6; ++f) { /* face f: axis f / 2, side f % 2 */
+        const int d = f / 2, side = f % 2, at = c[d] + side;
+        int n[3] = {c[0], c[1], c[2]};
+        n[d] += side ? 1 : -1;
+        if (at == 0 || at == TL_SIDE || tl_is_fine(T, n[0], n[1], n[2]))
+            t->quarter |= (uint8_t)(1u << f);
+    }
+}
+
+/* Whether coarse cell c has an edge on the block's boundary planes whose
+ * two halves both cross (its midpoint on the other side of its ends). Both
+ * unquartered faces holding such an edge would draw the segment between the
+ * two halves' vertices, on each side of the plane: four triangles on one
+ * edge. A cell with such an edge is fine; the block across the plane,
+ * seeing the same three shared nodes, makes its cells there fine too. */
+static int tl_plane_pinch(const lb__block *B, const int c[3]) {
+    for (int e = 0; e < 12; ++e) {
+        int p, q;
+        lb__cube_edge(e, &p, &q);
+        const int a = p ^ q;
+        int on_plane = 0;
+        for (int d = 0; d < 3; ++d) {
+            if ((1 << d) == a) continue;
+            const int at = c[d] + ((p >> d) & 1);
+            on_plane |= at == 0 || at == TL_SIDE;
+        }
+        if (!on_plane) continue;
+        const int lp = tl_corner(p), lq = tl_corner(q);
+        const int ip = B->vals[tl_lat(B, c, lp)] < 0.0, iq = B->vals[tl_lat(B, c, lq)] < 0.0,
+                  im = B->vals[tl_lat(B, c, (lp + lq) / 2)] < 0.0;
+        if (ip == iq && im != ip) return 1;
+    }
+    return 0;
+}
+
+/* the lattice nodes pattern t reads: corners, split edges' midpoints,
+ * quartered faces' centres (n of them into l) */
+static int tl_samples(const lb__tcell *t, int *l) {
+    int n = 0;
+    for (int o = 0; o < 8; ++o) l[n++] = tl_corner(o);
+    for (int e = 0; e < 12; ++e)
+        if ((t->split >> e) & 1) {
+            int p, q;
+            lb__cube_edge(e, &p, &q);
+            l[n++] = (tl_corner(p) + tl_corner(q)) / 2;
+        }
+    static const int STRIDE[3] = {1, 3, 9};
+    for (int f = 0; f < 6; ++f)
+        if ((t->quarter >> f) & 1) l[n++] = 13 + (f % 2 ? STRIDE[f / 2] : -STRIDE[f / 2]);
+    return n;
+}
+
+/* phi_c and its gradient at n points (T->x, y, z) under the block's plan */
+static lb_status tl_eval(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, bctx *C,
+                         size_t n, lb_error *err) {
+    if (!n) return LB_OK;
+    tlscratch *T = C->tl;
+    lb__boxeval *E = &C->S.E;
+    lb__boxeval_load(ev, &B->plan, E);
+    lb_status s = lb__boxeval_run(ev, E, n, T->x, T->y, T->z, T->v, T->gx, T->gy, T->gz, err);
+    if (s) return s;
+    const double boxmax = lb__block_boxmax(g, B);
+    for (size_t i = 0; i < n; ++i) {
+        const double X[3] = {T->x[i], T->y[i], T->z[i]}, gf[3] = {T->gx[i], T->gy[i], T->gz[i]};
+        double gp[3];
+        T->v[i] = lb__mesh_phi_in(g, boxmax, X, T->v[i], gf, gp);
+        T->gx[i] = gp[0];
+        T->gy[i] = gp[1];
+        T->gz[i] = gp[2];
+    }
+    return LB_OK;
+}
+
+/* the marked nodes among T->q[0..n-1] not yet evaluated, evaluated */
+static lb_status tl_nodes(const lb_evaluator *ev, const lb__grid *g, lb__block *B, bctx *C,
+                          size_t n, lb_error *err) {
+    tlscratch *T = C->tl;
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    size_t m = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const size_t q = T->q[i];
+        if (B->nmask[q] != 2) continue;
+        B->nmask[q] = 3; /* queued: once */
+        double X[3];
+        lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + q % D0,
+                     (uint64_t)B->b[1] * LB__MB + q / D0 % D1,
+                     (uint64_t)B->b[2] * LB__MB + q / ((size_t)D0 * D1), X);
+        T->x[m] = X[0];
+        T->y[m] = X[1];
+        T->z[m] = X[2];
+        T->q[m++] = q;
+    }
+    lb_status s = tl_eval(ev, g, B, C, m, err);
+    for (size_t i = 0; i < m && !s; ++i) {
+        const size_t q = T->q[i];
+        B->vals[q] = T->v[i];
+        B->grads[3 * q] = T->gx[i];
+        B->grads[3 * q + 1] = T->gy[i];
+        B->grads[3 * q + 2] = T->gz[i];
+        B->nmask[q] = 1;
+    }
+    return s;
+}
+
+/* a sub-edge's nodes: lattice a < b (a the lower end), its axis and length
+ * (1: a grid edge, 2: a whole coarse edge) */
+static inline void tl_sub(uint16_t s, int *a, int *b, int *d, int *len) {
+    *a = s / LB__TNODES;
+    *b = s % LB__TNODES;
+    const int diff = *b - *a;
+    *d = diff < 3 ? 0 : diff < 9 ? 1 : 2;
+    *len = diff == 1 || diff == 3 || diff == 9 ? 1 : 2;
+}
+
+/* The decisions (above). */
+static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block *B, bctx *C,
+                           lb_error *err) {
+    tlscratch *T = C->tl;
+    const double hmin = fmin(g->h[0], fmin(g->h[1], g->h[2])), tol = g->coarse;
+    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    const size_t stride[3] = {1, D0, (size_t)D0 * D1};
+    for (int ci = 0; ci < TL_CELLS; ++ci) {
+        tlcell *K = &T->cell[ci];
+        const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
+        K->state = TL_OFF;
+        K->t.split = 0xffff; /* no pattern yet */
+        int marked = 0;
+        for (int o = 0; o < 8; ++o)
+            marked |=
+                B->cmask[((size_t)(2 * c[2] + (o >> 2)) * B->nc[1] + 2 * c[1] + ((o >> 1) & 1)) *
+                             B->nc[0] +
+                         2 * c[0] + (o & 1)];
+        if (!marked) continue;
+        K->state = TL_TODO;
+        for (int l = 0; l < LB__TNODES; ++l) /* mark() marks its boxes whole: cannot happen */
+            if (!B->nmask[tl_lat(B, c, l)]) K->state = TL_FINE;
+    }
+    for (int round = 0; round <= TL_CELLS; ++round) {
+        /* the cells to decide, and the samples their patterns read */
+        size_t nq = 0;
+        int todo = 0;
+        for (int ci = 0; ci < TL_CELLS; ++ci) {
+            tlcell *K = &T->cell[ci];
+            if (K->state != TL_TODO && K->state != TL_OK) continue;
+            const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
+            lb__tcell t;
+            tl_pattern(T, c, &t);
+            if (K->state == TL_OK && t.split == K->t.split && t.quarter == K->t.quarter) continue;
+            K->state = TL_TODO;
+            K->t = t;
+            ++todo;
+            int l[26];
+            const int n = tl_samples(&t, l);
+            for (int i = 0; i < n; ++i) T->q[nq++] = tl_lat(B, c, l[i]);
+        }
+        if (!todo) return LB_OK;
+        lb_status s = tl_nodes(ev, g, B, C, nq, err);
+        if (s) return s;
+        /* their loops; a cell whose samples show no crossing needs all its
+         * nodes */
+        nq = 0;
+        for (int ci = 0; ci < TL_CELLS; ++ci) {
+            tlcell *K = &T->cell[ci];
+            if (K->state != TL_TODO) continue;
+            const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
+            if (tl_plane_pinch(B, c)) {
+                K->state = TL_FINE;
+                continue;
+            }
+            int l[26];
+            const int n = tl_samples(&K->t, l);
+            K->t.inside = 0;
+            for (int i = 0; i < n; ++i)
+                if (B->vals[tl_lat(B, c, l[i])] < 0.0) K->t.inside |= 1u << l[i];
+            int nloop = 0;
+            if (lb__tcell_loops(&K->t, K->sub, K->len, &nloop) < 0) {
+                K->state = TL_FINE; /* cannot happen (transition.c) */
+                continue;
+            }
+            K->nloop = (uint8_t)nloop;
+            if (!nloop)
+                for (int i = 0; i < LB__TNODES; ++i) T->q[nq++] = tl_lat(B, c, i);
+        }
+        s = tl_nodes(ev, g, B, C, nq, err);
+        if (s) return s;
+        /* quiet cells: fine where any node is on the other side; the loops'
+         * vertices into one batch */
+        size_t ne = 0;
+        for (int ci = 0; ci < TL_CELLS; ++ci) {
+            tlcell *K = &T->cell[ci];
+            if (K->state != TL_TODO) continue;
+            const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
+            if (!K->nloop) {
+                const int in0 = B->vals[tl_lat(B, c, 0)] < 0.0;
+                K->state = TL_OK;
+                K->ntri = 0;
+                for (int i = 1; i < LB__TNODES; ++i)
+                    if ((B->vals[tl_lat(B, c, i)] < 0.0) != in0) K->state = TL_FINE;
+                continue;
+            }
+            K->e0 = (uint16_t)ne;
+            int total = 0;
+            for (int lp = 0; lp < K->nloop; ++lp) total += K->len[lp];
+            for (int i = 0; i < total; ++i, ++ne) {
+                int a, b, d, len;
+                tl_sub(K->sub[i], &a, &b, &d, &len);
+                const size_t qa = tl_lat(B, c, a), qb = tl_lat(B, c, b);
+                const int ain = B->vals[qa] < 0.0;
+                const size_t qi = ain ? qa : qb, qo = ain ? qb : qa;
+                double P[3], Q[3];
+                lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + qi % D0,
+                             (uint64_t)B->b[1] * LB__MB + qi / D0 % D1,
+                             (uint64_t)B->b[2] * LB__MB + qi / stride[2], P);
+                lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + qo % D0,
+                             (uint64_t)B->b[1] * LB__MB + qo / D0 % D1,
+                             (uint64_t)B->b[2] * LB__MB + qo / stride[2], Q);
+                memcpy(T->ea + 3 * ne, P, sizeof P);
+                memcpy(T->eb + 3 * ne, Q, sizeof Q);
+                T->pa[ne] = B->vals[qi];
+                T->pb[ne] = B->vals[qo];
+                memcpy(T->ga + 3 * ne, B->grads + 3 * qi, 3 * sizeof(double));
+                memcpy(T->gb + 3 * ne, B->grads + 3 * qo, 3 * sizeof(double));
+            }
+        }
+        s = lb__refine_edges(ev, g, B, ne, T->ea, T->eb, T->pa, T->pb, T->ga, T->gb, T->pos, T->nrm,
+                             &C->S, err);
+        if (s) return s;
+        /* the triangulations, the bow of their edges, the check points */
+        size_t np = 0;
+        for (int ci = 0; ci < TL_CELLS; ++ci) {
+            tlcell *K = &T->cell[ci];
+            if (K->state != TL_TODO || !K->nloop) continue;
+            K->ntri = 0;
+            for (int lp = 0, off = 0; lp < K->nloop && K->state == TL_TODO; off += K->len[lp++]) {
+                const int n = K->len[lp];
+                const double *P = T->pos + 3 * (K->e0 + off), *N = T->nrm + 3 * (K->e0 + off);
+                uint8_t tri[3 * LB__TMAX];
+                const int nt = lb__tloop_triangles(K->sub + off, P, n, tri);
+                if (!nt) {
+                    K->state = TL_FINE;
+                    break;
+                }
+                for (int t = 0; t < nt && K->state == TL_TODO; ++t) {
+                    double mid[3] = {0, 0, 0};
+                    for (int v = 0; v < 3; ++v) {
+                        const int a = tri[3 * t + v], b = tri[3 * t + (v + 1) % 3];
+                        K->tri[3 * K->ntri + v] = (uint8_t)(off + a);
+                        const double *A = P + 3 * a, *Bp = P + 3 * b;
+                        const double L =
+                            sqrt((A[0] - Bp[0]) * (A[0] - Bp[0]) + (A[1] - Bp[1]) * (A[1] - Bp[1]) +
+                                 (A[2] - Bp[2]) * (A[2] - Bp[2]));
+                        double cs = N[3 * a] * N[3 * b] + N[3 * a + 1] * N[3 * b + 1] +
+                                    N[3 * a + 2] * N[3 * b + 2];
+                        cs = cs > 1.0 ? 1.0 : cs < -1.0 ? -1.0 : cs;
+                        if (L * acos(cs) / 8.0 > tol * hmin) K->state = TL_FINE;
+                        T->x[np] = 0.5 * (A[0] + Bp[0]);
+                        T->y[np] = 0.5 * (A[1] + Bp[1]);
+                        T->z[np] = 0.5 * (A[2] + Bp[2]);
+                        T->pcell[np++] = (uint8_t)ci;
+                        for (int d = 0; d < 3; ++d) mid[d] += A[d] / 3.0;
+                    }
+                    T->x[np] = mid[0];
+                    T->y[np] = mid[1];
+                    T->z[np] = mid[2];
+                    T->pcell[np++] = (uint8_t)ci;
+                    ++K->ntri;
+                }
+            }
+        }
+        s = tl_eval(ev, g, B, C, np, err);
+        if (s) return s;
+        for (size_t i = 0; i < np; ++i) {
+            tlcell *K = &T->cell[T->pcell[i]];
+            if (K->state != TL_TODO) continue;
+            const double gl = sqrt(T->gx[i] * T->gx[i] + T->gy[i] * T->gy[i] + T->gz[i] * T->gz[i]);
+            if (!(fabs(T->v[i]) <= tol * hmin * gl)) K->state = TL_FINE;
+        }
+        for (int ci = 0; ci < TL_CELLS; ++ci)
+            if (T->cell[ci].state == TL_TODO) T->cell[ci].state = TL_OK;
+    }
+    return LB_OK;
+}
+
+/* A whole coarse edge's vertex (from local node l along axis d, two cells
+ * long): the block's own, created on first use (as lb__cell_edge_new, with
+ * an id from the axis masks cube cells leave unused). */
+static int64_t tl_coarse_edge(bctx *C, uint32_t li, uint32_t lj, uint32_t lk, int d) {
+    const lb__block *B = C->B;
+    const uint32_t D0 = C->h.D0, D1 = C->h.D1;
+    const int mask = 1 << d;
+    const size_t np = ((size_t)lk * D1 + lj) * D0 + li;
+    const size_t nq = np + 2 * (d == 0 ? 1 : d == 1 ? (size_t)D0 : (size_t)D0 * D1);
+    lb__emap_entry *em = &C->h.emap[np * 8 + (size_t)(7 ^ mask)];
+    if (em->stamp == C->h.stamp) return em->e;
+    em->stamp = C->h.stamp;
+    const lb__grid *g = C->g;
+    const uint64_t gx = (uint64_t)B->b[0] * LB__MB + li, gy = (uint64_t)B->b[1] * LB__MB + lj,
+                   gz = (uint64_t)B->b[2] * LB__MB + lk;
+    double P[3], Q[3];
+    lb__node_pos(g, gx, gy, gz, P);
+    lb__node_pos(g, gx + 2 * (uint64_t)(d == 0), gy + 2 * (uint64_t)(d == 1),
+                 gz + 2 * (uint64_t)(d == 2), Q);
+    const size_t e = C->ne++;
+    const int pin = B->vals[np] < 0.0;
+    memcpy(C->ea + 3 * e, pin ? P : Q, sizeof P);
+    memcpy(C->eb + 3 * e, pin ? Q : P, sizeof P);
+    C->pa[e] = pin ? B->vals[np] : B->vals[nq];
+    C->pb[e] = pin ? B->vals[nq] : B->vals[np];
+    memcpy(C->ga + 3 * e, B->grads + 3 * (pin ? np : nq), 3 * sizeof(double));
+    memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
+    C->eloc[e] = li | lj << 4 | lk << 8 | (uint32_t)mask << 12 | COARSE_EDGE;
+    C->orph[e] = 0;
+    em->e = (uint32_t)e;
+    return (int64_t)e;
+}
+
+/* A two-level block's cells: the decisions, the fine cells' nodes and
+ * cells, the coarse cells' triangles. */
+static lb_status tl_cells(const lb_evaluator *ev, const lb__grid *g, lb__block *B, bctx *C,
+                          lb_error *err) {
+    if (!C->tl && !(C->tl = tl_new()))
+        return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+    tlscratch *T = C->tl;
+    lb_status s = tl_decide(ev, g, B, C, err);
+    if (s) return s;
+    size_t nq = 0;
+    for (int ci = 0; ci < TL_CELLS; ++ci) {
+        if (T->cell[ci].state != TL_FINE) continue;
+        const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
+        for (int l = 0; l < LB__TNODES; ++l) T->q[nq++] = tl_lat(B, c, l);
+    }
+    s = tl_nodes(ev, g, B, C, nq, err);
+    if (s) return s;
+    for (int ci = 0; ci < TL_CELLS; ++ci) {
+        const tlcell *K = &T->cell[ci];
+        const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
+        if (K->state == TL_FINE) {
+            for (int o = 0; o < 8; ++o) {
+                const uint32_t i = (uint32_t)(2 * c[0] + (o & 1)),
+                               j = (uint32_t)(2 * c[1] + ((o >> 1) & 1)),
+                               k = (uint32_t)(2 * c[2] + (o >> 2));
+                if (B->cmask[((size_t)k * B->nc[1] + j) * B->nc[0] + i] &&
+                    !cut_cell(C, g, B, i, j, k))
+                    return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+            }
+            continue;
+        }
+        if (K->state != TL_OK || !K->ntri) continue;
+        C->cell = (uint32_t)(2 * c[0]) | (uint32_t)(2 * c[1]) << 4 | (uint32_t)(2 * c[2]) << 8;
+        int total = 0;
+        for (int lp = 0; lp < K->nloop; ++lp) total += K->len[lp];
+        uint32_t v[LB__TMAX];
+        for (int i = 0; i < total; ++i) {
+            int a, b, d, len;
+            tl_sub(K->sub[i], &a, &b, &d, &len);
+            const uint32_t li = (uint32_t)(2 * c[0] + a % 3), lj = (uint32_t)(2 * c[1] + a / 3 % 3),
+                           lk = (uint32_t)(2 * c[2] + a / 9);
+            int64_t id;
+            if (len == 2) {
+                id = tl_coarse_edge(C, li, lj, lk, d);
+            } else {
+                double cv[8] = {0};
+                cv[0] = B->vals[tl_lat(B, c, a)];
+                cv[1 << d] = B->vals[tl_lat(B, c, b)];
+                id = lb__cell_edge(C, li, lj, lk, 0, 1 << d, cv);
+            }
+            if (id < 0) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+            v[i] = (uint32_t)id;
+        }
+        for (int t = 0; t < K->ntri; ++t) {
+            const uint32_t tv[3] = {v[K->tri[3 * t]], v[K->tri[3 * t + 1]], v[K->tri[3 * t + 2]]};
+            if (!lb__cell_polygon(C, tv, LB__ALL_PAIRS, 3))
+                return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+        }
+    }
+    return LB_OK;
+}
+
 lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B,
                          const lb__block *blocks, const uint32_t nbr[8], int gnext, lb__bctx *C,
                          lb_error *err) {
@@ -1046,33 +1583,27 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
     C->h.D0 = D0;
     C->h.D1 = D1;
     lb_status s = LB_OK;
-    for (uint32_t k = 0; k < B->nc[2]; ++k)
-        for (uint32_t j = 0; j < B->nc[1]; ++j) {
-            const uint8_t *row = B->cmask + ((size_t)k * B->nc[1] + j) * B->nc[0];
-            if (B->nc[0] == sizeof(uint64_t)) { /* most rows of most blocks: no marked cell */
-                uint64_t w;
-                memcpy(&w, row, sizeof w);
-                if (!w) continue;
-            }
-            for (uint32_t i = 0; i < B->nc[0]; ++i) {
-                if (!row[i]) continue;
-                double c[8];
-                int cfg = 0; /* bit o: corner o inside */
-                for (int o = 0; o < 8; ++o) {
-                    const size_t idx =
-                        ((size_t)(k + ((o >> 2) & 1)) * D1 + (j + ((o >> 1) & 1))) * D0 +
-                        (i + (o & 1));
-                    c[o] = B->vals[idx];
-                    cfg |= (c[o] < 0.0) << o;
+    if (lb__two_level_block(g, B)) {
+        s = tl_cells(ev, g, B, C, err);
+        if (s) goto done;
+    } else {
+        for (uint32_t k = 0; k < B->nc[2]; ++k)
+            for (uint32_t j = 0; j < B->nc[1]; ++j) {
+                const uint8_t *row = B->cmask + ((size_t)k * B->nc[1] + j) * B->nc[0];
+                if (B->nc[0] == sizeof(uint64_t)) { /* most rows of most blocks: none marked */
+                    uint64_t w;
+                    memcpy(&w, row, sizeof w);
+                    if (!w) continue;
                 }
-                if (cfg == 0 || cfg == 255) continue;
-                C->cell = i | j << 4 | k << 8;
-                if (!(g->tetrahedra ? lb__tetra_cell : lb__cube_cell)(C, i, j, k, c, cfg)) {
-                    s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
-                    goto done;
+                for (uint32_t i = 0; i < B->nc[0]; ++i) {
+                    if (!row[i]) continue;
+                    if (!cut_cell(C, g, B, i, j, k)) {
+                        s = lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");
+                        goto done;
+                    }
                 }
             }
-        }
+    }
     const size_t ne = C->ne, nref = C->nref;
     const int feats = g->features && !g->tetrahedra;
     B->nv = ne;

@@ -67,6 +67,9 @@ typedef struct lb__grid {
     int soft;
     int tetrahedra; /* LB_MESH_TETRAHEDRA: the Kuhn split instead of cube polygons */
     int features;   /* LB_MESH_FEATURES: a vertex on the crease or corner of a cell (features.c) */
+    /* LB_MESH_COARSE_FIRST: the tolerance in cells (0: off), for the
+     * blocks lb__two_level_block picks (extract.c) */
+    double coarse;
     lb__mctable mc;
 } lb__grid;
 
@@ -342,6 +345,16 @@ typedef struct lb__mscratch {
     double *edges;
     size_t *eact;
 } lb__mscratch;
+
+/* A block meshed coarse first (extract.c, two-level blocks): with a
+ * tolerance, cube cells, no sharp features, and a whole block (LB__MB
+ * cells a side, so that mark()'s smallest boxes are its coarse cells). Its
+ * other blocks are meshed as without it: every block's boundary faces are
+ * fine on both sides either way. */
+static inline int lb__two_level_block(const lb__grid *g, const lb__block *B) {
+    return g->coarse > 0.0 && !g->tetrahedra && !g->features && B->nc[0] == LB__MB &&
+           B->nc[1] == LB__MB && B->nc[2] == LB__MB;
+}
 
 /* Surface extraction over one block whose node values are final (extract.c):
  * finds the crossing edges cell by cell (cubes.c, or tetra.c with

@@ -93,6 +93,8 @@ static lb_status make_grid(const lb_evaluator *ev, const lb_mesh_options *o, lb_
     g->closed = !(o->flags & LB_MESH_OPEN_BOUNDARY);
     g->tetrahedra = (o->flags & LB_MESH_TETRAHEDRA) != 0;
     g->features = (o->flags & LB_MESH_FEATURES) != 0;
+    g->coarse =
+        (o->flags & LB_MESH_COARSE_FIRST) && !g->tetrahedra && !g->features ? o->simplify : 0.0;
     g->soft = lb_evaluator_convention(ev) == LB_CONVENTION_SOFT;
     for (int d = 0; d < 3; ++d) {
         const double nf = ceil(ext[d] / h - 1e-9);
@@ -785,8 +787,23 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
     } else {
         mark(R, B, &E->plan, E->iv, zero, B->nc, narrow ? S->pool : NULL, 0, NULL);
     }
+    if (lb__two_level_block(g, B)) {
+        /* coarse first (extract.c): now only the coarse cells' corners and
+         * the nodes on the block's boundary planes (what block_share and
+         * the cache read); the others marked are left for the extraction
+         * (2: marked, not yet evaluated) */
+        for (uint32_t k = 0; k < D2; ++k)
+            for (uint32_t j = 0; j < D1; ++j)
+                for (uint32_t i = 0; i < D0; ++i) {
+                    const size_t q = ((size_t)k * D1 + j) * D0 + i;
+                    const int even = !(i & 1) && !(j & 1) && !(k & 1);
+                    const int plane =
+                        !i || !j || !k || i == B->nc[0] || j == B->nc[1] || k == B->nc[2];
+                    if (B->nmask[q] && !even && !plane) B->nmask[q] = 2;
+                }
+    }
     size_t m = 0;
-    for (size_t q = 0; q < n; ++q) m += B->nmask[q];
+    for (size_t q = 0; q < n; ++q) m += B->nmask[q] == 1;
     if (m == 0) return LB_OK;
     /* m <= LB__SLAB_NODES: the thread's scratch holds the batch */
     double *x = S->nodes, *y = x + m, *z = y + m, *v = z + m, *gx = v + m, *gy = gx + m,
@@ -812,7 +829,7 @@ static lb_status block_nodes(run *R, lb__block *B, lb__mscratch *S, lb_error *er
             for (uint32_t j = r0[1]; j <= r1[1]; ++j)
                 for (uint32_t i = r0[0]; i <= r1[0]; ++i) {
                     const size_t q = ((size_t)k * D1 + j) * D0 + i;
-                    if (!B->nmask[q]) continue;
+                    if (B->nmask[q] != 1) continue;
                     double X[3];
                     lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + i, (uint64_t)B->b[1] * LB__MB + j,
                                  (uint64_t)B->b[2] * LB__MB + k, X);
@@ -1518,17 +1535,23 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: threads = %d; allowed: 0 (one per CPU) or a positive count", FN,
                         opt->threads);
-    if (opt->flags & ~(unsigned)(LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA | LB_MESH_FEATURES |
-                                 LB_MESH_CORNER_NORMALS | LB_MESH_MERGE_FLAT))
+    if (opt->flags &
+        ~(unsigned)(LB_MESH_OPEN_BOUNDARY | LB_MESH_TETRAHEDRA | LB_MESH_FEATURES |
+                    LB_MESH_CORNER_NORMALS | LB_MESH_MERGE_FLAT | LB_MESH_COARSE_FIRST))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: flags = %#x; allowed: 0 or LB_MESH_OPEN_BOUNDARY | "
                         "LB_MESH_TETRAHEDRA | LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS | "
-                        "LB_MESH_MERGE_FLAT",
+                        "LB_MESH_MERGE_FLAT | LB_MESH_COARSE_FIRST",
                         FN, opt->flags);
     if (!(opt->simplify >= 0.0 && opt->simplify <= LB_MESH_MAX_SIMPLIFY))
         return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
                         "%s: simplify = %g cells; allowed: 0 (off) to %g cells", FN, opt->simplify,
                         LB_MESH_MAX_SIMPLIFY);
+    if ((opt->flags & LB_MESH_COARSE_FIRST) && !(opt->simplify > 0.0))
+        return lb__fail(err, LB_ERR_INVALID_ARGUMENT,
+                        "%s: LB_MESH_COARSE_FIRST with simplify = 0; allowed: a tolerance "
+                        "above 0 (up to %g cells), which it meshes to",
+                        FN, LB_MESH_MAX_SIMPLIFY);
     lb__grid g;
     lb_status s = make_grid(ev, opt, &g, err);
     if (s) return s;
@@ -1635,7 +1658,7 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     if (!M || !R.ctx || R.nctx < nt) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
     /* with simplification, the blocks take the first half of the bar and
      * the simplification (often several times the meshing) the second */
-    P.weight = opt->simplify > 0.0 ? 0.45 : 0.90;
+    P.weight = opt->simplify > 0.0 && !(g.coarse > 0.0) ? 0.45 : 0.90;
     if (!s && !P.cancelled) s = blocks_run(&R, nt, &P);
     if (s && R.err_block != SIZE_MAX && err) *err = R.err;
     if (!s && !P.cancelled) {
@@ -1665,7 +1688,8 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
     if (!s && !P.cancelled && ((opt->flags & LB_MESH_MERGE_FLAT) || opt->simplify > 0.0) &&
         M->ntriangles) /* flat.c */
         s = lb__merge_flat(&g, M, feat, err);
-    if (!s && !P.cancelled && opt->simplify > 0.0 && M->ntriangles) /* simplify.c */
+    if (!s && !P.cancelled && opt->simplify > 0.0 && !(g.coarse > 0.0) &&
+        M->ntriangles) /* simplify.c; coarse first: the blocks did it */
         s = lb__simplify(ev, &g, M, feat, opt->simplify, max_memory, (int)nt, opt->cancel, P.fn,
                          P.user, P.base, 0.95 - P.base, err);
     if (!s && !M->positions) { /* an empty mesh: valid, with (empty) arrays */
