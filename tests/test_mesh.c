@@ -264,15 +264,16 @@ static int case_path(size_t s, int papers_only, char *path, size_t n) {
  * under ThreadSanitizer). */
 static void test_threads_identical(void **state) {
     (void)state;
-    for (int pass = 0; pass < 3; ++pass) {
+    for (int pass = 0; pass < 4; ++pass) {
         /* 0: the scenes; 1: the scenes and the sharp shapes with features;
-         * 2: those again, simplified */
-        const unsigned flags = pass ? LB_MESH_FEATURES : 0u;
-        const double simplify = pass == 2 ? 0.1 : 0.0;
+         * 2: those again, simplified; 3: the scenes and the sharp shapes
+         * meshed coarse first (LB_MESH_COARSE_FIRST) */
+        const unsigned flags = pass == 3 ? LB_MESH_COARSE_FIRST : pass ? LB_MESH_FEATURES : 0u;
+        const double simplify = pass == 2 ? 0.1 : pass == 3 ? 0.25 : 0.0;
         for (size_t s = 0; s < nscenes + (pass ? NSHARP : 0); ++s) {
             char path[1100];
             case_path(s, 0, path, sizeof path);
-            if (pass == 2 && s < nscenes && !strstr(path, "/bench-s") &&
+            if (pass >= 2 && s < nscenes && !strstr(path, "/bench-s") &&
                 !strstr(path, "-fig7-stool"))
                 continue;
             built A, B, C;
@@ -726,6 +727,133 @@ static void test_no_self_intersections_simplify(void **state) {
     fprintf(stderr, "  %zu nearby triangle pairs tested; %zu triangles simplified to %zu\n",
             checked, before, after);
     assert_true(checked > (nres == 2 ? 100000u : 20000u));
+}
+
+/* Coarse first (LB_MESH_COARSE_FIRST): every scene and the sharp shapes at
+ * 64 cells (and the papers' and bench scenes at 128 outside the
+ * sanitizers) closed, oriented, manifold, free of self-intersections, every
+ * vertex on the surface of phi_c to 1e-6 cells, fewer triangles than the
+ * uniform mesh where anything is meshed coarse; and on a sphere, whose
+ * distance is known, every point of every triangle within the tolerance. */
+static void test_coarse_first(void **state) {
+    (void)state;
+    const unsigned res[2] = {64, 128};
+    const int nres = LB_TEST_SANITIZERS ? 1 : 2;
+    size_t checked = 0, before = 0, after = 0, vertices = 0;
+    for (size_t s = 0; s < nscenes + NSHARP; ++s) {
+        char path[1100];
+        case_path(s, 0, path, sizeof path);
+        for (int r = 0; r < nres; ++r) {
+            if (r && s < nscenes && !strstr(path, "/scenes/hsu") && !strstr(path, "/bench-s"))
+                continue;
+            built A, B;
+            build_file_s(path, res[r], 0, 0, 0.0, &A);
+            build_file_s(path, res[r], LB_MESH_COARSE_FIRST, 0, 0.25, &B);
+            char what[1200];
+            snprintf(what, sizeof what, "%.1000s at %u coarse first", path, res[r]);
+            if (A.m->ntriangles) expect_closed_manifold(what, B.m);
+            if (!(B.m->ntriangles <= A.m->ntriangles))
+                fail_msg("%s: %zu triangles, %zu uniform", what, B.m->ntriangles, A.m->ntriangles);
+            size_t pairs = 0;
+            const size_t hits = self_intersections(B.m, &pairs);
+            if (hits) fail_msg("%s: %zu intersecting triangle pairs", what, hits);
+            /* the vertices on the surface of phi_c */
+            const size_t n = B.m->nvertices;
+            double *x = malloc(7 * (n ? n : 1) * sizeof *x);
+            assert_non_null(x);
+            double *y = x + n, *z = y + n, *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
+            for (size_t i = 0; i < n; ++i) {
+                x[i] = B.m->positions[3 * i];
+                y[i] = B.m->positions[3 * i + 1];
+                z[i] = B.m->positions[3 * i + 2];
+            }
+            lb_error e = {LB_OK, ""};
+            assert_int_equal(lb_evaluator_eval(B.ev, n, x, y, z, v, gx, gy, gz, 0, &e), LB_OK);
+            double lo[3], hi[3];
+            lb_scene_bounds(B.sc, lo, hi);
+            const int soft = lb_scene_convention(B.sc) == LB_CONVENTION_SOFT;
+            const double h = fmin(B.m->cell[0], fmin(B.m->cell[1], B.m->cell[2]));
+            for (size_t i = 0; i < n; ++i) {
+                double phi = soft ? 0.5 - v[i] : v[i];
+                double g[3] = {soft ? -gx[i] : gx[i], soft ? -gy[i] : gy[i], soft ? -gz[i] : gz[i]};
+                const double P[3] = {x[i], y[i], z[i]};
+                for (int d = 0; d < 3; ++d) {
+                    if (lo[d] - P[d] > phi) {
+                        phi = lo[d] - P[d];
+                        g[0] = g[1] = g[2] = 0.0;
+                        g[d] = -1.0;
+                    }
+                    if (P[d] - hi[d] > phi) {
+                        phi = P[d] - hi[d];
+                        g[0] = g[1] = g[2] = 0.0;
+                        g[d] = 1.0;
+                    }
+                }
+                const double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+                if (!(fabs(phi) <= 1e-6 * h * gl))
+                    fail_msg("%s: vertex %zu off the surface: |phi| = %g, |grad| = %g", what, i,
+                             fabs(phi), gl);
+            }
+            free(x);
+            checked += pairs;
+            vertices += n;
+            before += A.m->ntriangles;
+            after += B.m->ntriangles;
+            unbuild(&A);
+            unbuild(&B);
+        }
+    }
+    fprintf(stderr,
+            "  coarse first: %zu triangles for %zu uniform, %zu vertices on the surface, "
+            "%zu nearby triangle pairs tested\n",
+            after, before, vertices, checked);
+    assert_true(after < before * 3 / 4 && checked > 10000u);
+    /* a sphere of radius 1.3: the distance of points over every triangle
+     * (barycentric steps of a tenth) within the tolerance of its surface */
+    static const char text[] =
+        HEAD "\"convention\": \"zero\", \"root\": {\"type\": \"sphere\", \"radius\": 1.3}}";
+    for (int r = 0; r < nres; ++r) {
+        lb_mesh_options o;
+        lb_mesh_options_init(&o);
+        for (int d = 0; d < 3; ++d) {
+            o.bmin[d] = -1.5;
+            o.bmax[d] = 1.5;
+        }
+        o.resolution = res[r];
+        o.flags = LB_MESH_COARSE_FIRST;
+        o.simplify = 0.25;
+        built B, U;
+        build_text(text, &o, &B);
+        o.flags = 0;
+        o.simplify = 0.0;
+        build_text(text, &o, &U);
+        expect_closed_manifold("sphere coarse first", B.m);
+        const double h = B.m->cell[0];
+        double worst = 0.0;
+        for (size_t t = 0; t < B.m->ntriangles; ++t) {
+            const double *P[3];
+            for (int k = 0; k < 3; ++k) P[k] = B.m->positions + 3 * B.m->triangles[3 * t + k];
+            for (int i = 0; i <= 10; ++i)
+                for (int j = 0; i + j <= 10; ++j) {
+                    double X[3];
+                    for (int d = 0; d < 3; ++d)
+                        X[d] =
+                            P[0][d] + 0.1 * i * (P[1][d] - P[0][d]) + 0.1 * j * (P[2][d] - P[0][d]);
+                    const double dist = fabs(sqrt(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]) - 1.3);
+                    if (dist > worst) worst = dist;
+                }
+        }
+        fprintf(stderr,
+                "  sphere at %u cells coarse first: %zu triangles (%zu uniform), largest "
+                "distance %.4f cells\n",
+                res[r], B.m->ntriangles, U.m->ntriangles, worst / h);
+        if (!(worst <= 0.25 * h)) fail_msg("sphere at %u: %g cells off", res[r], worst / h);
+        if (!(B.m->ntriangles < U.m->ntriangles / 2))
+            fail_msg("sphere at %u: %zu triangles, %zu uniform", res[r], B.m->ntriangles,
+                     U.m->ntriangles);
+        unbuild(&B);
+        unbuild(&U);
+    }
 }
 
 /* Flat regions merged (LB_MESH_MERGE_FLAT, with features): the papers'
@@ -1627,7 +1755,8 @@ static void test_bad_options(void **state) {
         {2, -1, LB_ERR_INVALID_ARGUMENT, "cell_size = -1; allowed: a positive number"},
         {2, 1e-6, LB_ERR_INVALID_ARGUMENT, "allowed: at most 8192 cells per axis"},
         {3, -2, LB_ERR_INVALID_ARGUMENT, "threads = -2"},
-        {4, 32, LB_ERR_INVALID_ARGUMENT, "flags = 0x20"},
+        {4, 64, LB_ERR_INVALID_ARGUMENT, "flags = 0x40"},
+        {4, 32, LB_ERR_INVALID_ARGUMENT, "LB_MESH_COARSE_FIRST with simplify = 0"},
         {5, 1e9, LB_ERR_INVALID_ARGUMENT, "|value| <= 1e+09"},
         {6, 1 << 20, LB_ERR_INVALID_ARGUMENT, "over the memory cap of 1 MiB"},
         {7, NAN, LB_ERR_INVALID_ARGUMENT, "allowed: finite"},
@@ -1762,13 +1891,17 @@ static void test_mesh_cache(void **state) {
     static const double br[] = {0.15, 0.15, 0.15, 0.15, 0.15, 0.15, 0.15, 0.15, 0.15, 0.3, 0.15};
     enum { NSTEP = sizeof moved / sizeof moved[0] };
     size_t reused_total = 0, blocks_total = 0;
-    for (int variant = 0; variant < 2; ++variant)
+    for (int variant = 0; variant < 3; ++variant)
         for (int threads = 1; threads <= 3; ++threads) {
             lb_error e = {LB_OK, ""};
             lb_mesh_cache *cache = NULL;
             assert_int_equal(lb_mesh_cache_create(&cache, &e), LB_OK);
             lb_mesh_options o = lattice_options(64, threads);
-            o.flags = variant ? LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS : 0u;
+            /* 0: plain; 1: features and corner normals; 2: coarse first */
+            o.flags = variant == 1   ? LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS
+                      : variant == 2 ? LB_MESH_COARSE_FIRST
+                                     : 0u;
+            o.simplify = variant == 2 ? 0.25 : 0.0;
             for (int step = 0; step < NSTEP; ++step) {
                 char *text = lattice_text(moved[step], dx[step], dr[step], br[step]);
                 lb_scene *sc = NULL;
@@ -1976,6 +2109,7 @@ int main(int argc, char **argv) {
         cmocka_unit_test(test_no_self_intersections),
         cmocka_unit_test(test_no_self_intersections_features),
         cmocka_unit_test(test_no_self_intersections_simplify),
+        cmocka_unit_test(test_coarse_first),
         cmocka_unit_test(test_merge_flat),
         cmocka_unit_test(test_progress_and_cancel),
         cmocka_unit_test(test_simplify_limits),

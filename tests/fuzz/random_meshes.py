@@ -10,7 +10,8 @@ process per scene) and meshed at 12 cells on two threads and 20 on one, and
 at 20 on two with sharp features (LB_MESH_FEATURES, with corner normals),
 and, for one seed in four, at 20 on two with features simplified
 (simplify = 0.25 cells: the pass samples the field far more than the
-meshing, and every seed would add 90 s);
+meshing, and every seed would add 90 s), and at 32 on two meshed coarse
+first (LB_MESH_COARSE_FIRST, 0.25 cells);
 every non-empty mesh must be closed, oriented and 2-manifold (tests/mesh's
 numpy checks), its corner normals within their contract, and the
 scenes found wrong before (by an issue, or by this test's fresh seeds:
@@ -58,11 +59,15 @@ def closed(text, name, runs):
         with ev:
             lo, hi = sc.bounds
             n = 0
-            for res, th, feat, simp in runs:
-                how = "%d cells, %d threads%s%s" % (res, th, " with sharp features" if feat else "",
-                                                    ", simplify %g" % simp if simp else "")
+            for run in runs:
+                res, th, feat, simp = run[:4]
+                coarse = len(run) > 4 and run[4]
+                how = "%d cells, %d threads%s%s%s" % (
+                    res, th, " with sharp features" if feat else "",
+                    ", simplify %g" % simp if simp else "", ", coarse first" if coarse else "")
                 try:
-                    m = ev.mesh(lo, hi, resolution=res, threads=th, features=feat, simplify=simp)
+                    m = ev.mesh(lo, hi, resolution=res, threads=th, features=feat, simplify=simp,
+                                coarse_first=coarse)
                 except binding.LibblendError as e:  # a valid scene must mesh
                     fail("%s: mesh at %s: %s" % (name, how, e))
                     return n
@@ -98,7 +103,7 @@ def corners_ok(m):
 for p in sorted(glob.glob(os.path.join(SRC, "tests", "data", "regressions", "*.json"))):
     n = closed(open(p).read(), os.path.basename(p),
                ((20, 1, False, 0), (64, 2, False, 0), (97, 1, False, 0), (64, 2, True, 0),
-                (97, 1, True, 0), (64, 2, True, 0.25)))
+                (97, 1, True, 0), (64, 2, True, 0.25), (64, 2, False, 0.25, True)))
     if not n:
         fail("%s: nothing meshed" % p)
 
@@ -108,7 +113,7 @@ stats = {"scenes": 0, "meshes": 0, "refused": 0, "empty": 0}
 
 def run(seed):
     sc, _ = random_scenes.scene(seed)
-    runs = ((12, 2, False, 0), (20, 1, False, 0), (20, 2, True, 0))
+    runs = ((12, 2, False, 0), (20, 1, False, 0), (20, 2, True, 0), (32, 2, False, 0.25, True))
     if seed % 4 == 0:
         runs += ((20, 2, True, 0.25),)
     n = closed(json.dumps(sc), "seed %d" % seed, runs)
