@@ -170,6 +170,54 @@ static int setup(void **state) {
 
 #define HEAD "{\"format\": \"libblend-scene\", \"version\": 1, "
 
+/* Every vertex of B's mesh on the surface of max(phi, region box) to 1e-6
+ * cells, with the normal of the gradient there (what: for the messages). */
+static void vertices_on_surface(const built *B, const char *what, tally_t *acc, tally_t *nrm) {
+    const size_t n = B->m->nvertices;
+    double *x = malloc(7 * (n ? n : 1) * sizeof *x);
+    assert_non_null(x);
+    double *y = x + n, *z = y + n, *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
+    for (size_t i = 0; i < n; ++i) {
+        x[i] = B->m->positions[3 * i];
+        y[i] = B->m->positions[3 * i + 1];
+        z[i] = B->m->positions[3 * i + 2];
+    }
+    lb_error e = {LB_OK, ""};
+    assert_int_equal(lb_evaluator_eval(B->ev, n, x, y, z, v, gx, gy, gz, 0, &e), LB_OK);
+    double lo[3], hi[3];
+    lb_scene_bounds(B->sc, lo, hi);
+    const int soft = lb_scene_convention(B->sc) == LB_CONVENTION_SOFT;
+    const double h = fmin(B->m->cell[0], fmin(B->m->cell[1], B->m->cell[2]));
+    for (size_t i = 0; i < n; ++i) {
+        /* phi_c written out here: the field, or the region box where it is larger */
+        double phi = soft ? 0.5 - v[i] : v[i];
+        double g[3] = {soft ? -gx[i] : gx[i], soft ? -gy[i] : gy[i], soft ? -gz[i] : gz[i]};
+        const double P[3] = {x[i], y[i], z[i]};
+        for (int d = 0; d < 3; ++d) {
+            if (lo[d] - P[d] > phi) {
+                phi = lo[d] - P[d];
+                g[0] = g[1] = g[2] = 0.0;
+                g[d] = -1.0;
+            }
+            if (P[d] - hi[d] > phi) {
+                phi = P[d] - hi[d];
+                g[0] = g[1] = g[2] = 0.0;
+                g[d] = 1.0;
+            }
+        }
+        const double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        tally_check(acc, fabs(phi) <= 1e-6 * h * gl,
+                    "%s: vertex %zu: |phi| = %g, |grad| = %g, h = %g", what, i, fabs(phi), gl, h);
+        const double *N = B->m->normals + 3 * i;
+        const double dot = gl > 0.0 ? (N[0] * g[0] + N[1] * g[1] + N[2] * g[2]) / gl : 1.0;
+        const double nl = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+        tally_check(nrm, fabs(nl - 1.0) < 1e-9 && dot > 1.0 - 1e-9,
+                    "%s: vertex %zu: normal length %g, cosine to the gradient %g", what, i, nl,
+                    dot);
+    }
+    free(x);
+}
+
 /* ---- tests ---- */
 
 /* Every scene, two resolutions: closed, oriented, manifold, positive volume;
@@ -188,50 +236,7 @@ static void test_scenes_closed_and_accurate(void **state) {
             snprintf(what, sizeof what, "%.1000s at %u", scene_paths[s], res[r]);
             assert_true(B.m->ntriangles > 100);
             expect_closed_manifold(what, B.m);
-            const size_t n = B.m->nvertices;
-            double *x = malloc(7 * n * sizeof *x);
-            assert_non_null(x);
-            double *y = x + n, *z = y + n, *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
-            for (size_t i = 0; i < n; ++i) {
-                x[i] = B.m->positions[3 * i];
-                y[i] = B.m->positions[3 * i + 1];
-                z[i] = B.m->positions[3 * i + 2];
-            }
-            lb_error e = {LB_OK, ""};
-            assert_int_equal(lb_evaluator_eval(B.ev, n, x, y, z, v, gx, gy, gz, 0, &e), LB_OK);
-            double lo[3], hi[3];
-            lb_scene_bounds(B.sc, lo, hi);
-            const int soft = lb_scene_convention(B.sc) == LB_CONVENTION_SOFT;
-            const double h = fmin(B.m->cell[0], fmin(B.m->cell[1], B.m->cell[2]));
-            for (size_t i = 0; i < n; ++i) {
-                /* phi_c written out here: the field, or the region box where it is larger */
-                double phi = soft ? 0.5 - v[i] : v[i];
-                double g[3] = {soft ? -gx[i] : gx[i], soft ? -gy[i] : gy[i], soft ? -gz[i] : gz[i]};
-                const double P[3] = {x[i], y[i], z[i]};
-                for (int d = 0; d < 3; ++d) {
-                    if (lo[d] - P[d] > phi) {
-                        phi = lo[d] - P[d];
-                        g[0] = g[1] = g[2] = 0.0;
-                        g[d] = -1.0;
-                    }
-                    if (P[d] - hi[d] > phi) {
-                        phi = P[d] - hi[d];
-                        g[0] = g[1] = g[2] = 0.0;
-                        g[d] = 1.0;
-                    }
-                }
-                const double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-                tally_check(&acc, fabs(phi) <= 1e-6 * h * gl,
-                            "%s: vertex %zu: |phi| = %g, |grad| = %g, h = %g", what, i, fabs(phi),
-                            gl, h);
-                const double *N = B.m->normals + 3 * i;
-                const double dot = gl > 0.0 ? (N[0] * g[0] + N[1] * g[1] + N[2] * g[2]) / gl : 1.0;
-                const double nl = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
-                tally_check(&nrm, fabs(nl - 1.0) < 1e-9 && dot > 1.0 - 1e-9,
-                            "%s: vertex %zu: normal length %g, cosine to the gradient %g", what, i,
-                            nl, dot);
-            }
-            free(x);
+            vertices_on_surface(&B, what, &acc, &nrm);
             unbuild(&B);
         }
     tally_end(&acc, 100000);
@@ -737,6 +742,8 @@ static void test_no_self_intersections_simplify(void **state) {
  * distance is known, every point of every triangle within the tolerance. */
 static void test_coarse_first(void **state) {
     (void)state;
+    tally_t acc = {"coarse first: vertices on the surface", 0, 0, 0};
+    tally_t nrm = {"coarse first: normals from the gradient", 0, 0, 0};
     const unsigned res[2] = {64, 128};
     const int nres = LB_TEST_SANITIZERS ? 1 : 2;
     size_t checked = 0, before = 0, after = 0, vertices = 0;
@@ -757,46 +764,9 @@ static void test_coarse_first(void **state) {
             size_t pairs = 0;
             const size_t hits = self_intersections(B.m, &pairs);
             if (hits) fail_msg("%s: %zu intersecting triangle pairs", what, hits);
-            /* the vertices on the surface of phi_c */
-            const size_t n = B.m->nvertices;
-            double *x = malloc(7 * (n ? n : 1) * sizeof *x);
-            assert_non_null(x);
-            double *y = x + n, *z = y + n, *v = z + n, *gx = v + n, *gy = gx + n, *gz = gy + n;
-            for (size_t i = 0; i < n; ++i) {
-                x[i] = B.m->positions[3 * i];
-                y[i] = B.m->positions[3 * i + 1];
-                z[i] = B.m->positions[3 * i + 2];
-            }
-            lb_error e = {LB_OK, ""};
-            assert_int_equal(lb_evaluator_eval(B.ev, n, x, y, z, v, gx, gy, gz, 0, &e), LB_OK);
-            double lo[3], hi[3];
-            lb_scene_bounds(B.sc, lo, hi);
-            const int soft = lb_scene_convention(B.sc) == LB_CONVENTION_SOFT;
-            const double h = fmin(B.m->cell[0], fmin(B.m->cell[1], B.m->cell[2]));
-            for (size_t i = 0; i < n; ++i) {
-                double phi = soft ? 0.5 - v[i] : v[i];
-                double g[3] = {soft ? -gx[i] : gx[i], soft ? -gy[i] : gy[i], soft ? -gz[i] : gz[i]};
-                const double P[3] = {x[i], y[i], z[i]};
-                for (int d = 0; d < 3; ++d) {
-                    if (lo[d] - P[d] > phi) {
-                        phi = lo[d] - P[d];
-                        g[0] = g[1] = g[2] = 0.0;
-                        g[d] = -1.0;
-                    }
-                    if (P[d] - hi[d] > phi) {
-                        phi = P[d] - hi[d];
-                        g[0] = g[1] = g[2] = 0.0;
-                        g[d] = 1.0;
-                    }
-                }
-                const double gl = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-                if (!(fabs(phi) <= 1e-6 * h * gl))
-                    fail_msg("%s: vertex %zu off the surface: |phi| = %g, |grad| = %g", what, i,
-                             fabs(phi), gl);
-            }
-            free(x);
+            vertices_on_surface(&B, what, &acc, &nrm);
             checked += pairs;
-            vertices += n;
+            vertices += B.m->nvertices;
             before += A.m->ntriangles;
             after += B.m->ntriangles;
             unbuild(&A);
@@ -808,6 +778,8 @@ static void test_coarse_first(void **state) {
             "%zu nearby triangle pairs tested\n",
             after, before, vertices, checked);
     assert_true(after < before * 3 / 4 && checked > 10000u);
+    tally_end(&acc, 100000);
+    tally_end(&nrm, 100000);
     /* a sphere of radius 1.3: the distance of points over every triangle
      * (barycentric steps of a tenth) within the tolerance of its surface */
     static const char text[] =
