@@ -104,10 +104,39 @@ static inline size_t face_entry(int d, const uint32_t l[3], int mask) {
     return ((size_t)d * LB__FACE_NODES + l[d1] * (LB__MB + 1) + l[d2]) * 3 + (size_t)m;
 }
 
+/* A new own edge of block C->B from local node (li, lj, lk) along mask,
+ * step nodes long (1: a grid edge; 2: a whole coarse edge of a two-level
+ * block), vp and vq its end values: its ends, values and gradients into the
+ * refinement batch, not an orphan. Returns its index. */
+static size_t own_edge(bctx *C, uint32_t li, uint32_t lj, uint32_t lk, int mask, uint32_t step,
+                       double vp, double vq) {
+    const lb__block *B = C->B;
+    const uint32_t D0 = C->h.D0, D1 = C->h.D1;
+    const uint64_t gx = (uint64_t)B->b[0] * LB__MB + li, gy = (uint64_t)B->b[1] * LB__MB + lj,
+                   gz = (uint64_t)B->b[2] * LB__MB + lk;
+    const uint32_t sx = step * (uint32_t)(mask & 1), sy = step * (uint32_t)((mask >> 1) & 1),
+                   sz = step * (uint32_t)((mask >> 2) & 1);
+    double P[3], Q[3];
+    lb__node_pos(C->g, gx, gy, gz, P);
+    lb__node_pos(C->g, gx + sx, gy + sy, gz + sz, Q);
+    const size_t e = C->ne++;
+    const int pin = vp < 0.0;
+    memcpy(C->ea + 3 * e, pin ? P : Q, sizeof P);
+    memcpy(C->eb + 3 * e, pin ? Q : P, sizeof P);
+    C->pa[e] = pin ? vp : vq;
+    C->pb[e] = pin ? vq : vp;
+    const size_t np = ((size_t)lk * D1 + lj) * D0 + li;
+    const size_t nq = ((size_t)(lk + sz) * D1 + (lj + sy)) * D0 + (li + sx);
+    memcpy(C->ga + 3 * e, B->grads + 3 * (pin ? np : nq), 3 * sizeof(double));
+    memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
+    C->eloc[e] = li | lj << 4 | lk << 8 | (uint32_t)mask << 12;
+    C->orph[e] = 0;
+    return e;
+}
+
 int64_t lb__cell_edge_new(lb__bctx *C, size_t lid, uint32_t i, uint32_t j, uint32_t k, int op,
                           int oq, const double *c) {
     const lb__block *B = C->B;
-    const uint32_t D0 = C->h.D0, D1 = C->h.D1;
     const uint32_t li = i + (op & 1), lj = j + ((op >> 1) & 1), lk = k + ((op >> 2) & 1);
     const int mask = op ^ oq;
     lb__emap_entry *em = &C->h.emap[lid];
@@ -149,21 +178,7 @@ int64_t lb__cell_edge_new(lb__bctx *C, size_t lid, uint32_t i, uint32_t j, uint3
             (lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask) % 3 == 0)
             orphan = 1;
 #endif
-    double P[3], Q[3];
-    lb__node_pos(g, gx, gy, gz, P);
-    lb__node_pos(g, gx + (mask & 1), gy + ((mask >> 1) & 1), gz + ((mask >> 2) & 1), Q);
-    const size_t e = C->ne++;
-    const int pin = corner_in(c, op);
-    memcpy(C->ea + 3 * e, pin ? P : Q, sizeof P);
-    memcpy(C->eb + 3 * e, pin ? Q : P, sizeof P);
-    C->pa[e] = pin ? c[op] : c[oq];
-    C->pb[e] = pin ? c[oq] : c[op];
-    const size_t np = ((size_t)lk * D1 + lj) * D0 + li;
-    const size_t nq =
-        ((size_t)(lk + ((mask >> 2) & 1)) * D1 + (lj + ((mask >> 1) & 1))) * D0 + (li + (mask & 1));
-    memcpy(C->ga + 3 * e, B->grads + 3 * (pin ? np : nq), 3 * sizeof(double));
-    memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
-    C->eloc[e] = li | lj << 4 | lk << 8 | (uint32_t)mask << 12;
+    const size_t e = own_edge(C, li, lj, lk, mask, 1, c[op], c[oq]);
     C->orph[e] = (uint8_t)orphan;
     if (orphan) {
         C->key[e] = lb__node_index(g, gx, gy, gz) * 8u + (uint64_t)mask;
@@ -1086,9 +1101,8 @@ static inline int cut_cell(bctx *C, const lb__grid *g, const lb__block *B, uint3
 #define TL_SIDE (LB__MB / 2)
 #define TL_CELLS (TL_SIDE * TL_SIDE * TL_SIDE)
 #define TL_EDGES ((size_t)TL_CELLS * LB__TMAX)
-#define TL_POINTS                                                                                  \
-    ((size_t)TL_CELLS * LB__TMAX * 4) /* < LB__TMAX triangles a cell, 4 points each                \
-                                       */
+/* check points: under LB__TMAX triangles a cell, 4 points each */
+#define TL_POINTS ((size_t)TL_CELLS * LB__TMAX * 4)
 #define TL_NODES ((size_t)TL_CELLS * LB__TNODES)
 
 enum { TL_OFF, TL_TODO, TL_OK, TL_FINE };
@@ -1152,6 +1166,13 @@ static inline size_t tl_lat(const lb__block *B, const int c[3], int l) {
     const size_t i = (size_t)(2 * c[0] + l % 3), j = (size_t)(2 * c[1] + l / 3 % 3),
                  k = (size_t)(2 * c[2] + l / 9);
     return (k * (B->nc[1] + 1) + j) * (B->nc[0] + 1) + i;
+}
+
+/* the position of block B's local node q */
+static void tl_node_pos(const lb__grid *g, const lb__block *B, size_t q, double X[3]) {
+    const size_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
+    lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + q % D0, (uint64_t)B->b[1] * LB__MB + q / D0 % D1,
+                 (uint64_t)B->b[2] * LB__MB + q / (D0 * D1), X);
 }
 
 static inline int tl_corner(int o) {
@@ -1265,16 +1286,13 @@ static lb_status tl_eval(const lb_evaluator *ev, const lb__grid *g, const lb__bl
 static lb_status tl_nodes(const lb_evaluator *ev, const lb__grid *g, lb__block *B, bctx *C,
                           size_t n, lb_error *err) {
     tlscratch *T = C->tl;
-    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
     size_t m = 0;
     for (size_t i = 0; i < n; ++i) {
         const size_t q = T->q[i];
         if (B->nmask[q] != 2) continue;
         B->nmask[q] = 3; /* queued: once */
         double X[3];
-        lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + q % D0,
-                     (uint64_t)B->b[1] * LB__MB + q / D0 % D1,
-                     (uint64_t)B->b[2] * LB__MB + q / ((size_t)D0 * D1), X);
+        tl_node_pos(g, B, q, X);
         T->x[m] = X[0];
         T->y[m] = X[1];
         T->z[m] = X[2];
@@ -1307,8 +1325,6 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                            lb_error *err) {
     tlscratch *T = C->tl;
     const double hmin = fmin(g->h[0], fmin(g->h[1], g->h[2])), tol = g->coarse;
-    const uint32_t D0 = B->nc[0] + 1, D1 = B->nc[1] + 1;
-    const size_t stride[3] = {1, D0, (size_t)D0 * D1};
     for (int ci = 0; ci < TL_CELLS; ++ci) {
         tlcell *K = &T->cell[ci];
         const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
@@ -1397,15 +1413,8 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                 const size_t qa = tl_lat(B, c, a), qb = tl_lat(B, c, b);
                 const int ain = B->vals[qa] < 0.0;
                 const size_t qi = ain ? qa : qb, qo = ain ? qb : qa;
-                double P[3], Q[3];
-                lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + qi % D0,
-                             (uint64_t)B->b[1] * LB__MB + qi / D0 % D1,
-                             (uint64_t)B->b[2] * LB__MB + qi / stride[2], P);
-                lb__node_pos(g, (uint64_t)B->b[0] * LB__MB + qo % D0,
-                             (uint64_t)B->b[1] * LB__MB + qo / D0 % D1,
-                             (uint64_t)B->b[2] * LB__MB + qo / stride[2], Q);
-                memcpy(T->ea + 3 * ne, P, sizeof P);
-                memcpy(T->eb + 3 * ne, Q, sizeof Q);
+                tl_node_pos(g, B, qi, T->ea + 3 * ne);
+                tl_node_pos(g, B, qo, T->eb + 3 * ne);
                 T->pa[ne] = B->vals[qi];
                 T->pb[ne] = B->vals[qo];
                 memcpy(T->ga + 3 * ne, B->grads + 3 * qi, 3 * sizeof(double));
@@ -1483,23 +1492,8 @@ static int64_t tl_coarse_edge(bctx *C, uint32_t li, uint32_t lj, uint32_t lk, in
     lb__emap_entry *em = &C->h.emap[np * 8 + (size_t)(7 ^ mask)];
     if (em->stamp == C->h.stamp) return em->e;
     em->stamp = C->h.stamp;
-    const lb__grid *g = C->g;
-    const uint64_t gx = (uint64_t)B->b[0] * LB__MB + li, gy = (uint64_t)B->b[1] * LB__MB + lj,
-                   gz = (uint64_t)B->b[2] * LB__MB + lk;
-    double P[3], Q[3];
-    lb__node_pos(g, gx, gy, gz, P);
-    lb__node_pos(g, gx + 2 * (uint64_t)(d == 0), gy + 2 * (uint64_t)(d == 1),
-                 gz + 2 * (uint64_t)(d == 2), Q);
-    const size_t e = C->ne++;
-    const int pin = B->vals[np] < 0.0;
-    memcpy(C->ea + 3 * e, pin ? P : Q, sizeof P);
-    memcpy(C->eb + 3 * e, pin ? Q : P, sizeof P);
-    C->pa[e] = pin ? B->vals[np] : B->vals[nq];
-    C->pb[e] = pin ? B->vals[nq] : B->vals[np];
-    memcpy(C->ga + 3 * e, B->grads + 3 * (pin ? np : nq), 3 * sizeof(double));
-    memcpy(C->gb + 3 * e, B->grads + 3 * (pin ? nq : np), 3 * sizeof(double));
-    C->eloc[e] = li | lj << 4 | lk << 8 | (uint32_t)mask << 12 | COARSE_EDGE;
-    C->orph[e] = 0;
+    const size_t e = own_edge(C, li, lj, lk, mask, 2, B->vals[np], B->vals[nq]);
+    C->eloc[e] |= COARSE_EDGE;
     em->e = (uint32_t)e;
     return (int64_t)e;
 }
