@@ -54,8 +54,8 @@ static int check_box(lb_evaluator *ev, const double lo[3], const double hi[3], r
 
 static void test_repro(void **state) {
     (void)state;
-    lb_scene *sc;
-    lb_evaluator *ev;
+    lb_scene *sc = NULL;
+    lb_evaluator *ev = NULL;
     lb_error e = {LB_OK, ""};
     if (lb_scene_load(SOURCE_DIR "/tests/data/bounds/bounds-rfunction-bulge.json", &sc, &e) ||
         lb_evaluator_create(sc, &ev, &e))

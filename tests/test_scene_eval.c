@@ -285,7 +285,7 @@ static void test_regressions_match_reference(void **state) {
         for (int i = 0; i < 20000; ++i) {
             const double X[3] = {rng_range(&g, L.lo[0], L.hi[0]), rng_range(&g, L.lo[1], L.hi[1]),
                                  rng_range(&g, L.lo[2], L.hi[2])};
-            double v, vr, gr[3], blo, bhi;
+            double v = 0, vr = 0, gr[3], blo = 0, bhi = 0; /* fail_msg is not noreturn */
             lb_error e = {LB_OK, ""};
             if (lb_evaluator_eval(L.ev, 1, &X[0], &X[1], &X[2], &v, NULL, NULL, NULL, 1, &e) ||
                 lb_scene_eval_reference(L.sc, X, &vr, gr, &e) ||

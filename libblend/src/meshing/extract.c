@@ -92,10 +92,6 @@ typedef lb__bctx bctx;
 #define COARSE_EDGE (1u << 15)
 static void tl_free(struct tlscratch *T);
 
-static inline int corner_in(const double *c, int o) {
-    return c[o] < 0.0;
-}
-
 /* The near-face table entry of local node l's edge along mask, on the near
  * face of axis d (l[d] = 0, mask without bit d). */
 static inline size_t face_entry(int d, const uint32_t l[3], int mask) {
