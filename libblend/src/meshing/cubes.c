@@ -37,28 +37,15 @@
 
 #include <string.h>
 
-/* cube edge e: from corner EP[e] along axis bit EA[e] (to EP[e] | EA[e]) */
-static const uint8_t EP[12] = {0, 2, 4, 6, 0, 1, 4, 5, 0, 1, 2, 3};
-static const uint8_t EA[12] = {1, 1, 1, 1, 2, 2, 2, 2, 4, 4, 4, 4};
 /* the faces, corners counter-clockwise as seen from outside the cell */
 static const uint8_t FACE[6][4] = {{4, 6, 2, 0}, {1, 3, 7, 5}, {0, 1, 5, 4},
                                    {6, 7, 3, 2}, {2, 3, 1, 0}, {4, 5, 7, 6}};
 
-void lb__cube_edge(int e, int *p, int *q) {
-    *p = EP[e];
-    *q = EP[e] | EA[e];
-}
-
-static int edge_between(int p, int q) {
-    const int lo = p < q ? p : q, a = p ^ q;
-    for (int e = 0; e < 12; ++e)
-        if (EP[e] == lo && EA[e] == a) return e;
-    return -1;
-}
-
 static int on_face(int e, int f) {
     int hits = 0;
-    for (int q = 0; q < 4; ++q) hits += FACE[f][q] == EP[e] || FACE[f][q] == (EP[e] | EA[e]);
+    int p, r;
+    lb__cube_edge(e, &p, &r);
+    for (int q = 0; q < 4; ++q) hits += FACE[f][q] == p || FACE[f][q] == r;
     return hits == 2;
 }
 
@@ -96,7 +83,7 @@ void lb__mctable_init(lb__mctable *t) {
                 const int p = FACE[f][q], r = FACE[f][(q + 1) & 3];
                 const int pin = (cfg >> p) & 1, rin = (cfg >> r) & 1;
                 if (pin == rin) continue;
-                ce[n] = edge_between(p, r);
+                ce[n] = lb__cube_edge_between(p, r);
                 entry[n++] = !pin;
             }
             for (int q = 0; q < n; ++q)
@@ -151,7 +138,9 @@ int lb__cube_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, const double 
         uint32_t v[LB__MAXPOLY];
         for (int q = 0; q < n; ++q) {
             const int e = cs->e[off + q];
-            const int64_t id = lb__cell_edge(C, i, j, k, EP[e], EP[e] | EA[e], c);
+            int p, q1;
+            lb__cube_edge(e, &p, &q1);
+            const int64_t id = lb__cell_edge(C, i, j, k, p, q1, c);
             if (id < 0) return 0;
             v[q] = (uint32_t)id;
         }

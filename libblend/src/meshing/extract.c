@@ -1100,20 +1100,39 @@ static inline int cut_cell(bctx *C, const lb__grid *g, const lb__block *B, uint3
 /* check points: under LB__TMAX triangles a cell, 4 points each */
 #define TL_POINTS ((size_t)TL_CELLS * LB__TMAX * 4)
 #define TL_NODES ((size_t)TL_CELLS * LB__TNODES)
+#define TL_D ((size_t)LB__MB + 1) /* a whole block's nodes a side */
 
 enum { TL_OFF, TL_TODO, TL_OK, TL_FINE };
 
 typedef struct tlcell {
     lb__tcell t; /* the pattern it was decided with */
     uint16_t sub[LB__TMAX];
+    uint16_t key[LB__TMAX]; /* its sub-edges' roots (tlroot) */
     uint8_t len[LB__TMAX / 3];
     uint8_t tri[3 * LB__TMAX]; /* the loops' triangles, as positions in sub */
     uint8_t nloop, ntri, state;
-    uint16_t e0; /* its first sub-edge in the round's batch */
 } tlcell;
+
+/* The root on a sub-edge, solved once per block: a sub-edge is in the loops
+ * of up to four coarse cells, and its root depends only on its two nodes,
+ * so the rounds share it, and the block's refinement takes it as it is
+ * (the same inputs to lb__refine_edges, the same bytes). Keyed by the
+ * sub-edge's lower node, axis and length (tl_key). */
+typedef struct tlroot {
+    uint32_t stamp; /* T->rstamp: solved in this block */
+    double pos[3], nrm[3];
+} tlroot;
+#define TL_KEYS (TL_D * TL_D * TL_D * 6)
 
 struct tlscratch {
     tlcell cell[TL_CELLS];
+    tlroot root[TL_KEYS];
+    uint32_t rstamp;
+    uint16_t bkey[TL_EDGES]; /* the round's batch: each sub-edge's key */
+    uint8_t *known;          /* the block's own edges solved in the decisions */
+    /* a cell's pattern may have changed: a cell around it turned fine in
+     * the last round (seen: its turn has been passed on) */
+    uint8_t dirty[TL_CELLS], seen[TL_CELLS];
     size_t *q;                                       /* nodes to evaluate (TL_NODES) */
     double *ea, *eb, *pa, *pb, *ga, *gb, *pos, *nrm; /* the round's sub-edges (TL_EDGES) */
     double *x, *y, *z, *v, *gx, *gy, *gz;            /* points to evaluate (TL_POINTS) */
@@ -1127,6 +1146,7 @@ static void tl_free(tlscratch *T) {
     free(T->ea);
     free(T->x);
     free(T->pcell);
+    free(T->known);
     free(T);
 }
 
@@ -1137,7 +1157,8 @@ static tlscratch *tl_new(void) {
     T->ea = malloc(20 * TL_EDGES * sizeof *T->ea);
     T->x = malloc(7 * TL_POINTS * sizeof *T->x);
     T->pcell = malloc(TL_POINTS * sizeof *T->pcell);
-    if (!T->q || !T->ea || !T->x || !T->pcell) {
+    T->known = malloc(EMAP_SIZE);
+    if (!T->q || !T->ea || !T->x || !T->pcell || !T->known) {
         tl_free(T);
         return NULL;
     }
@@ -1157,11 +1178,20 @@ static tlscratch *tl_new(void) {
     return T;
 }
 
-/* lattice node l (x + 3 y + 9 z, 0..2 each) of coarse cell c, as a local node */
+/* lattice node l (x + 3 y + 9 z, 0..2 each) of coarse cell c, as a local
+ * node of B (a whole block: LB__MB + 1 nodes a side, so the strides are
+ * constants; these indices are the decisions' innermost work) */
 static inline size_t tl_lat(const lb__block *B, const int c[3], int l) {
+    (void)B;
     const size_t i = (size_t)(2 * c[0] + l % 3), j = (size_t)(2 * c[1] + l / 3 % 3),
                  k = (size_t)(2 * c[2] + l / 9);
-    return (k * (B->nc[1] + 1) + j) * (B->nc[0] + 1) + i;
+    return (k * TL_D + j) * TL_D + i;
+}
+
+/* the root key of the sub-edge from local node q (its lower end) along
+ * axis d, len nodes long */
+static inline uint16_t tl_key(size_t q, int d, int len) {
+    return (uint16_t)((q * 3 + (size_t)d) * 2 + (size_t)(len - 1));
 }
 
 /* the position of block B's local node q */
@@ -1337,13 +1367,20 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
         for (int l = 0; l < LB__TNODES; ++l) /* mark() marks its boxes whole: cannot happen */
             if (!B->nmask[tl_lat(B, c, l)]) K->state = TL_FINE;
     }
+    if (++T->rstamp == 0) { /* wrapped: clear the stamps once */
+        for (size_t i = 0; i < TL_KEYS; ++i) T->root[i].stamp = 0;
+        T->rstamp = 1;
+    }
+    memset(T->dirty, 1, sizeof T->dirty);
+    memset(T->seen, 0, sizeof T->seen);
     for (int round = 0; round <= TL_CELLS; ++round) {
         /* the cells to decide, and the samples their patterns read */
         size_t nq = 0;
         int todo = 0;
         for (int ci = 0; ci < TL_CELLS; ++ci) {
             tlcell *K = &T->cell[ci];
-            if (K->state != TL_TODO && K->state != TL_OK) continue;
+            if ((K->state != TL_TODO && K->state != TL_OK) || !T->dirty[ci]) continue;
+            T->dirty[ci] = 0;
             const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
             lb__tcell t;
             tl_pattern(T, c, &t);
@@ -1400,13 +1437,17 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                     if ((B->vals[tl_lat(B, c, i)] < 0.0) != in0) K->state = TL_FINE;
                 continue;
             }
-            K->e0 = (uint16_t)ne;
             int total = 0;
             for (int lp = 0; lp < K->nloop; ++lp) total += K->len[lp];
-            for (int i = 0; i < total; ++i, ++ne) {
+            for (int i = 0; i < total; ++i) {
                 int a, b, d, len;
                 tl_sub(K->sub[i], &a, &b, &d, &len);
                 const size_t qa = tl_lat(B, c, a), qb = tl_lat(B, c, b);
+                const uint16_t key = tl_key(qa, d, len);
+                K->key[i] = key;
+                if (T->root[key].stamp == T->rstamp) continue; /* solved, or queued */
+                T->root[key].stamp = T->rstamp;
+                T->bkey[ne] = key;
                 const int ain = B->vals[qa] < 0.0;
                 const size_t qi = ain ? qa : qb, qo = ain ? qb : qa;
                 tl_node_pos(g, B, qi, T->ea + 3 * ne);
@@ -1415,11 +1456,16 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                 T->pb[ne] = B->vals[qo];
                 memcpy(T->ga + 3 * ne, B->grads + 3 * qi, 3 * sizeof(double));
                 memcpy(T->gb + 3 * ne, B->grads + 3 * qo, 3 * sizeof(double));
+                ++ne;
             }
         }
-        s = lb__refine_edges(ev, g, B, ne, T->ea, T->eb, T->pa, T->pb, T->ga, T->gb, T->pos, T->nrm,
-                             &C->S, err);
+        s = lb__refine_edges(ev, g, B, ne, T->ea, T->eb, T->pa, T->pb, T->ga, T->gb, NULL, T->pos,
+                             T->nrm, &C->S, err);
         if (s) return s;
+        for (size_t i = 0; i < ne; ++i) {
+            memcpy(T->root[T->bkey[i]].pos, T->pos + 3 * i, 3 * sizeof(double));
+            memcpy(T->root[T->bkey[i]].nrm, T->nrm + 3 * i, 3 * sizeof(double));
+        }
         /* the triangulations, the bow of their edges, the check points */
         size_t np = 0;
         for (int ci = 0; ci < TL_CELLS; ++ci) {
@@ -1428,7 +1474,11 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             K->ntri = 0;
             for (int lp = 0, off = 0; lp < K->nloop && K->state == TL_TODO; off += K->len[lp++]) {
                 const int n = K->len[lp];
-                const double *P = T->pos + 3 * (K->e0 + off), *N = T->nrm + 3 * (K->e0 + off);
+                double P[3 * LB__TMAX], N[3 * LB__TMAX];
+                for (int i = 0; i < n; ++i) {
+                    memcpy(P + 3 * i, T->root[K->key[off + i]].pos, 3 * sizeof(double));
+                    memcpy(N + 3 * i, T->root[K->key[off + i]].nrm, 3 * sizeof(double));
+                }
                 uint8_t tri[3 * LB__TMAX];
                 const int nt = lb__tloop_triangles(K->sub + off, P, n, tri);
                 if (!nt) {
@@ -1470,8 +1520,17 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             const double gl = sqrt(T->gx[i] * T->gx[i] + T->gy[i] * T->gy[i] + T->gz[i] * T->gz[i]);
             if (!(fabs(T->v[i]) <= tol * hmin * gl)) K->state = TL_FINE;
         }
-        for (int ci = 0; ci < TL_CELLS; ++ci)
+        for (int ci = 0; ci < TL_CELLS; ++ci) {
             if (T->cell[ci].state == TL_TODO) T->cell[ci].state = TL_OK;
+            if (T->cell[ci].state != TL_FINE || T->seen[ci]) continue;
+            T->seen[ci] = 1;
+            const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
+            for (int z = c[2] - 1; z <= c[2] + 1; ++z)
+                for (int y = c[1] - 1; y <= c[1] + 1; ++y)
+                    for (int x = c[0] - 1; x <= c[0] + 1; ++x)
+                        if (x >= 0 && y >= 0 && z >= 0 && x < TL_SIDE && y < TL_SIDE && z < TL_SIDE)
+                            T->dirty[(z * TL_SIDE + y) * TL_SIDE + x] = 1;
+        }
     }
     return LB_OK;
 }
@@ -1556,6 +1615,28 @@ static lb_status tl_cells(const lb_evaluator *ev, const lb__grid *g, lb__block *
     return LB_OK;
 }
 
+/* A two-level block's own edges (after orphans_last) whose roots its
+ * decisions solved: their positions and normals written into B's, and
+ * marked in the returned array for lb__refine_edges to leave. */
+static const uint8_t *tl_known(bctx *C, lb__block *B) {
+    tlscratch *T = C->tl;
+    for (size_t e = 0; e < C->ne; ++e) {
+        const uint32_t w = C->eloc[e];
+        const size_t q = ((size_t)((w >> 8) & 15) * TL_D + ((w >> 4) & 15)) * TL_D + (w & 15);
+        const int mask = (int)((w >> 12) & 7);
+        const tlroot *R = &T->root[tl_key(q,
+                                          mask == 1   ? 0
+                                          : mask == 2 ? 1
+                                                      : 2,
+                                          w & COARSE_EDGE ? 2 : 1)];
+        T->known[e] = R->stamp == T->rstamp;
+        if (!T->known[e]) continue;
+        memcpy(B->vpos + 3 * e, R->pos, 3 * sizeof(double));
+        memcpy(B->vnrm + 3 * e, R->nrm, 3 * sizeof(double));
+    }
+    return T->known;
+}
+
 lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B,
                          const lb__block *blocks, const uint32_t nbr[8], int gnext, lb__bctx *C,
                          lb_error *err) {
@@ -1573,7 +1654,8 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
     C->h.D0 = D0;
     C->h.D1 = D1;
     lb_status s = LB_OK;
-    if (lb__two_level_block(g, B)) {
+    const int two_level = lb__two_level_block(g, B);
+    if (two_level) {
         s = tl_cells(ev, g, B, C, err);
         if (s) goto done;
     } else {
@@ -1615,7 +1697,8 @@ lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, lb__block *B
             orphans_last(C);
             memcpy(B->okey, C->key + B->np, C->norph * sizeof *B->okey);
         }
-        s = lb__refine_edges(ev, g, B, ne, C->ea, C->eb, C->pa, C->pb, C->ga, C->gb, B->vpos,
+        const uint8_t *known = two_level ? tl_known(C, B) : NULL;
+        s = lb__refine_edges(ev, g, B, ne, C->ea, C->eb, C->pa, C->pb, C->ga, C->gb, known, B->vpos,
                              B->vnrm, &C->S, err);
         if (s) goto done;
         publish(C);

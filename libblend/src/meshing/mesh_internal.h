@@ -379,12 +379,14 @@ LB_INTERNAL lb__mscratch *lb__bctx_scratch(lb__bctx *C);
 /* Safeguarded, batched root solve of phi_c along n grid edges: a[i] inside
  * (phi < 0), b[i] outside, pa/pb their values and ga/gb their gradients
  * (3 per edge), all inside block B; writes the surface points and unit
- * normals. */
+ * normals. An edge's result depends on its own inputs alone, whatever the
+ * batch. known (NULL: none): the edges whose pos and nrm the caller has
+ * already written (solved before from the same inputs), left as they are. */
 LB_INTERNAL lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g,
                                        const lb__block *B, size_t n, const double *a,
                                        const double *b, const double *pa, const double *pb,
-                                       const double *ga, const double *gb, double *pos, double *nrm,
-                                       lb__mscratch *S, lb_error *err);
+                                       const double *ga, const double *gb, const uint8_t *known,
+                                       double *pos, double *nrm, lb__mscratch *S, lb_error *err);
 
 /* ---- the cell methods' side of extract.c */
 
@@ -493,8 +495,22 @@ LB_INTERNAL int lb__tetra_cell(lb__bctx *C, uint32_t i, uint32_t j, uint32_t k, 
 LB_INTERNAL const lb__grid *lb__cell_grid(const lb__bctx *C);
 
 LB_INTERNAL void lb__mctable_init(lb__mctable *t);
-/* Cube edge e (0..11) runs from corner *p to corner *q. */
-LB_INTERNAL void lb__cube_edge(int e, int *p, int *q);
+/* Cube edge e (0..11) runs from corner *p to corner *q: edges 0-3 along x,
+ * 4-7 along y, 8-11 along z, each group in the order of its lower corner.
+ * Inline: the two-level cells (extract.c, transition.c) ask for it in their
+ * innermost loops. */
+static inline void lb__cube_edge(int e, int *p, int *q) {
+    static const uint8_t P[12] = {0, 2, 4, 6, 0, 1, 4, 5, 0, 1, 2, 3};
+    *p = P[e];
+    *q = P[e] | 1 << (e >> 2);
+}
+/* The cube edge between corners p and q, which differ in one bit. */
+static inline int lb__cube_edge_between(int p, int q) {
+    const int lo = p < q ? p : q, a = p ^ q;
+    const int d = a >> 1 < 2 ? a >> 1 : 2; /* 1, 2, 4 -> 0, 1, 2 */
+    const int r = d == 0 ? lo >> 1 : d == 1 ? (lo & 1) | (lo >> 1 & 2) : lo;
+    return 4 * d + r;
+}
 /* 1 when every loop of every case is a polygon of 3..LB__MAXPOLY vertices
  * with a triangulation off the cell's faces (the manifold argument in
  * cubes.c needs it), else 0. */

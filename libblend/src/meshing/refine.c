@@ -117,8 +117,8 @@ static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxe
 
 lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, size_t n,
                            const double *a, const double *b, const double *pa, const double *pb,
-                           const double *ga, const double *gb, double *pos, double *nrm,
-                           lb__mscratch *S, lb_error *err) {
+                           const double *ga, const double *gb, const uint8_t *known, double *pos,
+                           double *nrm, lb__mscratch *S, lb_error *err) {
     if (n == 0) return LB_OK;
     double hmin = g->h[0];
     if (g->h[1] < hmin) hmin = g->h[1];
@@ -159,6 +159,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
             size_t fill[8];
             for (int o = 0; o < 8; ++o) fill[o] = start[o];
             for (size_t i = 0; i < n; ++i) {
+                if (known && known[i]) continue;
                 int o = 0;
                 for (int d = 0; d < 3; ++d)
                     o |= (0.5 * (a[3 * i + d] + b[3 * i + d]) >= mid[d]) << d;
@@ -171,8 +172,10 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
                 for (int o = 0; o < 8; ++o) start[o + 1] += start[o];
         }
     } else {
-        for (size_t i = 0; i < n; ++i) act[i] = i;
-        start[1] = n;
+        size_t m = 0;
+        for (size_t i = 0; i < n; ++i)
+            if (!known || !known[i]) act[m++] = i;
+        start[1] = m;
     }
     const double boxmax = lb__block_boxmax(g, B);
     for (int o = 0; o < ngroups && !s; ++o) {

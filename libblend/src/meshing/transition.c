@@ -51,16 +51,6 @@ static int corner_node(int o) {
     return 2 * (o & 1) + 6 * ((o >> 1) & 1) + 18 * ((o >> 2) & 1);
 }
 
-/* the cube edge (cubes.c's numbering) between corners p and q */
-static int cube_edge_of(int p, int q) {
-    for (int e = 0; e < 12; ++e) {
-        int a, b;
-        lb__cube_edge(e, &a, &b);
-        if ((a == p && b == q) || (a == q && b == p)) return e;
-    }
-    return -1;
-}
-
 static uint16_t sub_key(int a, int b) {
     return (uint16_t)(a < b ? a * LB__TNODES + b : b * LB__TNODES + a);
 }
@@ -103,7 +93,7 @@ int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop)
         for (int q = 0; q < 4; ++q) {
             const int p = FACE[f][q], r = FACE[f][(q + 1) & 3];
             mid[q] = (uint8_t)((corner_node(p) + corner_node(r)) / 2);
-            if (!((c->split >> cube_edge_of(p, r)) & 1)) mid[q] = 0xff;
+            if (!((c->split >> lb__cube_edge_between(p, r)) & 1)) mid[q] = 0xff;
         }
         if ((c->quarter >> f) & 1) {
             const int centre = (corner_node(FACE[f][0]) + corner_node(FACE[f][2])) / 2;
