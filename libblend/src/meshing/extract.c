@@ -1091,9 +1091,10 @@ static inline int cut_cell(bctx *C, const lb__grid *g, const lb__block *B, uint3
  * sharing: every sub-edge of a coarse cell that is a grid edge is one
  * (lb__cell_edge: shared with the fine cells and, on the block's faces,
  * with the next blocks as now); a whole coarse edge, never on a boundary
- * plane, is the block's own (tl_coarse_edge). The decisions solve their
- * vertices in a batch of their own; the refinement after the cells solves
- * them again with the rest (the same inputs, the same positions). */
+ * plane, is the block's own (tl_coarse_edge). The decisions solve each
+ * sub-edge's vertex once for the block (tlroot); the refinement after the
+ * cells takes those and solves only the rest (the same inputs would give
+ * the same positions). */
 #define TL_SIDE (LB__MB / 2)
 #define TL_CELLS (TL_SIDE * TL_SIDE * TL_SIDE)
 #define TL_EDGES ((size_t)TL_CELLS * LB__TMAX)
