@@ -1137,7 +1137,10 @@ struct tlscratch {
     size_t *q;                                       /* nodes to evaluate (TL_NODES) */
     double *ea, *eb, *pa, *pb, *ga, *gb, *pos, *nrm; /* the round's sub-edges (TL_EDGES) */
     double *x, *y, *z, *v, *gx, *gy, *gz;            /* points to evaluate (TL_POINTS) */
-    uint8_t *pcell;                                  /* a check point's cell */
+    double *sx;     /* the same, grouped by octant (7 TL_POINTS; tl_eval) */
+    uint8_t *poct;  /* a point's octant of the block (its plan) */
+    size_t *pord;   /* tl_eval's grouping */
+    uint8_t *pcell; /* a check point's cell */
 };
 typedef struct tlscratch tlscratch;
 
@@ -1147,6 +1150,8 @@ static void tl_free(tlscratch *T) {
     free(T->ea);
     free(T->x);
     free(T->pcell);
+    free(T->poct);
+    free(T->pord);
     free(T->known);
     free(T);
 }
@@ -1156,10 +1161,12 @@ static tlscratch *tl_new(void) {
     if (!T) return NULL;
     T->q = malloc(TL_NODES * sizeof *T->q);
     T->ea = malloc(20 * TL_EDGES * sizeof *T->ea);
-    T->x = malloc(7 * TL_POINTS * sizeof *T->x);
+    T->x = malloc(14 * TL_POINTS * sizeof *T->x);
     T->pcell = malloc(TL_POINTS * sizeof *T->pcell);
+    T->poct = malloc(TL_POINTS * sizeof *T->poct);
+    T->pord = malloc(TL_POINTS * sizeof *T->pord);
     T->known = malloc(EMAP_SIZE);
-    if (!T->q || !T->ea || !T->x || !T->pcell || !T->known) {
+    if (!T->q || !T->ea || !T->x || !T->pcell || !T->poct || !T->pord || !T->known) {
         tl_free(T);
         return NULL;
     }
@@ -1176,17 +1183,22 @@ static tlscratch *tl_new(void) {
     T->gx = T->v + TL_POINTS;
     T->gy = T->gx + TL_POINTS;
     T->gz = T->gy + TL_POINTS;
+    T->sx = T->gz + TL_POINTS;
     return T;
 }
 
 /* lattice node l (x + 3 y + 9 z, 0..2 each) of coarse cell c, as a local
- * node of B (a whole block: LB__MB + 1 nodes a side, so the strides are
- * constants; these indices are the decisions' innermost work) */
+ * node of B (a whole block: TL_D nodes a side; the offsets are a table,
+ * these indices being the decisions' innermost work) */
+#define TL_O(l) ((l) / 9 * TL_D * TL_D + (l) / 3 % 3 * TL_D + (l) % 3)
+static const uint16_t TL_LATOFF[LB__TNODES] = {
+    TL_O(0),  TL_O(1),  TL_O(2),  TL_O(3),  TL_O(4),  TL_O(5),  TL_O(6),  TL_O(7),  TL_O(8),
+    TL_O(9),  TL_O(10), TL_O(11), TL_O(12), TL_O(13), TL_O(14), TL_O(15), TL_O(16), TL_O(17),
+    TL_O(18), TL_O(19), TL_O(20), TL_O(21), TL_O(22), TL_O(23), TL_O(24), TL_O(25), TL_O(26)};
 static inline size_t tl_lat(const lb__block *B, const int c[3], int l) {
     (void)B;
-    const size_t i = (size_t)(2 * c[0] + l % 3), j = (size_t)(2 * c[1] + l / 3 % 3),
-                 k = (size_t)(2 * c[2] + l / 9);
-    return (k * TL_D + j) * TL_D + i;
+    return ((size_t)(2 * c[2]) * TL_D + (size_t)(2 * c[1])) * TL_D + (size_t)(2 * c[0]) +
+           TL_LATOFF[l];
 }
 
 /* the root key of the sub-edge from local node q (its lower end) along
@@ -1288,14 +1300,50 @@ static int tl_samples(const lb__tcell *t, int *l) {
     return n;
 }
 
-/* phi_c and its gradient at n points (T->x, y, z) under the block's plan */
+/* phi_c and its gradient at n points (T->x, y, z): where the block's plan
+ * is narrowed octant by octant (as for its nodes and roots: mesher.c,
+ * refine.c), each point under the plan of its octant T->poct[i] */
 static lb_status tl_eval(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, bctx *C,
                          size_t n, lb_error *err) {
     if (!n) return LB_OK;
     tlscratch *T = C->tl;
     lb__boxeval *E = &C->S.E;
     lb__boxeval_load(ev, &B->plan, E);
-    lb_status s = lb__boxeval_run(ev, E, n, T->x, T->y, T->z, T->v, T->gx, T->gy, T->gz, err);
+    lb_status s = LB_OK;
+    if (lb__plan_prims(ev, &E->plan) < LB__NARROW_MIN_PRIMS) {
+        s = lb__boxeval_run(ev, E, n, T->x, T->y, T->z, T->v, T->gx, T->gy, T->gz, err);
+    } else {
+        if (!B->octmem) lb__plan_load(ev, &E->plan, &C->S.outer);
+        size_t start[9] = {0};
+        for (size_t i = 0; i < n; ++i) ++start[T->poct[i] + 1];
+        for (int o = 0; o < 8; ++o) start[o + 1] += start[o];
+        size_t fill[8];
+        memcpy(fill, start, sizeof fill);
+        for (size_t i = 0; i < n; ++i) T->pord[fill[T->poct[i]]++] = i;
+        double *X = T->sx, *Y = X + n, *Z = Y + n, *V = Z + n, *GX = V + n, *GY = GX + n,
+               *GZ = GY + n;
+        for (size_t r = 0; r < n; ++r) {
+            X[r] = T->x[T->pord[r]];
+            Y[r] = T->y[T->pord[r]];
+            Z[r] = T->z[T->pord[r]];
+        }
+        for (int o = 0; o < 8 && !s; ++o) {
+            const size_t a = start[o], m = start[o + 1] - a;
+            if (!m) continue;
+            if (B->octmem)
+                lb__boxeval_load(ev, &B->oct[o], E);
+            else
+                lb__octant_narrow(ev, g, B, o, &C->S.outer, E);
+            s = lb__boxeval_run(ev, E, m, X + a, Y + a, Z + a, V + a, GX + a, GY + a, GZ + a, err);
+        }
+        for (size_t r = 0; r < n && !s; ++r) {
+            const size_t i = T->pord[r];
+            T->v[i] = V[r];
+            T->gx[i] = GX[r];
+            T->gy[i] = GY[r];
+            T->gz[i] = GZ[r];
+        }
+    }
     if (s) return s;
     const double boxmax = lb__block_boxmax(g, B);
     for (size_t i = 0; i < n; ++i) {
@@ -1320,6 +1368,9 @@ static lb_status tl_nodes(const lb_evaluator *ev, const lb__grid *g, lb__block *
         B->nmask[q] = 3; /* queued: once */
         double X[3];
         tl_node_pos(g, B, q, X);
+        /* its octant: nodes up to the middle one in the low half (mesher.c) */
+        T->poct[m] = (uint8_t)((q % TL_D > LB__MB / 2) | (q / TL_D % TL_D > LB__MB / 2) << 1 |
+                               (q / (TL_D * TL_D) > LB__MB / 2) << 2);
         T->x[m] = X[0];
         T->y[m] = X[1];
         T->z[m] = X[2];
@@ -1473,6 +1524,10 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             tlcell *K = &T->cell[ci];
             if (K->state != TL_TODO || !K->nloop) continue;
             K->ntri = 0;
+            const int half = TL_SIDE / 2;
+            const uint8_t oct =
+                (uint8_t)((ci % TL_SIDE >= half) | (ci / TL_SIDE % TL_SIDE >= half) << 1 |
+                          (ci / (TL_SIDE * TL_SIDE) >= half) << 2);
             for (int lp = 0, off = 0; lp < K->nloop && K->state == TL_TODO; off += K->len[lp++]) {
                 const int n = K->len[lp];
                 double P[3 * LB__TMAX], N[3 * LB__TMAX];
@@ -1502,12 +1557,14 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                         T->x[np] = 0.5 * (A[0] + Bp[0]);
                         T->y[np] = 0.5 * (A[1] + Bp[1]);
                         T->z[np] = 0.5 * (A[2] + Bp[2]);
+                        T->poct[np] = oct;
                         T->pcell[np++] = (uint8_t)ci;
                         for (int d = 0; d < 3; ++d) mid[d] += A[d] / 3.0;
                     }
                     T->x[np] = mid[0];
                     T->y[np] = mid[1];
                     T->z[np] = mid[2];
+                    T->poct[np] = oct;
                     T->pcell[np++] = (uint8_t)ci;
                     ++K->ntri;
                 }
