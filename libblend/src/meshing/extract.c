@@ -1553,7 +1553,12 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                         double cs = N[3 * a] * N[3 * b] + N[3 * a + 1] * N[3 * b + 1] +
                                     N[3 * a + 2] * N[3 * b + 2];
                         cs = cs > 1.0 ? 1.0 : cs < -1.0 ? -1.0 : cs;
-                        if (L * acos(cs) / 8.0 > tol * hmin) K->state = TL_FINE;
+                        /* the arc's bow L a / 8 against the tolerance, acos
+                         * only where its bounds by the chord angle
+                         * c = sqrt(2 (1 - cs)) <= a <= pi c / 2 do not decide */
+                        const double lim = tol * hmin, ch = L * sqrt(2.0 * (1.0 - cs)) / 8.0;
+                        if (ch > lim || (1.5707963267948966 * ch > lim && L * acos(cs) / 8.0 > lim))
+                            K->state = TL_FINE;
                         T->x[np] = 0.5 * (A[0] + Bp[0]);
                         T->y[np] = 0.5 * (A[1] + Bp[1]);
                         T->z[np] = 0.5 * (A[2] + Bp[2]);

@@ -42,14 +42,29 @@
 #include <math.h>
 #include <string.h>
 
-/* the corners of the faces counter-clockwise seen from outside (cubes.c's
- * order); corner o is lattice node (2 (o & 1), 2 (o >> 1 & 1), 2 (o >> 2)) */
-static const uint8_t FACE[6][4] = {{4, 6, 2, 0}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                   {6, 7, 3, 2}, {2, 3, 1, 0}, {4, 5, 7, 6}};
-
-static int corner_node(int o) {
-    return 2 * (o & 1) + 6 * ((o >> 1) & 1) + 18 * ((o >> 2) & 1);
-}
+/* The corners of the faces counter-clockwise seen from outside (cubes.c's
+ * order); corner o is lattice node (2 (o & 1), 2 (o >> 1 & 1), 2 (o >> 2)).
+ * From them, as constants: each face's corner nodes, the midpoint nodes of
+ * its edges (corner q to q + 1) and those edges' cube numbers. */
+#define FACES(X)                                                                                   \
+    { X(4, 6, 2, 0), X(1, 3, 7, 5), X(0, 1, 5, 4), X(6, 7, 3, 2), X(2, 3, 1, 0), X(4, 5, 7, 6) }
+#define CN(o) (2 * ((o)&1) + 6 * (((o) >> 1) & 1) + 18 * (((o) >> 2) & 1))
+#define MID(p, q) ((CN(p) + CN(q)) / 2)
+#define LO(p, q) ((p) < (q) ? (p) : (q))
+#define AXIS(p, q) (((p) ^ (q)) == 1 ? 0 : ((p) ^ (q)) == 2 ? 1 : 2)
+#define EB(p, q)                                                                                   \
+    (4 * AXIS(p, q) + (AXIS(p, q) == 0   ? LO(p, q) >> 1                                           \
+                       : AXIS(p, q) == 1 ? (LO(p, q) & 1) | (LO(p, q) >> 1 & 2)                    \
+                                         : LO(p, q)))
+#define ROW_NODE(a, b, c, d)                                                                       \
+    { CN(a), CN(b), CN(c), CN(d) }
+#define ROW_MID(a, b, c, d)                                                                        \
+    { MID(a, b), MID(b, c), MID(c, d), MID(d, a) }
+#define ROW_EDGE(a, b, c, d)                                                                       \
+    { EB(a, b), EB(b, c), EB(c, d), EB(d, a) }
+static const uint8_t FNODE[6][4] = FACES(ROW_NODE);
+static const uint8_t FMID[6][4] = FACES(ROW_MID);
+static const uint8_t FEDGE[6][4] = FACES(ROW_EDGE);
 
 static uint16_t sub_key(int a, int b) {
     return (uint16_t)(a < b ? a * LB__TNODES + b : b * LB__TNODES + a);
@@ -90,25 +105,20 @@ int lb__tcell_loops(const lb__tcell *c, uint16_t *sub, uint8_t *len, int *nloop)
     *nloop = 0;
     for (int f = 0; f < 6; ++f) {
         uint8_t mid[4];
-        for (int q = 0; q < 4; ++q) {
-            const int p = FACE[f][q], r = FACE[f][(q + 1) & 3];
-            mid[q] = (uint8_t)((corner_node(p) + corner_node(r)) / 2);
-            if (!((c->split >> lb__cube_edge_between(p, r)) & 1)) mid[q] = 0xff;
-        }
+        for (int q = 0; q < 4; ++q) mid[q] = (c->split >> FEDGE[f][q]) & 1 ? FMID[f][q] : 0xff;
         if ((c->quarter >> f) & 1) {
-            const int centre = (corner_node(FACE[f][0]) + corner_node(FACE[f][2])) / 2;
+            const int centre = (FNODE[f][0] + FNODE[f][2]) / 2;
             for (int q = 0; q < 4; ++q)
                 if (mid[q] == 0xff) return -1; /* a quartered face needs its edges split */
             for (int q = 0; q < 4; ++q) {
-                const uint8_t w[4] = {(uint8_t)corner_node(FACE[f][q]), mid[q], (uint8_t)centre,
-                                      mid[(q + 3) & 3]};
+                const uint8_t w[4] = {FNODE[f][q], mid[q], (uint8_t)centre, mid[(q + 3) & 3]};
                 if (!walk(w, 4, c->inside, &S)) return -1;
             }
         } else {
             uint8_t w[8];
             int n = 0;
             for (int q = 0; q < 4; ++q) {
-                w[n++] = (uint8_t)corner_node(FACE[f][q]);
+                w[n++] = FNODE[f][q];
                 if (mid[q] != 0xff) w[n++] = mid[q];
             }
             if (!walk(w, n, c->inside, &S)) return -1;
@@ -180,6 +190,15 @@ int lb__tloop_triangles(const uint16_t *s, const double *pos, int n, uint8_t *tr
     }
     const double nl = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
     if (!(nl > 0)) return 0;
+    if (n == 3) { /* the one triangulation: what the search below finds */
+        double t[3];
+        lb__facing(pos, pos + 3, pos + 6, t);
+        if (!(t[0] * N[0] + t[1] * N[1] + t[2] * N[2] > 0)) return 0;
+        tri[0] = 0;
+        tri[1] = 1;
+        tri[2] = 2;
+        return 1;
+    }
     /* best[a][b]: over the triangulations of the sub-polygon a..b whose
      * diagonals keep off the faces, the largest smallest cosine between a
      * triangle's normal and N (2: a side, nothing to cut); at[a][b]: the
