@@ -1102,6 +1102,7 @@ static inline int cut_cell(bctx *C, const lb__grid *g, const lb__block *B, uint3
 #define TL_POINTS ((size_t)TL_CELLS * LB__TMAX * 4)
 #define TL_NODES ((size_t)TL_CELLS * LB__TNODES)
 #define TL_D ((size_t)LB__MB + 1) /* a whole block's nodes a side */
+#define TL_MIDS (1u << 15)        /* > 2 TL_POINTS: the midpoints' table */
 
 enum { TL_OFF, TL_TODO, TL_OK, TL_FINE };
 
@@ -1137,10 +1138,16 @@ struct tlscratch {
     size_t *q;                                       /* nodes to evaluate (TL_NODES) */
     double *ea, *eb, *pa, *pb, *ga, *gb, *pos, *nrm; /* the round's sub-edges (TL_EDGES) */
     double *x, *y, *z, *v, *gx, *gy, *gz;            /* points to evaluate (TL_POINTS) */
-    double *sx;     /* the same, grouped by octant (7 TL_POINTS; tl_eval) */
-    uint8_t *poct;  /* a point's octant of the block (its plan) */
-    size_t *pord;   /* tl_eval's grouping */
-    uint8_t *pcell; /* a check point's cell */
+    double *sx;      /* the same, grouped by octant (7 TL_POINTS; tl_eval) */
+    uint8_t *poct;   /* a point's octant of the block (its plan) */
+    size_t *pord;    /* tl_eval's grouping */
+    uint8_t *pcell;  /* a check point's cell */
+    uint8_t *pcell2; /* and the other cell whose triangles hold that edge (0xff: none) */
+    /* the round's edge midpoints by their two roots (tl_midpoint) */
+    struct tlmid {
+        uint32_t key, stamp, idx;
+    } mid[TL_MIDS];
+    uint32_t mstamp;
 };
 typedef struct tlscratch tlscratch;
 
@@ -1150,6 +1157,7 @@ static void tl_free(tlscratch *T) {
     free(T->ea);
     free(T->x);
     free(T->pcell);
+    free(T->pcell2);
     free(T->poct);
     free(T->pord);
     free(T->known);
@@ -1163,10 +1171,11 @@ static tlscratch *tl_new(void) {
     T->ea = malloc(20 * TL_EDGES * sizeof *T->ea);
     T->x = malloc(14 * TL_POINTS * sizeof *T->x);
     T->pcell = malloc(TL_POINTS * sizeof *T->pcell);
+    T->pcell2 = malloc(TL_POINTS * sizeof *T->pcell2);
     T->poct = malloc(TL_POINTS * sizeof *T->poct);
     T->pord = malloc(TL_POINTS * sizeof *T->pord);
     T->known = malloc(EMAP_SIZE);
-    if (!T->q || !T->ea || !T->x || !T->pcell || !T->poct || !T->pord || !T->known) {
+    if (!T->q || !T->ea || !T->x || !T->pcell || !T->pcell2 || !T->poct || !T->pord || !T->known) {
         tl_free(T);
         return NULL;
     }
@@ -1398,6 +1407,35 @@ static inline void tl_sub(uint16_t s, int *a, int *b, int *d, int *len) {
     *len = diff == 1 || diff == 3 || diff == 9 ? 1 : 2;
 }
 
+/* The check point at the midpoint of the triangle edge between roots ka
+ * and kb, for cell ci: a new one at T->x[*np], or the one this round
+ * already has there (the other triangle on a diagonal, or the cell across
+ * a face drawing the same segment), then checked for both cells. */
+static void tl_midpoint(tlscratch *T, uint16_t ka, uint16_t kb, const double *A, const double *Bp,
+                        int ci, uint8_t oct, size_t *np) {
+    const uint32_t key = ka < kb ? (uint32_t)ka << 16 | kb : (uint32_t)kb << 16 | ka;
+    uint32_t h = (key * 2654435761u) >> 17;
+    for (;; h = (h + 1) & (TL_MIDS - 1)) {
+        struct tlmid *M = &T->mid[h];
+        if (M->stamp != T->mstamp) {
+            M->stamp = T->mstamp;
+            M->key = key;
+            M->idx = (uint32_t)*np;
+            break;
+        }
+        if (M->key != key) continue;
+        if (T->pcell[M->idx] != ci) T->pcell2[M->idx] = (uint8_t)ci;
+        return;
+    }
+    const size_t i = (*np)++;
+    T->x[i] = 0.5 * (A[0] + Bp[0]);
+    T->y[i] = 0.5 * (A[1] + Bp[1]);
+    T->z[i] = 0.5 * (A[2] + Bp[2]);
+    T->poct[i] = oct;
+    T->pcell[i] = (uint8_t)ci;
+    T->pcell2[i] = 0xff;
+}
+
 /* The decisions (above). */
 static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block *B, bctx *C,
                            lb_error *err) {
@@ -1520,6 +1558,10 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
         }
         /* the triangulations, the bow of their edges, the check points */
         size_t np = 0;
+        if (++T->mstamp == 0) { /* wrapped: clear the stamps once */
+            for (size_t i = 0; i < TL_MIDS; ++i) T->mid[i].stamp = 0;
+            T->mstamp = 1;
+        }
         for (int ci = 0; ci < TL_CELLS; ++ci) {
             tlcell *K = &T->cell[ci];
             if (K->state != TL_TODO || !K->nloop) continue;
@@ -1559,17 +1601,14 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                         const double lim = tol * hmin, ch = L * sqrt(2.0 * (1.0 - cs)) / 8.0;
                         if (ch > lim || (1.5707963267948966 * ch > lim && L * acos(cs) / 8.0 > lim))
                             K->state = TL_FINE;
-                        T->x[np] = 0.5 * (A[0] + Bp[0]);
-                        T->y[np] = 0.5 * (A[1] + Bp[1]);
-                        T->z[np] = 0.5 * (A[2] + Bp[2]);
-                        T->poct[np] = oct;
-                        T->pcell[np++] = (uint8_t)ci;
+                        tl_midpoint(T, K->key[off + a], K->key[off + b], A, Bp, ci, oct, &np);
                         for (int d = 0; d < 3; ++d) mid[d] += A[d] / 3.0;
                     }
                     T->x[np] = mid[0];
                     T->y[np] = mid[1];
                     T->z[np] = mid[2];
                     T->poct[np] = oct;
+                    T->pcell2[np] = 0xff;
                     T->pcell[np++] = (uint8_t)ci;
                     ++K->ntri;
                 }
@@ -1578,10 +1617,11 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
         s = tl_eval(ev, g, B, C, np, err);
         if (s) return s;
         for (size_t i = 0; i < np; ++i) {
-            tlcell *K = &T->cell[T->pcell[i]];
-            if (K->state != TL_TODO) continue;
             const double gl = sqrt(T->gx[i] * T->gx[i] + T->gy[i] * T->gy[i] + T->gz[i] * T->gz[i]);
-            if (!(fabs(T->v[i]) <= tol * hmin * gl)) K->state = TL_FINE;
+            if (fabs(T->v[i]) <= tol * hmin * gl) continue;
+            if (T->cell[T->pcell[i]].state == TL_TODO) T->cell[T->pcell[i]].state = TL_FINE;
+            if (T->pcell2[i] != 0xff && T->cell[T->pcell2[i]].state == TL_TODO)
+                T->cell[T->pcell2[i]].state = TL_FINE;
         }
         for (int ci = 0; ci < TL_CELLS; ++ci) {
             if (T->cell[ci].state == TL_TODO) T->cell[ci].state = TL_OK;
