@@ -79,15 +79,18 @@ class _Job:
     run() touches no Blender data and may run on a worker thread."""
 
     def __init__(self, lib, text, name, bmin, bmax, resolution, open_boundary, threads, paths,
-                 fit=False, features=False, simplify=0.0, cache=(None, None), merge_flat=False):
+                 fit=False, features=False, simplify=0.0, cache=(None, None), merge_flat=False,
+                 coarse_first=False):
         self.lib, self.text, self.name = lib, text, name
         self.bmin, self.bmax, self.resolution = bmin, bmax, resolution
         self.open_boundary, self.threads, self.paths = open_boundary, threads, paths
         self.fit, self.features, self.simplify = fit, features, simplify
         self.merge_flat = merge_flat
+        # Simplify's method: coarse first (LB_MESH_COARSE_FIRST) or the collapses
+        self.coarse_first = bool(coarse_first) and simplify > 0.0
         self.cache, self.cache_lock = cache
         self.key = mesh_key(text, "fit" if fit else bmin, "fit" if fit else bmax, resolution,
-                            open_boundary, features, simplify, merge_flat)
+                            open_boundary, features, simplify, merge_flat, self.coarse_first)
         self.cell = 0.0        # Fit Region's cell size (0: not fitted)
         self.region_note = ""  # why the fit fell back to the box, if it did
         self.clipped = ""      # the region faces the surface reaches ("+z -x"), if any
@@ -166,7 +169,8 @@ class _Job:
         return ev.mesh(self.bmin, self.bmax, resolution=self.resolution, cell_size=self.cell,
                        open_boundary=self.open_boundary, threads=self.threads, cancel=self.cancel,
                        edges=compat.takes_libblend_edges(), features=self.features,
-                       simplify=self.simplify, cache=cache, merge_flat=self.merge_flat)
+                       simplify=self.simplify, cache=cache, merge_flat=self.merge_flat,
+                       coarse_first=self.coarse_first)
 
     def _fit(self, ev, text):
         # only local unions read the bounds when meshing: other scenes keep
@@ -340,9 +344,10 @@ def set_materials(me, mesh):
 # --------------------------------------------------------------------------- jobs
 
 def mesh_key(text, bmin, bmax, resolution, open_boundary, features=False, simplify=0.0,
-             merge_flat=False):
+             merge_flat=False, coarse_first=False):
     """What a mesh is a function of: the scene text, the region, the
-    resolution, the boundary mode, Sharp Features, Merge Flat and Simplify.
+    resolution, the boundary mode, Sharp Features, Merge Flat and Simplify
+    with its method.
     Equal keys, equal meshes; so a field whose key did not change is not
     meshed again (frames where nothing moved, a driver that did not change
     its value, a render's first frame). Without those three options the key
@@ -352,6 +357,8 @@ def mesh_key(text, bmin, bmax, resolution, open_boundary, features=False, simpli
         parts.append("features")
     if simplify > 0.0:
         parts.append("simplify %r" % float(simplify))
+        if coarse_first:
+            parts.append("coarse first")
     if merge_flat:
         parts.append("merge flat")
     h = hashlib.sha256(json.dumps(parts).encode())
@@ -393,7 +400,8 @@ def prepare(output, resolution, depsgraph=None):
                 output.libblend.open_boundary, libhandle.threads(), paths,
                 fit=output.libblend.fit_region, features=output.libblend.sharp_features,
                 simplify=output.libblend.simplify, cache=_state(output.name).mesh_cache(lib),
-                merge_flat=output.libblend.merge_flat)
+                merge_flat=output.libblend.merge_flat,
+                coarse_first=output.libblend.simplify_method == "COARSE")
 
 
 def _finish(output, st, job, t_start, defer_normals=False):
@@ -472,7 +480,7 @@ def cached_key(output, depsgraph=None):
     text, _paths = tree.to_json(output, depsgraph, render=False, compact=True)
     bmin, bmax = ("fit", "fit") if s.fit_region else _region(output)
     return mesh_key(text, bmin, bmax, s.render_resolution, s.open_boundary, s.sharp_features,
-                    s.simplify, s.merge_flat)
+                    s.simplify, s.merge_flat, s.simplify_method == "COARSE")
 
 
 def from_cache(output, frame, depsgraph=None):

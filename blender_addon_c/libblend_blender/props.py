@@ -116,6 +116,13 @@ class LB_ObjectSettings(bpy.types.PropertyGroup):
                             "cells of the field, never across a crease (with Sharp Features a "
                             "flat face becomes a few large triangles). 0 = off", default=0.0,
                             min=0.0, max=1.0, step=5, precision=2, update=_changed)
+    simplify_method: EnumProperty(name="Method", items=[
+        ("COLLAPSE", "Collapse", "mesh, then merge triangles: the fewest triangles, at several "
+         "times the meshing time (bakes and renders)"),
+        ("COARSE", "Coarse First", "mesh cells of twice the size wherever the surface stays "
+         "within the tolerance: more triangles than Collapse for far less time (live "
+         "updates). With Sharp Features, Collapse is used")],
+        default="COLLAPSE", update=_changed)
     merge_flat: BoolProperty(name="Merge Flat", description="flat faces (a box's sides, a "
                              "slab's, a cylinder's caps) as few large triangles, the surface "
                              "unchanged: fewer triangles for Blender to take in", default=False,

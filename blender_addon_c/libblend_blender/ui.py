@@ -128,6 +128,8 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
         layout.prop(s, "sharp_features")
         layout.prop(s, "merge_flat")
         layout.prop(s, "simplify")
+        if s.simplify > 0.0:
+            layout.prop(s, "simplify_method")
         box = layout.box()
         box.label(text="Bake (render resolution, one file per frame)")
         box.prop(s, "bake_dir")

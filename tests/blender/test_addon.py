@@ -1241,6 +1241,28 @@ check(live.update_now(lat, force=True)[0] and
       live.state_of(lat).cache.stats[1] == live.state_of(lat).cache.stats[0],
       "the same field again: every block from the cache")
 
+# Simplify's Coarse First method (LB_MESH_COARSE_FIRST) on the lattice: cells
+# of twice the size wherever the surface stays within 0.25 cells. Closed,
+# oriented and manifold in Blender, fewer triangles than without Simplify,
+# the full remesh's mesh through the field's cache, and the method part of
+# the mesh key (a bake made with the collapses is not reused).
+plain_tris = len(lat.data.polygons)
+lat.libblend.simplify = 0.25
+collapse_key = live.prepare(lat, 96).key
+lat.libblend.simplify_method = "COARSE"
+check(live.update_now(lat)[0], "mesh the lattice with Simplify, Coarse First")
+Vc, Fc = blender_mesh(lat)
+icf = meshcheck.check(Vc, Fc)
+print("Coarse First on the lattice at 96 cells: %d triangles (without Simplify %d)"
+      % (len(Fc), plain_tris))
+check(icf["closed"] and icf["manifold"] and icf["oriented"] and 0 < len(Fc) < 0.9 * plain_tris,
+      "Coarse First: closed, oriented, manifold, %d triangles against %d" % (len(Fc), plain_tris))
+cf_job = live.prepare(lat, 96)
+check(cf_job.coarse_first and cf_job.key != collapse_key, "Simplify's method is in the mesh key")
+check(same_as_full(lat, 96), "Coarse First through the cache: the full remesh's mesh")
+lat.libblend.simplify, lat.libblend.simplify_method = 0.0, "COLLAPSE"
+check(not live.prepare(lat, 96).coarse_first, "Simplify off: no Coarse First")
+
 # The field's last evaluator is kept too: the next compile copies the
 # curves of the local unions whose children did not change (a flat local
 # union of 8 spheres is a fold of 7; moving the last sphere keeps the first

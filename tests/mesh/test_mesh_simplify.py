@@ -20,6 +20,9 @@ apart over every triangle (a simplified triangle can be 100 cells long):
 - corner normals (OBJ) on the simplified boxes are still their faces';
 - S1 and S2 (smooth) simplified: fewer triangles, the same bytes with 1 and
   2 threads;
+- --coarse-first on S1 and S2 at 96 cells (0.25 cells): closed, oriented
+  and manifold, fewer triangles, the same bytes with 1 and 2 threads, and
+  --coarse-first without --simplify exits 2 naming the fix;
 - bad tolerances exit 2 naming the option and write nothing;
 - --merge-flat (no tolerance): the boxes in 12, 12 and 36 triangles, exact
   to 1e-5 cells, every corner kept; the cylinder cut by a slab with its
@@ -196,6 +199,29 @@ for sname in ("bench-s1-three-spheres", "bench-s2-64-spheres"):
     check(len(F) < 0.8 * len(F0), "%s: %d triangles of %d (bar: under 0.8x)" %
           (tag, len(F), len(F0)))
     check(outs[0] == outs[1], "%s: the same bytes with 1 and 2 threads" % tag)
+
+# ---- --coarse-first: the tolerance met by meshing coarse cells ----
+# (its vertices on coarse edges are not the uniform mesh's: no subset check;
+# tests/test_mesh.c's test_coarse_first checks them on the surface and a
+# sphere's triangles against its closed form)
+for sname in ("bench-s1-three-spheres", "bench-s2-64-spheres"):
+    path = os.path.join(SRC, "scenes", sname + ".json")
+    _V0, _N0, F0 = meshcheck.read(mesh(path, 96))
+    outs = [open(mesh(path, 96, "--simplify", "0.25", "--coarse-first", "--threads", th),
+                 "rb").read() for th in ("1", "2")]
+    V, _N, F = meshcheck.read(mesh(path, 96, "--simplify", "0.25", "--coarse-first",
+                                   "--threads", "2"))
+    tag = "%s at 96 --simplify 0.25 --coarse-first" % sname
+    topology(tag, V, F)
+    check(len(F) < 0.95 * len(F0), "%s: %d triangles of %d (bar: under 0.95x)" %
+          (tag, len(F), len(F0)))
+    check(outs[0] == outs[1], "%s: the same bytes with 1 and 2 threads" % tag)
+out = os.path.join(WORK, "bad-coarse.ply")
+p = subprocess.run([BLENDTOOL, "mesh", shape("cube"), "-o", out, "--resolution", "16",
+                    "--coarse-first"], capture_output=True, text=True)
+check(p.returncode == 2 and "--coarse-first" in p.stderr and "--simplify TOL" in p.stderr and
+      not os.path.exists(out), "--coarse-first alone: exit %d, %r, nothing written" %
+      (p.returncode, p.stderr.strip()))
 
 # ---- --merge-flat: flat regions merged, no tolerance ----
 # the boxes' faces become two triangles each, exact, every corner kept; the
