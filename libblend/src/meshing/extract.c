@@ -1126,8 +1126,18 @@ typedef struct tlroot {
 } tlroot;
 #define TL_KEYS (TL_D * TL_D * TL_D * 6)
 
+/* A coarse cell's fixed surroundings in its block (made once, tl_new) */
+typedef struct tlgeom {
+    uint16_t plane_split;  /* its edges on the block's boundary planes */
+    uint8_t plane_quarter; /* its faces on them */
+    uint8_t fnbr[6];       /* the cell across each face (0xff: none) */
+    uint8_t enbr[12][3];   /* the other cells around each edge (0xff: none) */
+} tlgeom;
+
 struct tlscratch {
     tlcell cell[TL_CELLS];
+    tlgeom geom[TL_CELLS];
+    uint8_t elat[12][3]; /* cube edge e's lattice nodes: its ends, its midpoint */
     tlroot root[TL_KEYS];
     uint32_t rstamp;
     uint16_t bkey[TL_EDGES]; /* the round's batch: each sub-edge's key */
@@ -1150,6 +1160,10 @@ struct tlscratch {
     uint32_t mstamp;
 };
 typedef struct tlscratch tlscratch;
+
+static inline int tl_corner(int o) {
+    return 2 * (o & 1) + 6 * ((o >> 1) & 1) + 18 * ((o >> 2) & 1);
+}
 
 static void tl_free(tlscratch *T) {
     if (!T) return;
@@ -1193,6 +1207,50 @@ static tlscratch *tl_new(void) {
     T->gy = T->gx + TL_POINTS;
     T->gz = T->gy + TL_POINTS;
     T->sx = T->gz + TL_POINTS;
+    for (int e = 0; e < 12; ++e) {
+        int p, q;
+        lb__cube_edge(e, &p, &q);
+        T->elat[e][0] = (uint8_t)tl_corner(p);
+        T->elat[e][1] = (uint8_t)tl_corner(q);
+        T->elat[e][2] = (uint8_t)((tl_corner(p) + tl_corner(q)) / 2);
+    }
+    for (int ci = 0; ci < TL_CELLS; ++ci) {
+        const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
+        tlgeom *G = &T->geom[ci];
+        memset(G, 0xff, sizeof *G);
+        G->plane_split = 0;
+        G->plane_quarter = 0;
+        for (int e = 0; e < 12; ++e) {
+            int p, q, m = 0;
+            lb__cube_edge(e, &p, &q);
+            const int a = p ^ q;
+            for (int d = 0; d < 3; ++d) {
+                if ((1 << d) == a) continue;
+                const int at = c[d] + ((p >> d) & 1);
+                if (at == 0 || at == TL_SIDE) G->plane_split |= (uint16_t)(1u << e);
+            }
+            for (int k = 0; k < 4; ++k) { /* the four cells around it */
+                int n[3], j = 0;
+                for (int d = 0; d < 3; ++d) {
+                    n[d] = c[d];
+                    if ((1 << d) != a) n[d] += ((p >> d) & 1) - ((k >> j++) & 1);
+                }
+                const int in = n[0] >= 0 && n[1] >= 0 && n[2] >= 0 && n[0] < TL_SIDE &&
+                               n[1] < TL_SIDE && n[2] < TL_SIDE;
+                const int ni = (n[2] * TL_SIDE + n[1]) * TL_SIDE + n[0];
+                if (in && ni != ci) G->enbr[e][m++] = (uint8_t)ni;
+            }
+        }
+        for (int f = 0; f < 6; ++f) { /* face f: axis f / 2, side f % 2 */
+            const int d = f / 2, side = f % 2, at = c[d] + side;
+            int n[3] = {c[0], c[1], c[2]};
+            n[d] += side ? 1 : -1;
+            if (at == 0 || at == TL_SIDE)
+                G->plane_quarter |= (uint8_t)(1u << f);
+            else
+                G->fnbr[f] = (uint8_t)((n[2] * TL_SIDE + n[1]) * TL_SIDE + n[0]);
+        }
+    }
     return T;
 }
 
@@ -1223,70 +1281,37 @@ static void tl_node_pos(const lb__grid *g, const lb__block *B, size_t q, double 
                  (uint64_t)B->b[2] * LB__MB + q / (D0 * D1), X);
 }
 
-static inline int tl_corner(int o) {
-    return 2 * (o & 1) + 6 * ((o >> 1) & 1) + 18 * ((o >> 2) & 1);
+static inline int tl_is_fine(const tlscratch *T, uint8_t ci) {
+    return ci != 0xff && T->cell[ci].state == TL_FINE;
 }
 
-static inline int tl_is_fine(const tlscratch *T, int x, int y, int z) {
-    if (x < 0 || y < 0 || z < 0 || x >= TL_SIDE || y >= TL_SIDE || z >= TL_SIDE) return 0;
-    return T->cell[(z * TL_SIDE + y) * TL_SIDE + x].state == TL_FINE;
-}
-
-/* coarse cell c's splits: on the block's boundary planes, and where a fine
+/* coarse cell ci's splits: on the block's boundary planes, and where a fine
  * cell is around an edge or across a face */
-static void tl_pattern(const tlscratch *T, const int c[3], lb__tcell *t) {
-    t->split = 0;
-    t->quarter = 0;
-    for (int e = 0; e < 12; ++e) {
-        int p, q;
-        lb__cube_edge(e, &p, &q);
-        const int a = p ^ q;
-        int on_plane = 0, any = 0;
-        for (int d = 0; d < 3; ++d) {
-            if ((1 << d) == a) continue;
-            const int at = c[d] + ((p >> d) & 1);
-            on_plane |= at == 0 || at == TL_SIDE;
-        }
-        for (int k = 0; k < 4 && !on_plane && !any; ++k) { /* the four cells around it */
-            int n[3], j = 0;
-            for (int d = 0; d < 3; ++d) {
-                n[d] = c[d];
-                if ((1 << d) != a) n[d] += ((p >> d) & 1) - ((k >> j++) & 1);
-            }
-            any = tl_is_fine(T, n[0], n[1], n[2]);
-        }
-        if (on_plane || any) t->split |= (uint16_t)(1u << e);
-    }
-    for (int f = 0; f < 6; ++f) { /* face f: axis f / 2, side f % 2 */
-        const int d = f / 2, side = f % 2, at = c[d] + side;
-        int n[3] = {c[0], c[1], c[2]};
-        n[d] += side ? 1 : -1;
-        if (at == 0 || at == TL_SIDE || tl_is_fine(T, n[0], n[1], n[2]))
-            t->quarter |= (uint8_t)(1u << f);
-    }
+static void tl_pattern(const tlscratch *T, int ci, lb__tcell *t) {
+    const tlgeom *G = &T->geom[ci];
+    t->split = G->plane_split;
+    t->quarter = G->plane_quarter;
+    for (int e = 0; e < 12; ++e)
+        if (tl_is_fine(T, G->enbr[e][0]) || tl_is_fine(T, G->enbr[e][1]) ||
+            tl_is_fine(T, G->enbr[e][2]))
+            t->split |= (uint16_t)(1u << e);
+    for (int f = 0; f < 6; ++f)
+        if (tl_is_fine(T, G->fnbr[f])) t->quarter |= (uint8_t)(1u << f);
 }
 
-/* Whether coarse cell c has an edge on the block's boundary planes whose
- * two halves both cross (its midpoint on the other side of its ends). Both
- * unquartered faces holding such an edge would draw the segment between the
- * two halves' vertices, on each side of the plane: four triangles on one
- * edge. A cell with such an edge is fine; the block across the plane,
- * seeing the same three shared nodes, makes its cells there fine too. */
-static int tl_plane_pinch(const lb__block *B, const int c[3]) {
+/* Whether coarse cell ci (at c) has an edge on the block's boundary planes
+ * whose two halves both cross (its midpoint on the other side of its ends).
+ * Both unquartered faces holding such an edge would draw the segment
+ * between the two halves' vertices, on each side of the plane: four
+ * triangles on one edge. A cell with such an edge is fine; the block across
+ * the plane, seeing the same three shared nodes, makes its cells there fine
+ * too. */
+static int tl_plane_pinch(const tlscratch *T, const lb__block *B, int ci, const int c[3]) {
     for (int e = 0; e < 12; ++e) {
-        int p, q;
-        lb__cube_edge(e, &p, &q);
-        const int a = p ^ q;
-        int on_plane = 0;
-        for (int d = 0; d < 3; ++d) {
-            if ((1 << d) == a) continue;
-            const int at = c[d] + ((p >> d) & 1);
-            on_plane |= at == 0 || at == TL_SIDE;
-        }
-        if (!on_plane) continue;
-        const int lp = tl_corner(p), lq = tl_corner(q);
-        const int ip = B->vals[tl_lat(B, c, lp)] < 0.0, iq = B->vals[tl_lat(B, c, lq)] < 0.0,
-                  im = B->vals[tl_lat(B, c, (lp + lq) / 2)] < 0.0;
+        if (!((T->geom[ci].plane_split >> e) & 1)) continue;
+        const int ip = B->vals[tl_lat(B, c, T->elat[e][0])] < 0.0,
+                  iq = B->vals[tl_lat(B, c, T->elat[e][1])] < 0.0,
+                  im = B->vals[tl_lat(B, c, T->elat[e][2])] < 0.0;
         if (ip == iq && im != ip) return 1;
     }
     return 0;
@@ -1294,18 +1319,15 @@ static int tl_plane_pinch(const lb__block *B, const int c[3]) {
 
 /* the lattice nodes pattern t reads: corners, split edges' midpoints,
  * quartered faces' centres (n of them into l) */
-static int tl_samples(const lb__tcell *t, int *l) {
+static int tl_samples(const tlscratch *T, const lb__tcell *t, int *l) {
+    static const uint8_t CORNERS[8] = {0, 2, 6, 8, 18, 20, 24, 26},
+                         CENTRES[6] = {12, 14, 10, 16, 4, 22};
     int n = 0;
-    for (int o = 0; o < 8; ++o) l[n++] = tl_corner(o);
+    for (int o = 0; o < 8; ++o) l[n++] = CORNERS[o];
     for (int e = 0; e < 12; ++e)
-        if ((t->split >> e) & 1) {
-            int p, q;
-            lb__cube_edge(e, &p, &q);
-            l[n++] = (tl_corner(p) + tl_corner(q)) / 2;
-        }
-    static const int STRIDE[3] = {1, 3, 9};
+        if ((t->split >> e) & 1) l[n++] = T->elat[e][2];
     for (int f = 0; f < 6; ++f)
-        if ((t->quarter >> f) & 1) l[n++] = 13 + (f % 2 ? STRIDE[f / 2] : -STRIDE[f / 2]);
+        if ((t->quarter >> f) & 1) l[n++] = CENTRES[f];
     return n;
 }
 
@@ -1473,13 +1495,13 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             T->dirty[ci] = 0;
             const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
             lb__tcell t;
-            tl_pattern(T, c, &t);
+            tl_pattern(T, ci, &t);
             if (K->state == TL_OK && t.split == K->t.split && t.quarter == K->t.quarter) continue;
             K->state = TL_TODO;
             K->t = t;
             ++todo;
             int l[26];
-            const int n = tl_samples(&t, l);
+            const int n = tl_samples(T, &t, l);
             for (int i = 0; i < n; ++i) T->q[nq++] = tl_lat(B, c, l[i]);
         }
         if (!todo) return LB_OK;
@@ -1492,12 +1514,12 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             tlcell *K = &T->cell[ci];
             if (K->state != TL_TODO) continue;
             const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
-            if (tl_plane_pinch(B, c)) {
+            if (tl_plane_pinch(T, B, ci, c)) {
                 K->state = TL_FINE;
                 continue;
             }
             int l[26];
-            const int n = tl_samples(&K->t, l);
+            const int n = tl_samples(T, &K->t, l);
             K->t.inside = 0;
             for (int i = 0; i < n; ++i)
                 if (B->vals[tl_lat(B, c, l[i])] < 0.0) K->t.inside |= 1u << l[i];
