@@ -1134,8 +1134,20 @@ typedef struct tlgeom {
     uint8_t enbr[12][3];   /* the other cells around each edge (0xff: none) */
 } tlgeom;
 
+/* lb__tcell_loops' answers by pattern (tl_loops): patterns repeat across
+ * cells, blocks and rounds (key + 1; 0: empty) */
+#define TL_LCACHE 4096u
+typedef struct tlloops {
+    uint64_t key;
+    int16_t total;
+    uint8_t nloop;
+    uint8_t len[LB__TMAX / 3];
+    uint16_t sub[LB__TMAX];
+} tlloops;
+
 struct tlscratch {
     tlcell cell[TL_CELLS];
+    tlloops lcache[TL_LCACHE];
     tlgeom geom[TL_CELLS];
     uint8_t elat[12][3]; /* cube edge e's lattice nodes: its ends, its midpoint */
     tlroot root[TL_KEYS];
@@ -1429,6 +1441,26 @@ static inline void tl_sub(uint16_t s, int *a, int *b, int *d, int *len) {
     *len = diff == 1 || diff == 3 || diff == 9 ? 1 : 2;
 }
 
+/* lb__tcell_loops for cell K's pattern, through the thread's cache */
+static int tl_loops(tlscratch *T, tlcell *K) {
+    const uint64_t key =
+        ((uint64_t)K->t.split | (uint64_t)K->t.quarter << 12 | (uint64_t)K->t.inside << 18) + 1;
+    tlloops *L = &T->lcache[(key * 0x9E3779B97F4A7C15ull) >> 52];
+    if (L->key != key) {
+        int nloop = 0;
+        const int total = lb__tcell_loops(&K->t, L->sub, L->len, &nloop);
+        L->key = key;
+        L->total = (int16_t)total;
+        L->nloop = (uint8_t)nloop;
+    }
+    K->nloop = L->nloop;
+    if (L->total > 0) {
+        memcpy(K->sub, L->sub, (size_t)L->total * sizeof *K->sub);
+        memcpy(K->len, L->len, L->nloop);
+    }
+    return L->total;
+}
+
 /* The check point at the midpoint of the triangle edge between roots ka
  * and kb, for cell ci: a new one at T->x[*np], or the one this round
  * already has there (the other triangle on a diagonal, or the cell across
@@ -1523,13 +1555,11 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             K->t.inside = 0;
             for (int i = 0; i < n; ++i)
                 if (B->vals[tl_lat(B, c, l[i])] < 0.0) K->t.inside |= 1u << l[i];
-            int nloop = 0;
-            if (lb__tcell_loops(&K->t, K->sub, K->len, &nloop) < 0) {
+            if (tl_loops(T, K) < 0) {
                 K->state = TL_FINE; /* cannot happen (transition.c) */
                 continue;
             }
-            K->nloop = (uint8_t)nloop;
-            if (!nloop)
+            if (!K->nloop)
                 for (int i = 0; i < LB__TNODES; ++i) T->q[nq++] = tl_lat(B, c, i);
         }
         s = tl_nodes(ev, g, B, C, nq, err);
