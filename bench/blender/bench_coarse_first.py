@@ -20,43 +20,23 @@ import json
 import os
 import statistics
 import sys
-import time
 
 import bpy
-import addon_utils
 import mathutils
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 ADDON_PARENT, SRC = argv[:2]
-sys.path.insert(0, ADDON_PARENT)
-os.environ.pop("LIBBLEND_LIBRARY", None)
-addon_utils.enable("libblend_blender", default_set=True)
-from libblend_blender import live, tree  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import addon_bench  # noqa: E402
 
-for o in list(bpy.data.objects):
-    bpy.data.objects.remove(o)
+addon_bench.start(ADDON_PARENT)
+from libblend_blender import live, tree  # noqa: E402
 ROUNDS, REPS = 5, 3
 SCENES = (("S2", os.path.join(SRC, "scenes", "bench-s2-64-spheres.json")),
           ("S1", os.path.join(SRC, "scenes", "bench-s1-three-spheres.json")),
           ("stool", os.path.join(SRC, "scenes", "hsu-bounded-fig7-stool.json")))
 CONFIGS = (("plain", 0.0, "COLLAPSE"), ("coarse 0.25", 0.25, "COARSE"),
            ("coarse 1", 1.0, "COARSE"), ("collapse 0.25", 0.25, "COLLAPSE"))
-
-
-def moves(out, mover, step, st, n, times, parts):
-    for i in range(n):
-        t0 = time.perf_counter()
-        mover.location.x += step if i % 2 == 0 else -step
-        live.mark_dirty(mover)
-        wait = live.tick()
-        while wait is not None and (st.dirty or st.job is not None):
-            time.sleep(wait)
-            wait = live.tick()
-        times.append(time.perf_counter() - t0)
-        assert not st.error, st.status
-        parts.append((st.last["mesh"], st.last["apply"]))
-        while live.tick() is not None:
-            time.sleep(live.TICK)
 
 
 rows = []
@@ -82,7 +62,9 @@ for name, path in SCENES:
                 ok, msg = live.update_now(out)
                 assert ok, msg
                 out.libblend.live = True
-                moves(out, mover, step, live.state_of(out), ROUNDS, times[k], parts[k])
+                for sec, last in addon_bench.live_moves(mover, live.state_of(out), ROUNDS, step):
+                    times[k].append(sec)
+                    parts[k].append((last["mesh"], last["apply"]))
                 tris[k] = len(out.data.polygons)
         out.libblend.live = False
         r = {"scene": name, "cells": res}

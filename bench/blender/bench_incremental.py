@@ -23,18 +23,15 @@ import sys
 import time
 
 import bpy
-import addon_utils
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 ADDON_PARENT, SRC, WORK = argv[:3]
 os.makedirs(WORK, exist_ok=True)
-sys.path.insert(0, ADDON_PARENT)
-os.environ.pop("LIBBLEND_LIBRARY", None)
-addon_utils.enable("libblend_blender", default_set=True)
-from libblend_blender import live, tree  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import addon_bench  # noqa: E402
 
-for o in list(bpy.data.objects):
-    bpy.data.objects.remove(o)
+addon_bench.start(ADDON_PARENT)
+from libblend_blender import live, tree  # noqa: E402
 ROUNDS = 9
 CENTRES = [(-1.75 + 0.5 * (q % 8), -1.75 + 0.5 * (q // 8 % 8), -1.75 + 0.5 * (q // 64))
            for q in range(512)]
@@ -74,20 +71,8 @@ def timed(res, cached):
     live.update_now(out)
     out.libblend.live = True
     st = live.state_of(out)
-    ts, meshes = [], []
-    for i in range(ROUNDS):
-        t0 = time.perf_counter()
-        mid.location.x += 0.04 if i % 2 == 0 else -0.04
-        live.mark_dirty(mid)
-        wait = live.tick()
-        while wait is not None and (st.dirty or st.job is not None):
-            time.sleep(wait)
-            wait = live.tick()
-        ts.append(time.perf_counter() - t0)
-        assert not st.error, st.status
-        meshes.append(st.last["mesh"])
-        while live.tick() is not None:  # the idle normals
-            time.sleep(live.TICK)
+    runs = addon_bench.live_moves(mid, st, ROUNDS, 0.04)
+    ts, meshes = [r[0] for r in runs], [r[1]["mesh"] for r in runs]
     out.libblend.live = False
     live._State.mesh_cache = with_cache
     cs = st.cache.stats if cached else (0, 0, 0, 0)
