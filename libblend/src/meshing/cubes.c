@@ -83,7 +83,7 @@ void lb__mctable_init(lb__mctable *t) {
                 const int p = FACE[f][q], r = FACE[f][(q + 1) & 3];
                 const int pin = (cfg >> p) & 1, rin = (cfg >> r) & 1;
                 if (pin == rin) continue;
-                ce[n] = lb__cube_edge_between(p, r);
+                ce[n] = LB__CUBE_EDGE_BETWEEN(p, r);
                 entry[n++] = !pin;
             }
             for (int q = 0; q < n; ++q)

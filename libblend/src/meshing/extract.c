@@ -1173,10 +1173,6 @@ struct tlscratch {
 };
 typedef struct tlscratch tlscratch;
 
-static inline int tl_corner(int o) {
-    return 2 * (o & 1) + 6 * ((o >> 1) & 1) + 18 * ((o >> 2) & 1);
-}
-
 static void tl_free(tlscratch *T) {
     if (!T) return;
     free(T->q);
@@ -1222,9 +1218,9 @@ static tlscratch *tl_new(void) {
     for (int e = 0; e < 12; ++e) {
         int p, q;
         lb__cube_edge(e, &p, &q);
-        T->elat[e][0] = (uint8_t)tl_corner(p);
-        T->elat[e][1] = (uint8_t)tl_corner(q);
-        T->elat[e][2] = (uint8_t)((tl_corner(p) + tl_corner(q)) / 2);
+        T->elat[e][0] = (uint8_t)LB__TCORNER(p);
+        T->elat[e][1] = (uint8_t)LB__TCORNER(q);
+        T->elat[e][2] = (uint8_t)((LB__TCORNER(p) + LB__TCORNER(q)) / 2);
     }
     for (int ci = 0; ci < TL_CELLS; ++ci) {
         const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
@@ -1267,15 +1263,14 @@ static tlscratch *tl_new(void) {
 }
 
 /* lattice node l (x + 3 y + 9 z, 0..2 each) of coarse cell c, as a local
- * node of B (a whole block: TL_D nodes a side; the offsets are a table,
+ * node of its block (a whole block: TL_D nodes a side; the offsets are a table,
  * these indices being the decisions' innermost work) */
 #define TL_O(l) ((l) / 9 * TL_D * TL_D + (l) / 3 % 3 * TL_D + (l) % 3)
 static const uint16_t TL_LATOFF[LB__TNODES] = {
     TL_O(0),  TL_O(1),  TL_O(2),  TL_O(3),  TL_O(4),  TL_O(5),  TL_O(6),  TL_O(7),  TL_O(8),
     TL_O(9),  TL_O(10), TL_O(11), TL_O(12), TL_O(13), TL_O(14), TL_O(15), TL_O(16), TL_O(17),
     TL_O(18), TL_O(19), TL_O(20), TL_O(21), TL_O(22), TL_O(23), TL_O(24), TL_O(25), TL_O(26)};
-static inline size_t tl_lat(const lb__block *B, const int c[3], int l) {
-    (void)B;
+static inline size_t tl_lat(const int c[3], int l) {
     return ((size_t)(2 * c[2]) * TL_D + (size_t)(2 * c[1])) * TL_D + (size_t)(2 * c[0]) +
            TL_LATOFF[l];
 }
@@ -1321,9 +1316,9 @@ static void tl_pattern(const tlscratch *T, int ci, lb__tcell *t) {
 static int tl_plane_pinch(const tlscratch *T, const lb__block *B, int ci, const int c[3]) {
     for (int e = 0; e < 12; ++e) {
         if (!((T->geom[ci].plane_split >> e) & 1)) continue;
-        const int ip = B->vals[tl_lat(B, c, T->elat[e][0])] < 0.0,
-                  iq = B->vals[tl_lat(B, c, T->elat[e][1])] < 0.0,
-                  im = B->vals[tl_lat(B, c, T->elat[e][2])] < 0.0;
+        const int ip = B->vals[tl_lat(c, T->elat[e][0])] < 0.0,
+                  iq = B->vals[tl_lat(c, T->elat[e][1])] < 0.0,
+                  im = B->vals[tl_lat(c, T->elat[e][2])] < 0.0;
         if (ip == iq && im != ip) return 1;
     }
     return 0;
@@ -1332,7 +1327,9 @@ static int tl_plane_pinch(const tlscratch *T, const lb__block *B, int ci, const 
 /* the lattice nodes pattern t reads: corners, split edges' midpoints,
  * quartered faces' centres (n of them into l) */
 static int tl_samples(const tlscratch *T, const lb__tcell *t, int *l) {
-    static const uint8_t CORNERS[8] = {0, 2, 6, 8, 18, 20, 24, 26},
+    static const uint8_t CORNERS[8] = {LB__TCORNER(0), LB__TCORNER(1), LB__TCORNER(2),
+                                       LB__TCORNER(3), LB__TCORNER(4), LB__TCORNER(5),
+                                       LB__TCORNER(6), LB__TCORNER(7)},
                          CENTRES[6] = {12, 14, 10, 16, 4, 22};
     int n = 0;
     for (int o = 0; o < 8; ++o) l[n++] = CORNERS[o];
@@ -1509,7 +1506,7 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
         if (!marked) continue;
         K->state = TL_TODO;
         for (int l = 0; l < LB__TNODES; ++l) /* mark() marks its boxes whole: cannot happen */
-            if (!B->nmask[tl_lat(B, c, l)]) K->state = TL_FINE;
+            if (!B->nmask[tl_lat(c, l)]) K->state = TL_FINE;
     }
     if (++T->rstamp == 0) { /* wrapped: clear the stamps once */
         for (size_t i = 0; i < TL_KEYS; ++i) T->root[i].stamp = 0;
@@ -1534,7 +1531,7 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             ++todo;
             int l[26];
             const int n = tl_samples(T, &t, l);
-            for (int i = 0; i < n; ++i) T->q[nq++] = tl_lat(B, c, l[i]);
+            for (int i = 0; i < n; ++i) T->q[nq++] = tl_lat(c, l[i]);
         }
         if (!todo) return LB_OK;
         lb_status s = tl_nodes(ev, g, B, C, nq, err);
@@ -1554,13 +1551,13 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             const int n = tl_samples(T, &K->t, l);
             K->t.inside = 0;
             for (int i = 0; i < n; ++i)
-                if (B->vals[tl_lat(B, c, l[i])] < 0.0) K->t.inside |= 1u << l[i];
+                if (B->vals[tl_lat(c, l[i])] < 0.0) K->t.inside |= 1u << l[i];
             if (tl_loops(T, K) < 0) {
                 K->state = TL_FINE; /* cannot happen (transition.c) */
                 continue;
             }
             if (!K->nloop)
-                for (int i = 0; i < LB__TNODES; ++i) T->q[nq++] = tl_lat(B, c, i);
+                for (int i = 0; i < LB__TNODES; ++i) T->q[nq++] = tl_lat(c, i);
         }
         s = tl_nodes(ev, g, B, C, nq, err);
         if (s) return s;
@@ -1572,11 +1569,11 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             if (K->state != TL_TODO) continue;
             const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
             if (!K->nloop) {
-                const int in0 = B->vals[tl_lat(B, c, 0)] < 0.0;
+                const int in0 = B->vals[tl_lat(c, 0)] < 0.0;
                 K->state = TL_OK;
                 K->ntri = 0;
                 for (int i = 1; i < LB__TNODES; ++i)
-                    if ((B->vals[tl_lat(B, c, i)] < 0.0) != in0) K->state = TL_FINE;
+                    if ((B->vals[tl_lat(c, i)] < 0.0) != in0) K->state = TL_FINE;
                 continue;
             }
             int total = 0;
@@ -1584,7 +1581,7 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             for (int i = 0; i < total; ++i) {
                 int a, b, d, len;
                 tl_sub(K->sub[i], &a, &b, &d, &len);
-                const size_t qa = tl_lat(B, c, a), qb = tl_lat(B, c, b);
+                const size_t qa = tl_lat(c, a), qb = tl_lat(c, b);
                 const uint16_t key = tl_key(qa, d, len);
                 K->key[i] = key;
                 if (T->root[key].stamp == T->rstamp) continue; /* solved, or queued */
@@ -1721,7 +1718,7 @@ static lb_status tl_cells(const lb_evaluator *ev, const lb__grid *g, lb__block *
     for (int ci = 0; ci < TL_CELLS; ++ci) {
         if (T->cell[ci].state != TL_FINE) continue;
         const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
-        for (int l = 0; l < LB__TNODES; ++l) T->q[nq++] = tl_lat(B, c, l);
+        for (int l = 0; l < LB__TNODES; ++l) T->q[nq++] = tl_lat(c, l);
     }
     s = tl_nodes(ev, g, B, C, nq, err);
     if (s) return s;
@@ -1754,8 +1751,8 @@ static lb_status tl_cells(const lb_evaluator *ev, const lb__grid *g, lb__block *
                 id = tl_coarse_edge(C, li, lj, lk, d);
             } else {
                 double cv[8] = {0};
-                cv[0] = B->vals[tl_lat(B, c, a)];
-                cv[1 << d] = B->vals[tl_lat(B, c, b)];
+                cv[0] = B->vals[tl_lat(c, a)];
+                cv[1 << d] = B->vals[tl_lat(c, b)];
                 id = lb__cell_edge(C, li, lj, lk, 0, 1 << d, cv);
             }
             if (id < 0) return lb__fail(err, LB_ERR_NO_MEMORY, "lb_mesh_create: out of memory");

@@ -504,13 +504,16 @@ static inline void lb__cube_edge(int e, int *p, int *q) {
     *p = P[e];
     *q = P[e] | 1 << (e >> 2);
 }
-/* The cube edge between corners p and q, which differ in one bit. */
-static inline int lb__cube_edge_between(int p, int q) {
-    const int lo = p < q ? p : q, a = p ^ q;
-    const int d = a >> 1 < 2 ? a >> 1 : 2; /* 1, 2, 4 -> 0, 1, 2 */
-    const int r = d == 0 ? lo >> 1 : d == 1 ? (lo & 1) | (lo >> 1 & 2) : lo;
-    return 4 * d + r;
-}
+/* The cube edge between corners p and q, which differ in one bit: its axis
+ * and the place of its lower corner among that axis's four edges. A
+ * constant expression (transition.c's face tables are built from it). */
+#define LB__CUBE_AXIS(p, q) (((p) ^ (q)) == 1 ? 0 : ((p) ^ (q)) == 2 ? 1 : 2)
+#define LB__CUBE_LO(p, q) ((p) < (q) ? (p) : (q))
+#define LB__CUBE_EDGE_BETWEEN(p, q)                                                                \
+    (4 * LB__CUBE_AXIS(p, q) + (LB__CUBE_AXIS(p, q) == 0 ? LB__CUBE_LO(p, q) >> 1                  \
+                                : LB__CUBE_AXIS(p, q) == 1                                         \
+                                    ? (LB__CUBE_LO(p, q) & 1) | (LB__CUBE_LO(p, q) >> 1 & 2)       \
+                                    : LB__CUBE_LO(p, q)))
 /* 1 when every loop of every case is a polygon of 3..LB__MAXPOLY vertices
  * with a triangulation off the cell's faces (the manifold argument in
  * cubes.c needs it), else 0. */
@@ -522,6 +525,8 @@ LB_INTERNAL int lb__mctable_check(const lb__mctable *t);
  * 3 x 3 x 3 fine-grid nodes in it, lattice node x + 3 y + 9 z (x, y, z in
  * 0..2; the body centre, 13, is never read). */
 #define LB__TNODES 27
+/* cube corner o (bit d: the far side along axis d) as a lattice node */
+#define LB__TCORNER(o) (2 * ((o)&1) + 6 * (((o) >> 1) & 1) + 18 * (((o) >> 2) & 1))
 /* most crossing sub-edges of one cell: 24 edge halves, 24 in the faces */
 #define LB__TMAX 48
 typedef struct lb__tcell {

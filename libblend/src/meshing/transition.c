@@ -48,14 +48,9 @@
  * its edges (corner q to q + 1) and those edges' cube numbers. */
 #define FACES(X)                                                                                   \
     { X(4, 6, 2, 0), X(1, 3, 7, 5), X(0, 1, 5, 4), X(6, 7, 3, 2), X(2, 3, 1, 0), X(4, 5, 7, 6) }
-#define CN(o) (2 * ((o)&1) + 6 * (((o) >> 1) & 1) + 18 * (((o) >> 2) & 1))
+#define CN(o) LB__TCORNER(o)
 #define MID(p, q) ((CN(p) + CN(q)) / 2)
-#define LO(p, q) ((p) < (q) ? (p) : (q))
-#define AXIS(p, q) (((p) ^ (q)) == 1 ? 0 : ((p) ^ (q)) == 2 ? 1 : 2)
-#define EB(p, q)                                                                                   \
-    (4 * AXIS(p, q) + (AXIS(p, q) == 0   ? LO(p, q) >> 1                                           \
-                       : AXIS(p, q) == 1 ? (LO(p, q) & 1) | (LO(p, q) >> 1 & 2)                    \
-                                         : LO(p, q)))
+#define EB(p, q) LB__CUBE_EDGE_BETWEEN(p, q)
 #define ROW_NODE(a, b, c, d)                                                                       \
     { CN(a), CN(b), CN(c), CN(d) }
 #define ROW_MID(a, b, c, d)                                                                        \
