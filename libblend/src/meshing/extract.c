@@ -1370,10 +1370,7 @@ static lb_status tl_eval(const lb_evaluator *ev, const lb__grid *g, const lb__bl
         for (int o = 0; o < 8 && !s; ++o) {
             const size_t a = start[o], m = start[o + 1] - a;
             if (!m) continue;
-            if (B->octmem)
-                lb__boxeval_load(ev, &B->oct[o], E);
-            else
-                lb__octant_narrow(ev, g, B, o, &C->S.outer, E);
+            lb__octant_plan(ev, g, B, o, &C->S.outer, E);
             s = lb__boxeval_run(ev, E, m, X + a, Y + a, Z + a, V + a, GX + a, GY + a, GZ + a, err);
         }
         for (size_t r = 0; r < n && !s; ++r) {

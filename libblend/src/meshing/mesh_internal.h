@@ -306,6 +306,12 @@ static inline void lb__octant_nodes(const lb__block *B, int o, uint32_t l0[3], u
  * octant o of B (lb__octant_nodes). */
 LB_INTERNAL void lb__octant_narrow(const lb_evaluator *ev, const lb__grid *g, const lb__block *B,
                                    int o, const lb__plan *outer, lb__boxeval *E);
+/* E's plan for octant o of B: mark()'s plan of that octant where the block
+ * kept them (B->octmem), else narrowed from outer (the block's plan, which
+ * the caller copied there before its first octant). The refinement and the
+ * two-level blocks' decisions evaluate octant by octant through it. */
+LB_INTERNAL void lb__octant_plan(const lb_evaluator *ev, const lb__grid *g, const lb__block *B,
+                                 int o, const lb__plan *outer, lb__boxeval *E);
 /* The box of the block's local nodes [l0, l1] (padded by 1e-9 of a cell). */
 LB_INTERNAL void lb__node_box(const lb__grid *g, const lb__block *B, const uint32_t l0[3],
                               const uint32_t l1[3], double bmin[3], double bmax[3]);

@@ -109,6 +109,14 @@ void lb__octant_narrow(const lb_evaluator *ev, const lb__grid *g, const lb__bloc
     lb__boxeval_narrow(ev, E, outer, omin, omax);
 }
 
+void lb__octant_plan(const lb_evaluator *ev, const lb__grid *g, const lb__block *B, int o,
+                     const lb__plan *outer, lb__boxeval *E) {
+    if (B->octmem) /* mark()'s plan of this octant */
+        lb__boxeval_load(ev, &B->oct[o], E);
+    else
+        lb__octant_narrow(ev, g, B, o, outer, E);
+}
+
 static lb_status refine_some(const lb_evaluator *ev, const lb__grid *g, lb__boxeval *E, size_t *act,
                              size_t na, const double *a, const double *b, const double *ga,
                              const double *gb, double tol, double *t, double *lo, double *hi,
@@ -181,10 +189,7 @@ lb_status lb__refine_edges(const lb_evaluator *ev, const lb__grid *g, const lb__
     for (int o = 0; o < ngroups && !s; ++o) {
         const size_t na = start[o + 1] - start[o];
         if (!na) continue;
-        if (narrow && B->octmem) /* mark()'s plan of this octant */
-            lb__boxeval_load(ev, &B->oct[o], E);
-        else if (narrow)
-            lb__octant_narrow(ev, g, B, o, &S->outer, E);
+        if (narrow) lb__octant_plan(ev, g, B, o, &S->outer, E);
         s = refine_some(ev, g, E, act + start[o], na, a, b, ga, gb, tol, t, lo, hi, x, y, z, v, gx,
                         gy, gz, pos, nrm, boxmax, err);
     }
