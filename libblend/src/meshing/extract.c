@@ -1102,7 +1102,8 @@ static inline int cut_cell(bctx *C, const lb__grid *g, const lb__block *B, uint3
 #define TL_POINTS ((size_t)TL_CELLS * LB__TMAX * 4)
 #define TL_NODES ((size_t)TL_CELLS * LB__TNODES)
 #define TL_D ((size_t)LB__MB + 1) /* a whole block's nodes a side */
-#define TL_MIDS (1u << 15)        /* > 2 TL_POINTS: the midpoints' table */
+#define TL_CHKS_BITS 13           /* the block's check points by their roots (tl_check) */
+#define TL_CHKS (1u << TL_CHKS_BITS)
 
 enum { TL_OFF, TL_TODO, TL_OK, TL_FINE };
 
@@ -1165,11 +1166,15 @@ struct tlscratch {
     size_t *pord;    /* tl_eval's grouping */
     uint8_t *pcell;  /* a check point's cell */
     uint8_t *pcell2; /* and the other cell whose triangles hold that edge (0xff: none) */
-    /* the round's edge midpoints by their two roots (tl_midpoint) */
-    struct tlmid {
-        uint32_t key, stamp, idx;
-    } mid[TL_MIDS];
-    uint32_t mstamp;
+    uint32_t *pslot; /* a check point's entry in chk (TL_NOSLOT: none) */
+    /* the block's check points by the roots they are made of (tl_check):
+     * this round's (info: TL_PENDING | index), the earlier rounds' results
+     * (TL_PASS, TL_FAIL) */
+    struct tlchk {
+        uint64_t key;
+        uint32_t stamp, info;
+    } chk[TL_CHKS];
+    uint32_t nchk; /* entries made in this block (at most TL_CHKS / 2) */
 };
 typedef struct tlscratch tlscratch;
 
@@ -1180,6 +1185,7 @@ static void tl_free(tlscratch *T) {
     free(T->x);
     free(T->pcell);
     free(T->pcell2);
+    free(T->pslot);
     free(T->poct);
     free(T->pord);
     free(T->known);
@@ -1194,10 +1200,12 @@ static tlscratch *tl_new(void) {
     T->x = malloc(14 * TL_POINTS * sizeof *T->x);
     T->pcell = malloc(TL_POINTS * sizeof *T->pcell);
     T->pcell2 = malloc(TL_POINTS * sizeof *T->pcell2);
+    T->pslot = malloc(TL_POINTS * sizeof *T->pslot);
     T->poct = malloc(TL_POINTS * sizeof *T->poct);
     T->pord = malloc(TL_POINTS * sizeof *T->pord);
     T->known = malloc(EMAP_SIZE);
-    if (!T->q || !T->ea || !T->x || !T->pcell || !T->pcell2 || !T->poct || !T->pord || !T->known) {
+    if (!T->q || !T->ea || !T->x || !T->pcell || !T->pcell2 || !T->pslot || !T->poct || !T->pord ||
+        !T->known) {
         tl_free(T);
         return NULL;
     }
@@ -1455,33 +1463,49 @@ static int tl_loops(tlscratch *T, tlcell *K) {
     return L->total;
 }
 
-/* The check point at the midpoint of the triangle edge between roots ka
- * and kb, for cell ci: a new one at T->x[*np], or the one this round
- * already has there (the other triangle on a diagonal, or the cell across
- * a face drawing the same segment), then checked for both cells. */
-static void tl_midpoint(tlscratch *T, uint16_t ka, uint16_t kb, const double *A, const double *Bp,
-                        int ci, uint8_t oct, size_t *np) {
-    const uint32_t key = ka < kb ? (uint32_t)ka << 16 | kb : (uint32_t)kb << 16 | ka;
-    uint32_t h = (key * 2654435761u) >> 17;
-    for (;; h = (h + 1) & (TL_MIDS - 1)) {
-        struct tlmid *M = &T->mid[h];
-        if (M->stamp != T->mstamp) {
-            M->stamp = T->mstamp;
+#define TL_PENDING 0x40000000u
+#define TL_PASS 0x80000000u
+#define TL_FAIL 0xc0000000u
+#define TL_NOSLOT 0xffffffffu
+
+/* The check point X (a triangle edge's midpoint or a triangle's centroid,
+ * made of the roots that key names) for cell ci. A point's place depends on
+ * its roots only, so it is checked once per block: a new point at
+ * T->x[*np]; or the one this round already has there (the other triangle
+ * on a diagonal, or the cell across a face drawing the same segment),
+ * then checked for both cells; or an earlier round's result (a cell
+ * re-decided with a changed pattern keeps most of its triangles). Returns
+ * 0 where an earlier round found the point off the surface: ci is fine. */
+static int tl_check(tlscratch *T, uint64_t key, const double X[3], int ci, uint8_t oct,
+                    size_t *np) {
+    uint32_t h = (uint32_t)((key * 0x9E3779B97F4A7C15ull) >> (64 - TL_CHKS_BITS)), slot = TL_NOSLOT;
+    for (;; h = (h + 1) & (TL_CHKS - 1)) {
+        struct tlchk *M = &T->chk[h];
+        if (M->stamp != T->rstamp) {
+            if (T->nchk >= TL_CHKS / 2) break; /* full: checked without an entry */
+            ++T->nchk;
+            M->stamp = T->rstamp;
             M->key = key;
-            M->idx = (uint32_t)*np;
+            M->info = TL_PENDING | (uint32_t)*np;
+            slot = h;
             break;
         }
         if (M->key != key) continue;
-        if (T->pcell[M->idx] != ci) T->pcell2[M->idx] = (uint8_t)ci;
-        return;
+        if (M->info == TL_PASS) return 1;
+        if (M->info == TL_FAIL) return 0;
+        const uint32_t i = M->info & ~TL_PENDING;
+        if (T->pcell[i] != ci) T->pcell2[i] = (uint8_t)ci;
+        return 1;
     }
     const size_t i = (*np)++;
-    T->x[i] = 0.5 * (A[0] + Bp[0]);
-    T->y[i] = 0.5 * (A[1] + Bp[1]);
-    T->z[i] = 0.5 * (A[2] + Bp[2]);
+    T->x[i] = X[0];
+    T->y[i] = X[1];
+    T->z[i] = X[2];
     T->poct[i] = oct;
     T->pcell[i] = (uint8_t)ci;
     T->pcell2[i] = 0xff;
+    T->pslot[i] = slot;
+    return 1;
 }
 
 /* The decisions (above). */
@@ -1507,8 +1531,10 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
     }
     if (++T->rstamp == 0) { /* wrapped: clear the stamps once */
         for (size_t i = 0; i < TL_KEYS; ++i) T->root[i].stamp = 0;
+        for (size_t i = 0; i < TL_CHKS; ++i) T->chk[i].stamp = 0;
         T->rstamp = 1;
     }
+    T->nchk = 0;
     memset(T->dirty, 1, sizeof T->dirty);
     memset(T->seen, 0, sizeof T->seen);
     for (int round = 0; round <= TL_CELLS; ++round) {
@@ -1602,20 +1628,13 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             memcpy(T->root[T->bkey[i]].pos, T->pos + 3 * i, 3 * sizeof(double));
             memcpy(T->root[T->bkey[i]].nrm, T->nrm + 3 * i, 3 * sizeof(double));
         }
-        /* the triangulations, the bow of their edges, the check points */
+        /* the triangulations and the bow of their edges; then the check
+         * points of the cells that pass */
         size_t np = 0;
-        if (++T->mstamp == 0) { /* wrapped: clear the stamps once */
-            for (size_t i = 0; i < TL_MIDS; ++i) T->mid[i].stamp = 0;
-            T->mstamp = 1;
-        }
         for (int ci = 0; ci < TL_CELLS; ++ci) {
             tlcell *K = &T->cell[ci];
             if (K->state != TL_TODO || !K->nloop) continue;
             K->ntri = 0;
-            const int half = TL_SIDE / 2;
-            const uint8_t oct =
-                (uint8_t)((ci % TL_SIDE >= half) | (ci / TL_SIDE % TL_SIDE >= half) << 1 |
-                          (ci / (TL_SIDE * TL_SIDE) >= half) << 2);
             for (int lp = 0, off = 0; lp < K->nloop && K->state == TL_TODO; off += K->len[lp++]) {
                 const int n = K->len[lp];
                 double P[3 * LB__TMAX], N[3 * LB__TMAX];
@@ -1630,7 +1649,6 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                     break;
                 }
                 for (int t = 0; t < nt && K->state == TL_TODO; ++t) {
-                    double mid[3] = {0, 0, 0};
                     for (int v = 0; v < 3; ++v) {
                         const int a = tri[3 * t + v], b = tri[3 * t + (v + 1) % 3];
                         K->tri[3 * K->ntri + v] = (uint8_t)(off + a);
@@ -1647,24 +1665,42 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                         const double lim = tol * hmin, ch = L * sqrt(2.0 * (1.0 - cs)) / 8.0;
                         if (ch > lim || (1.5707963267948966 * ch > lim && L * acos(cs) / 8.0 > lim))
                             K->state = TL_FINE;
-                        tl_midpoint(T, K->key[off + a], K->key[off + b], A, Bp, ci, oct, &np);
-                        for (int d = 0; d < 3; ++d) mid[d] += A[d] / 3.0;
                     }
-                    T->x[np] = mid[0];
-                    T->y[np] = mid[1];
-                    T->z[np] = mid[2];
-                    T->poct[np] = oct;
-                    T->pcell2[np] = 0xff;
-                    T->pcell[np++] = (uint8_t)ci;
                     ++K->ntri;
                 }
+            }
+            if (K->state != TL_TODO) continue;
+            const int half = TL_SIDE / 2;
+            const uint8_t oct =
+                (uint8_t)((ci % TL_SIDE >= half) | (ci / TL_SIDE % TL_SIDE >= half) << 1 |
+                          (ci / (TL_SIDE * TL_SIDE) >= half) << 2);
+            for (int t = 0; t < K->ntri && K->state == TL_TODO; ++t) {
+                double mid[3] = {0, 0, 0};
+                for (int v = 0; v < 3 && K->state == TL_TODO; ++v) {
+                    const uint16_t ka = K->key[K->tri[3 * t + v]],
+                                   kb = K->key[K->tri[3 * t + (v + 1) % 3]];
+                    const double *A = T->root[ka].pos, *Bp = T->root[kb].pos;
+                    const double X[3] = {0.5 * (A[0] + Bp[0]), 0.5 * (A[1] + Bp[1]),
+                                         0.5 * (A[2] + Bp[2])};
+                    if (!tl_check(T, ka < kb ? (uint64_t)ka << 16 | kb : (uint64_t)kb << 16 | ka, X,
+                                  ci, oct, &np))
+                        K->state = TL_FINE;
+                    for (int d = 0; d < 3; ++d) mid[d] += A[d] / 3.0;
+                }
+                if (K->state != TL_TODO) break;
+                const uint64_t key = 1ull << 63 | (uint64_t)K->key[K->tri[3 * t]] << 32 |
+                                     (uint64_t)K->key[K->tri[3 * t + 1]] << 16 |
+                                     K->key[K->tri[3 * t + 2]];
+                if (!tl_check(T, key, mid, ci, oct, &np)) K->state = TL_FINE;
             }
         }
         s = tl_eval(ev, g, B, C, np, err);
         if (s) return s;
         for (size_t i = 0; i < np; ++i) {
             const double gl = sqrt(T->gx[i] * T->gx[i] + T->gy[i] * T->gy[i] + T->gz[i] * T->gz[i]);
-            if (fabs(T->v[i]) <= tol * hmin * gl) continue;
+            const int pass = fabs(T->v[i]) <= tol * hmin * gl;
+            if (T->pslot[i] != TL_NOSLOT) T->chk[T->pslot[i]].info = pass ? TL_PASS : TL_FAIL;
+            if (pass) continue;
             if (T->cell[T->pcell[i]].state == TL_TODO) T->cell[T->pcell[i]].state = TL_FINE;
             if (T->pcell2[i] != 0xff && T->cell[T->pcell2[i]].state == TL_TODO)
                 T->cell[T->pcell2[i]].state = TL_FINE;
