@@ -101,6 +101,10 @@ struct lb_mesh_cache {
         void *p;
         size_t bytes;
     } run[LB__RUN_SLOTS];
+    /* the threads' coarse-first scratch, kept for the next run
+     * (lb__cache_tl_take, lb__cache_tl_keep) */
+    void *tl[LB__TL_KEEP];
+    size_t ntl;
 };
 
 /* The matching of an evaluator against the cache (mesher.c's rule):
@@ -728,7 +732,7 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     slab_settle(C);
     for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
     for (size_t i = 0; i < nnodes; ++i) bytes += cblock_bytes(&nodes[i]);
-    bytes += spare_bytes(C) + run_bytes(C) + C->slab_bytes +
+    bytes += spare_bytes(C) + run_bytes(C) + C->ntl * lb__tl_bytes() + C->slab_bytes +
              (C->slabcap + C->idlecap) * sizeof(lb__slab *) +
              (C->nslabs + C->nidle) * sizeof(lb__slab);
     C->stats.blocks = n;
@@ -775,6 +779,22 @@ void lb__cache_run_keep(lb_mesh_cache *C, int slot, void *p, size_t bytes) {
     C->stats.bytes += C->run[slot].bytes;
 }
 
+void *lb__cache_tl_take(lb_mesh_cache *C) {
+    if (!C->ntl) return NULL;
+    C->stats.bytes -= lb__tl_bytes();
+    return C->tl[--C->ntl];
+}
+
+void lb__cache_tl_keep(lb_mesh_cache *C, void *tl) {
+    if (!tl) return;
+    if (C->ntl == LB__TL_KEEP) {
+        lb__tl_free(tl);
+        return;
+    }
+    C->tl[C->ntl++] = tl;
+    C->stats.bytes += lb__tl_bytes();
+}
+
 /* ---- the public side ---- */
 
 lb_status lb_mesh_cache_create(lb_mesh_cache **out, lb_error *err) {
@@ -815,6 +835,7 @@ void lb_mesh_cache_free(lb_mesh_cache *C) {
     if (!C) return;
     spare_free(C);
     for (int i = 0; i < LB__RUN_SLOTS; ++i) free(C->run[i].p);
+    for (size_t i = 0; i < C->ntl; ++i) lb__tl_free(C->tl[i]);
     blocks_free(C);
     slabs_free(C);
     lb__recs_free(&C->full);

@@ -1192,6 +1192,22 @@ static void tl_free(tlscratch *T) {
     free(T);
 }
 
+void *lb__bctx_tl_swap(lb__bctx *C, void *tl) {
+    void *had = C->tl;
+    C->tl = tl;
+    return had;
+}
+
+void lb__tl_free(void *tl) {
+    tl_free(tl);
+}
+
+size_t lb__tl_bytes(void) {
+    return sizeof(tlscratch) + TL_NODES * sizeof(size_t) + 20 * TL_EDGES * sizeof(double) +
+           14 * TL_POINTS * sizeof(double) + TL_POINTS * (3 + sizeof(size_t) + sizeof(uint32_t)) +
+           EMAP_SIZE;
+}
+
 static tlscratch *tl_new(void) {
     tlscratch *T = calloc(1, sizeof *T);
     if (!T) return NULL;

@@ -238,6 +238,21 @@ LB_INTERNAL void lb__cache_take_spare(lb_mesh_cache *C, lb_mesh *M, size_t *vcap
 #define LB__RUN_SLOTS 16
 LB_INTERNAL void *lb__cache_run_take(lb_mesh_cache *C, int slot, size_t bytes, size_t *got);
 LB_INTERNAL void lb__cache_run_keep(lb_mesh_cache *C, int slot, void *p, size_t bytes);
+/* The coarse-first decisions' scratch of a thread (extract.c: a few MiB of
+ * tables, most of them found by stamps, and the loops' answers by pattern),
+ * kept by the cache from one run to the next as the arrays above are: made
+ * afresh, it was the larger part of a live update's coarse-first cost at
+ * 64 cells (its pages mapped and zeroed every run; docs/meshing.md, Coarse
+ * first). lb__cache_tl_take hands out one kept scratch (NULL: none);
+ * lb__cache_tl_keep takes one back (freed beyond LB__TL_KEEP). Counted in
+ * the cache's bytes. lb__bctx_tl_swap puts tl into a thread's context and
+ * returns the one it had (the context frees the one it holds at the end);
+ * lb__tl_free frees one (NULL is fine), lb__tl_bytes is one's size. */
+#define LB__TL_KEEP 64
+LB_INTERNAL void *lb__cache_tl_take(lb_mesh_cache *C);
+LB_INTERNAL void lb__cache_tl_keep(lb_mesh_cache *C, void *tl);
+LB_INTERNAL void lb__tl_free(void *tl);
+LB_INTERNAL size_t lb__tl_bytes(void);
 
 /* The facing of triangle (a, b, c): (b - a) x (c - a), not normalised
  * (features.c's flips and folds, corners.c). */
@@ -380,6 +395,8 @@ LB_INTERNAL lb_status lb__mesh_block(const lb_evaluator *ev, const lb__grid *g, 
  * lb__bctx_free (NULL is fine). */
 LB_INTERNAL lb__bctx *lb__bctx_new(const lb_evaluator *ev);
 LB_INTERNAL void lb__bctx_free(lb__bctx *C);
+/* (lb__cache_tl_take) */
+LB_INTERNAL void *lb__bctx_tl_swap(lb__bctx *C, void *tl);
 LB_INTERNAL lb__mscratch *lb__bctx_scratch(lb__bctx *C);
 
 /* Safeguarded, batched root solve of phi_c along n grid edges: a[i] inside

@@ -1656,6 +1656,8 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         for (R.nctx = 0; R.nctx < nt; ++R.nctx)
             if (!(R.ctx[R.nctx] = lb__bctx_new(ev))) break;
     if (!M || !R.ctx || R.nctx < nt) s = lb__fail(err, LB_ERR_NO_MEMORY, "%s: out of memory", FN);
+    if (cache && g.coarse > 0.0) /* the decisions' scratch the last run kept */
+        for (size_t t = 0; t < R.nctx; ++t) lb__bctx_tl_swap(R.ctx[t], lb__cache_tl_take(cache));
     /* with simplification, the blocks take the first half of the bar and
      * the simplification (often several times the meshing) the second */
     P.weight = opt->simplify > 0.0 && !(g.coarse > 0.0) ? 0.45 : 0.90;
@@ -1773,7 +1775,10 @@ lb_status lb_mesh_create_cached(const lb_evaluator *ev, const lb_mesh_options *o
         plan_drop(B);
     }
     run_free(&R, RS_SORTED, R.blocks);
-    for (size_t t = 0; t < R.nctx; ++t) lb__bctx_free(R.ctx[t]);
+    for (size_t t = 0; t < R.nctx; ++t) {
+        if (cache) lb__cache_tl_keep(cache, lb__bctx_tl_swap(R.ctx[t], NULL));
+        lb__bctx_free(R.ctx[t]);
+    }
     free(R.ctx);
     for (size_t i = 0; i < R.nall; ++i) free(R.all[i]);
     run_free(&R, RS_ALL, R.all);
