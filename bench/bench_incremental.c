@@ -12,7 +12,8 @@
  * bytes.
  * bench/incremental/run_incremental_bench.py runs it.
  *
- * Usage: bench_incremental BEFORE AFTER RESOLUTION THREADS [--features] */
+ * Usage: bench_incremental BEFORE AFTER RESOLUTION THREADS [--features]
+ *                          [--simplify TOL [--coarse-first]] */
 #define _POSIX_C_SOURCE 200809L
 #include <libblend/libblend.h>
 
@@ -38,12 +39,22 @@ static int same(const lb_mesh *a, const lb_mesh *b) {
 
 int main(int argc, char **argv) {
     unsigned flags = 0;
+    double simplify = 0.0;
+    if (argc > 1 && strcmp(argv[argc - 1], "--coarse-first") == 0) {
+        flags |= LB_MESH_COARSE_FIRST;
+        --argc;
+    }
+    if (argc > 2 && strcmp(argv[argc - 2], "--simplify") == 0) {
+        simplify = atof(argv[argc - 1]);
+        argc -= 2;
+    }
     if (argc == 6 && strcmp(argv[5], "--features") == 0) {
-        flags = LB_MESH_FEATURES;
+        flags |= LB_MESH_FEATURES;
         --argc;
     }
     if (argc != 5) {
-        fprintf(stderr, "usage: bench_incremental BEFORE AFTER RESOLUTION THREADS [--features]\n");
+        fprintf(stderr, "usage: bench_incremental BEFORE AFTER RESOLUTION THREADS [--features] "
+                        "[--simplify TOL [--coarse-first]]\n");
         return 2;
     }
     lb_error e = {LB_OK, ""};
@@ -85,6 +96,7 @@ int main(int argc, char **argv) {
     o.resolution = (unsigned)atoi(argv[3]);
     o.threads = atoi(argv[4]);
     o.flags = flags;
+    o.simplify = simplify;
     double full = 1e30, inc = 1e30, fresh = 1e30;
     lb_mesh *mf = NULL, *mi = NULL, *mn = NULL;
     lb_mesh_cache_stats st = {0, 0, 0, 0};
