@@ -58,3 +58,12 @@ def threads():
     """Threads for meshing and evaluation (0: one per CPU)."""
     p = prefs()
     return p.threads if p else 0
+
+
+VIEWPORT_SIMPLIFY = 0.0  # the preference's default (ui.py): off
+
+
+def viewport_simplify():
+    """The Viewport Simplify preference, cells (0: off)."""
+    p = prefs()
+    return p.viewport_simplify if p else VIEWPORT_SIMPLIFY

@@ -389,19 +389,36 @@ def region_of(output):
     return _region(output)
 
 
-def prepare(output, resolution, depsgraph=None):
+def viewport_simplify(output):
+    """The tolerance (cells) the Viewport Simplify preference gives the
+    field's viewport mesh: the preference where the field's own Simplify is
+    0 and Sharp Features off (Coarse First cannot keep creases, and the
+    collapses cost more than they save while editing), else 0."""
+    s = output.libblend
+    if s.simplify > 0.0 or s.sharp_features:
+        return 0.0
+    return max(0.0, min(1.0, float(libhandle.viewport_simplify())))
+
+
+def prepare(output, resolution, depsgraph=None, viewport=False):
     """Read the tree (main thread) into a _Job; raises tree.TreeError or
     binding.LibraryError. With a depsgraph the values are that depsgraph's
-    (a render's frame), else the objects' own."""
+    (a render's frame), else the objects' own. viewport: the mesh is the
+    viewport's (live updates, playback), where the Viewport Simplify
+    preference applies (viewport_simplify); renders, bakes and Apply mesh
+    with the field's own settings."""
     lib = libhandle.library()
     text, paths = tree.to_json(output, depsgraph, render=False, compact=True)
     bmin, bmax = _region(output)
+    s = output.libblend
+    simplify, coarse = s.simplify, s.simplify_method == "COARSE"
+    if viewport and viewport_simplify(output) > 0.0:
+        simplify, coarse = viewport_simplify(output), True
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
-                output.libblend.open_boundary, libhandle.threads(), paths,
-                fit=output.libblend.fit_region, features=output.libblend.sharp_features,
-                simplify=output.libblend.simplify, cache=_state(output.name).mesh_cache(lib),
-                merge_flat=output.libblend.merge_flat,
-                coarse_first=output.libblend.simplify_method == "COARSE")
+                s.open_boundary, libhandle.threads(), paths,
+                fit=s.fit_region, features=s.sharp_features,
+                simplify=simplify, cache=_state(output.name).mesh_cache(lib),
+                merge_flat=s.merge_flat, coarse_first=coarse)
 
 
 def _finish(output, st, job, t_start, defer_normals=False):
@@ -456,7 +473,7 @@ def update_now(output, final=False, depsgraph=None, force=True):
         st.job.cancel.cancel()
     try:
         job = prepare(output, output.libblend.render_resolution if final
-                      else output.libblend.preview_resolution, depsgraph)
+                      else output.libblend.preview_resolution, depsgraph, viewport=not final)
     except (tree.TreeError, binding.LibraryError) as e:
         st.status, st.error = str(e), True
         return False, str(e)
@@ -632,7 +649,7 @@ def tick():
             if out.libblend.use_bake and from_cache(out, bpy.context.scene.frame_current)[0]:
                 continue  # scrubbing a baked field: its frame's file
             try:
-                job = prepare(out, out.libblend.preview_resolution)
+                job = prepare(out, out.libblend.preview_resolution, viewport=True)
             except (tree.TreeError, binding.LibraryError) as e:
                 st.status, st.error = str(e), True
                 continue

@@ -1,8 +1,15 @@
 """The sidebar panel (View3D > N > libblend), menus and add-on preferences."""
 import bpy
-from bpy.props import IntProperty, StringProperty
+from bpy.props import FloatProperty, IntProperty, StringProperty
 
 from . import libhandle, live, tree
+
+
+def _viewport_simplify_changed(self, context):
+    """Every live field's viewport mesh follows the new value."""
+    for obj in bpy.data.objects:
+        if tree.is_node(obj) and obj.libblend.kind == "OUTPUT":
+            live.mark_dirty(obj)
 
 
 class LIBBLEND_AP_preferences(bpy.types.AddonPreferences):
@@ -13,11 +20,20 @@ class LIBBLEND_AP_preferences(bpy.types.AddonPreferences):
                                  "copy (empty: $LIBBLEND_LIBRARY, then the add-on's lib/)")
     threads: IntProperty(name="Threads", default=0, min=0, max=256,
                          description="meshing threads (0 = one per CPU, 1 = no extra threads)")
+    viewport_simplify: FloatProperty(
+        name="Viewport Simplify", default=0.0, min=0.0, max=1.0, step=5, precision=2,
+        update=_viewport_simplify_changed,
+        description="the viewport's meshes of fields whose Simplify is 0 and Sharp Features off: "
+        "cells of twice the size wherever the surface stays within this many cells of the field "
+        "(Coarse First): fewer triangles, faster updates when a primitive moves, slower ones "
+        "when a change remeshes the whole field. Renders, bakes and Apply are not simplified. "
+        "0 = off")
 
     def draw(self, context):
         col = self.layout.column()
         col.prop(self, "library_path")
         col.prop(self, "threads")
+        col.prop(self, "viewport_simplify")
         _library_box(col)
 
 
@@ -130,6 +146,11 @@ class LIBBLEND_PT_panel(bpy.types.Panel):
         layout.prop(s, "simplify")
         if s.simplify > 0.0:
             layout.prop(s, "simplify_method")
+        else:
+            vs = live.viewport_simplify(obj)
+            if vs > 0.0:  # the preference at work: say so where Simplify is
+                layout.label(text="Viewport: Coarse First %.2g cells (Preferences)" % vs,
+                             icon="INFO")
         box = layout.box()
         box.label(text="Bake (render resolution, one file per frame)")
         box.prop(s, "bake_dir")

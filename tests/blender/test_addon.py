@@ -46,6 +46,10 @@ assert ok, msg
 print("library:", msg)
 lib = libhandle.library()
 check, active, activate = addon_env.check, addon_env.active, addon_env.activate
+# Viewport Simplify ships off (its own section below): viewport meshes are
+# the unsimplified ones the checks compare them with
+check(libhandle.prefs().viewport_simplify == libhandle.VIEWPORT_SIMPLIFY == 0.0,
+      "Viewport Simplify ships off (%r)" % libhandle.prefs().viewport_simplify)
 
 
 def blender_mesh(obj):
@@ -474,7 +478,8 @@ draw(lbb.ui.LIBBLEND_PT_panel, b2)
 fake = type("Prefs", (), {"layout": Recorder(), "bl_rna": libhandle.prefs().bl_rna})()
 lbb.ui.LIBBLEND_AP_preferences.draw(fake, bpy.context)
 check({"bounds_min", "preview_resolution", "radius", "arg_r", "bulge_omega",
-       "libblend.update_mesh", "libblend.export_pov"} <= set(Recorder.drawn), "the panel shows them")
+       "libblend.update_mesh", "libblend.export_pov", "viewport_simplify"} <= set(Recorder.drawn),
+      "the panel and the preferences show them")
 
 # without a library the panel shows the reason and the reload button, nothing else
 os.environ["LIBBLEND_LIBRARY"] = os.path.join(WORK, "gone", "libblend.so")
@@ -1220,10 +1225,10 @@ check(live.update_now(lat)[0], "mesh the lattice with one sphere moved")
 blocks, reused, _recycled, nbytes = live.state_of(lat).cache.stats
 
 
-def same_as_full(obj, res):
+def same_as_full(obj, res, viewport=False):
     """is obj's Blender mesh the one a full remesh (no cache, a fresh compile) gives?"""
     V, F = blender_mesh(obj)
-    full = live.prepare(obj, res)
+    full = live.prepare(obj, res, viewport=viewport)
     full.cache = None
     full.run()
     return (not full.error and V.shape == full.mesh.positions.shape and
@@ -1262,6 +1267,46 @@ check(cf_job.coarse_first and cf_job.key != collapse_key, "Simplify's method is 
 check(same_as_full(lat, 96), "Coarse First through the cache: the full remesh's mesh")
 lat.libblend.simplify, lat.libblend.simplify_method = 0.0, "COLLAPSE"
 check(not live.prepare(lat, 96).coarse_first, "Simplify off: no Coarse First")
+
+# Viewport Simplify (an add-on preference, off as shipped) at 0.5 cells:
+# the viewport's mesh of a field without Simplify and Sharp Features is
+# meshed Coarse First (docs/blender.md); renders, bakes and Apply are not
+# simplified; the field's own Simplify and Sharp Features take precedence;
+# 0 turns it off; the sidebar says so under Simplify.
+check(live.viewport_simplify(lat) == 0.0, "Viewport Simplify off: nothing for the lattice")
+libhandle.prefs().viewport_simplify = 0.5
+check(live.viewport_simplify(lat) == 0.5, "Viewport Simplify applies to the lattice")
+check(live.update_now(lat)[0], "mesh the lattice's viewport mesh with Viewport Simplify")
+Vv, Fv = blender_mesh(lat)
+iv = meshcheck.check(Vv, Fv)
+vjob = live.prepare(lat, 96, viewport=True)
+print("Viewport Simplify on the lattice at 96 cells: %d triangles (without %d)"
+      % (len(Fv), plain_tris))
+check(iv["closed"] and iv["manifold"] and iv["oriented"] and 0 < len(Fv) < 0.8 * plain_tris,
+      "Viewport Simplify: closed, oriented, manifold, %d triangles against %d" % (
+          len(Fv), plain_tris))
+check(vjob.coarse_first and vjob.simplify == 0.5 and vjob.key == live.state_of(lat).applied_key,
+      "the viewport mesh is Coarse First at 0.5 cells, and so keyed")
+check(same_as_full(lat, 96, viewport=True), "Viewport Simplify: the full remesh's mesh")
+final = live.prepare(lat, 96)
+check(not final.coarse_first and final.simplify == 0.0,
+      "renders, bakes and Apply (not the viewport) are not simplified")
+lat.libblend.simplify = 0.25  # the field's own Simplify (Collapse) wins
+own = live.prepare(lat, 96, viewport=True)
+check(own.simplify == 0.25 and not own.coarse_first, "the field's own Simplify takes precedence")
+lat.libblend.simplify = 0.0
+lat.libblend.sharp_features = True
+check(not live.prepare(lat, 96, viewport=True).coarse_first,
+      "Sharp Features: no Viewport Simplify (Coarse First cannot keep creases)")
+lat.libblend.sharp_features = False
+Recorder.drawn = []
+draw(lbb.ui.LIBBLEND_PT_panel, lat)
+check("label:Viewport: Coarse First 0.5 cells (Preferences)" in Recorder.drawn,
+      "the sidebar names Viewport Simplify under Simplify")
+libhandle.prefs().viewport_simplify = 0.0
+check(not live.prepare(lat, 96, viewport=True).coarse_first, "Viewport Simplify 0: off")
+check(live.update_now(lat)[0] and len(lat.data.polygons) == plain_tris,
+      "off again: the unsimplified viewport mesh")
 
 # The field's last evaluator is kept too: the next compile copies the
 # curves of the local unions whose children did not change (a flat local
