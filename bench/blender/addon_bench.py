@@ -10,10 +10,12 @@ import bpy
 
 
 def start(addon_parent):
-    """enable the add-on found under addon_parent; remove every object"""
+    """enable the add-on found under addon_parent, with Viewport Simplify
+    off (each benchmark sets the options it compares); remove every object"""
     sys.path.insert(0, addon_parent)
     os.environ.pop("LIBBLEND_LIBRARY", None)
     addon_utils.enable("libblend_blender", default_set=True)
+    bpy.context.preferences.addons["libblend_blender"].preferences.viewport_simplify = 0.0
     for o in list(bpy.data.objects):
         bpy.data.objects.remove(o)
 

@@ -7,7 +7,10 @@
    set (its update callback marks the field dirty), then the add-on's own
    timer function runs as Blender's main loop would (again after the
    interval it returns) until the new mesh is in the Blender mesh. The analytic normals that follow once the
-   field is idle (0.3 s later) are timed separately. 15 changes each.
+   field is idle (0.3 s later) are timed separately. 15 changes each. The
+   same with the add-on's Viewport Simplify preference at 0.5 cells (Coarse
+   First; it ships off), and both again at 128 cells: a blend parameter
+   remeshes every block, the case where Coarse First gains least.
 2. Next to it, Blender's own metaballs: the same balls (S1 / S2 placement,
    radii matched as in bench/mesh/blender_metaballs.py), polygonized at the
    same cell size, time of the depsgraph update after changing one ball.
@@ -31,7 +34,8 @@ ADDON_PARENT, SRC = argv[:2]
 sys.path.insert(0, ADDON_PARENT)
 os.environ.pop("LIBBLEND_LIBRARY", None)
 addon_utils.enable("libblend_blender", default_set=True)
-from libblend_blender import live  # noqa: E402
+PREFS = bpy.context.preferences.addons["libblend_blender"].preferences
+from libblend_blender import libhandle, live  # noqa: E402
 
 for o in list(bpy.data.objects):
     bpy.data.objects.remove(o)
@@ -46,10 +50,14 @@ def report(**kw):
     print("BENCH " + json.dumps(kw), flush=True)
 
 
-def live_update(name, scene_file):
+def live_update(name, scene_file, viewport_simplify=0.0, cells=64):
+    """the live update of name's blend parameter (every block remeshed);
+    viewport_simplify: the add-on's Viewport Simplify preference (0, as
+    shipped: the unsimplified mesh)"""
+    PREFS.viewport_simplify = viewport_simplify
     bpy.ops.libblend.import_scene(filepath=os.path.join(SRC, "scenes", scene_file))
     out = bpy.context.view_layer.objects.active
-    out.libblend.preview_resolution = 64
+    out.libblend.preview_resolution = cells
     live.update_now(out)
     root = [c for c in out.children if c.libblend.kind == "BLEND"][0]
     r0 = root.libblend.r
@@ -69,14 +77,18 @@ def live_update(name, scene_file):
         assert not st.error, st.status
         parts.append(st.last)
     tris = len(out.data.polygons)
-    report(what="live update", scene=name, cells=64, triangles=tris,
+    report(what="live update" if not viewport_simplify else "live update, viewport simplify",
+           scene=name, cells=cells, triangles=tris,
            median_ms=1000 * statistics.median(times), max_ms=1000 * max(times),
            libblend_ms=1000 * statistics.median(p["mesh"] for p in parts),
            apply_ms=1000 * statistics.median(p["apply"] for p in parts))
+    if viewport_simplify or cells != 64:
+        bpy.data.objects.remove(out)
+        return None
     job = live.prepare(out, 64)
     job.run()
     t0 = time.perf_counter()
-    live.set_normals(out.data, job.mesh.normals)
+    live.set_normals(out.data, job.mesh)
     out.data.update()
     report(what="idle analytic normals", scene=name, ms=1000 * (time.perf_counter() - t0))
     # the synchronous path (Update button, renders)
@@ -124,12 +136,18 @@ def metaballs(name, res):
 
 
 s1 = live_update("S1", "bench-s1-three-spheres.json")
+live_update("S1", "bench-s1-three-spheres.json", 0.5)
 metaballs("S1", 64)
 s2 = live_update("S2", "bench-s2-64-spheres.json")
+live_update("S2", "bench-s2-64-spheres.json", 0.5)
 metaballs("S2", 64)
+for vs in (0.0, 0.5):  # the same at 128 cells
+    live_update("S1", "bench-s1-three-spheres.json", vs, 128)
+    live_update("S2", "bench-s2-64-spheres.json", vs, 128)
+PREFS.viewport_simplify = 0.0
 
 # ---- 1M triangles into a Blender mesh
-lib = live.library()
+lib = libhandle.library()
 with lib.load_scene(os.path.join(SRC, "scenes", "bench-s2-64-spheres.json")) as sc, \
         sc.compile() as ev:
     big = ev.mesh(*sc.bounds, resolution=260)
@@ -155,14 +173,25 @@ metaballs("S2", 260)
 # ---- the table (docs/blender.md)
 R = {(r["what"], r.get("scene"), r.get("normals"), r.get("cells")): r for r in RESULTS}
 print("\n| scene (64 cells) | libblend live update: median / max | of which libblend / Blender mesh "
-      "data | idle analytic normals | Blender metaballs update | ratio |")
-print("|---|---|---|---|---|---|")
+      "data | idle analytic normals | with Viewport Simplify 0.5: median / max | "
+      "Blender metaballs update | ratio (without / with Viewport Simplify) |")
+print("|---|---|---|---|---|---|---|")
 for sc in ("S1", "S2"):
     lu, mb = R[("live update", sc, None, 64)], R[("metaball update", sc, None, 64)]
+    dv = R[("live update, viewport simplify", sc, None, 64)]
     nm = R[("idle analytic normals", sc, None, None)]
-    print("| %s | %.0f / %.0f ms (%d triangles) | %.0f / %.0f ms | %.0f ms | %.1f ms (%d quads) | %.1fx |"
+    print("| %s | %.0f / %.0f ms (%d triangles) | %.0f / %.0f ms | %.0f ms | %.0f / %.0f ms (%d "
+          "triangles) | %.1f ms (%d quads) | %.1fx / %.1fx |"
           % (sc, lu["median_ms"], lu["max_ms"], lu["triangles"], lu["libblend_ms"], lu["apply_ms"],
-             nm["ms"], mb["median_ms"], mb["faces"], lu["median_ms"] / mb["median_ms"]))
+             nm["ms"], dv["median_ms"], dv["max_ms"], dv["triangles"], mb["median_ms"], mb["faces"],
+             lu["median_ms"] / mb["median_ms"], dv["median_ms"] / mb["median_ms"]))
+print("\n| scene (128 cells) | live update: median / max | with Viewport Simplify 0.5 | ratio |")
+print("|---|---|---|---|")
+for sc in ("S1", "S2"):
+    lu, dv = R[("live update", sc, None, 128)], R[("live update, viewport simplify", sc, None, 128)]
+    print("| %s | %.0f / %.0f ms (%d triangles) | %.0f / %.0f ms (%d triangles) | %.2fx |"
+          % (sc, lu["median_ms"], lu["max_ms"], lu["triangles"], dv["median_ms"], dv["max_ms"],
+             dv["triangles"], dv["median_ms"] / lu["median_ms"]))
 print("\n| moving %d triangles into a Blender mesh | seconds |" % nt)
 print("|---|---|")
 for k in ("FACES", "ANALYTIC", "from_pydata baseline"):

@@ -38,6 +38,8 @@ ADDON_PARENT, SRC = argv[:2]
 sys.path.insert(0, ADDON_PARENT)
 os.environ.pop("LIBBLEND_LIBRARY", None)
 addon_utils.enable("libblend_blender", default_set=True)
+# Viewport Simplify off: the configurations below say what they simplify
+bpy.context.preferences.addons["libblend_blender"].preferences.viewport_simplify = 0.0
 from libblend_blender import libhandle, live  # noqa: E402
 
 for o in list(bpy.data.objects):
