@@ -1122,7 +1122,6 @@ typedef struct tlcell {
  * (the same inputs to lb__refine_edges, the same bytes). Keyed by the
  * sub-edge's lower node, axis and length (tl_key). */
 typedef struct tlroot {
-    uint32_t stamp; /* T->rstamp: solved in this block */
     double pos[3], nrm[3];
 } tlroot;
 #define TL_KEYS (TL_D * TL_D * TL_D * 6)
@@ -1139,7 +1138,6 @@ typedef struct tlgeom {
  * cells, blocks and rounds (key + 1; 0: empty) */
 #define TL_LCACHE 4096u
 typedef struct tlloops {
-    uint64_t key;
     int16_t total;
     uint8_t nloop;
     uint8_t len[LB__TMAX / 3];
@@ -1148,10 +1146,14 @@ typedef struct tlloops {
 
 struct tlscratch {
     tlcell cell[TL_CELLS];
+    uint64_t lkey[TL_LCACHE]; /* apart from the answers: most lookups miss */
     tlloops lcache[TL_LCACHE];
     tlgeom geom[TL_CELLS];
     uint8_t elat[12][3]; /* cube edge e's lattice nodes: its ends, its midpoint */
     tlroot root[TL_KEYS];
+    /* T->rstamp: the root is solved in this block (apart from root: the
+     * decisions test these far more often than they read a root) */
+    uint32_t rdone[TL_KEYS];
     uint32_t rstamp;
     uint16_t bkey[TL_EDGES]; /* the round's batch: each sub-edge's key */
     uint8_t *known;          /* the block's own edges solved in the decisions */
@@ -1312,22 +1314,26 @@ static void tl_node_pos(const lb__grid *g, const lb__block *B, size_t q, double 
                  (uint64_t)B->b[2] * LB__MB + q / (D0 * D1), X);
 }
 
-static inline int tl_is_fine(const tlscratch *T, uint8_t ci) {
-    return ci != 0xff && T->cell[ci].state == TL_FINE;
+_Static_assert(TL_CELLS == 64, "a block's fine cells as one 64-bit mask");
+
+/* whether cell ci (0xff: none) is fine in mask fine (bit ci) */
+static inline int tl_is_fine(uint64_t fine, uint8_t ci) {
+    return ci != 0xff && (fine >> ci) & 1u;
 }
 
 /* coarse cell ci's splits: on the block's boundary planes, and where a fine
- * cell is around an edge or across a face */
-static void tl_pattern(const tlscratch *T, int ci, lb__tcell *t) {
+ * cell (fine: the cells turned fine, a bit each) is around an edge or
+ * across a face */
+static void tl_pattern(const tlscratch *T, uint64_t fine, int ci, lb__tcell *t) {
     const tlgeom *G = &T->geom[ci];
     t->split = G->plane_split;
     t->quarter = G->plane_quarter;
     for (int e = 0; e < 12; ++e)
-        if (tl_is_fine(T, G->enbr[e][0]) || tl_is_fine(T, G->enbr[e][1]) ||
-            tl_is_fine(T, G->enbr[e][2]))
+        if (tl_is_fine(fine, G->enbr[e][0]) || tl_is_fine(fine, G->enbr[e][1]) ||
+            tl_is_fine(fine, G->enbr[e][2]))
             t->split |= (uint16_t)(1u << e);
     for (int f = 0; f < 6; ++f)
-        if (tl_is_fine(T, G->fnbr[f])) t->quarter |= (uint8_t)(1u << f);
+        if (tl_is_fine(fine, G->fnbr[f])) t->quarter |= (uint8_t)(1u << f);
 }
 
 /* Whether coarse cell ci (at c) has an edge on the block's boundary planes
@@ -1463,11 +1469,12 @@ static inline void tl_sub(uint16_t s, int *a, int *b, int *d, int *len) {
 static int tl_loops(tlscratch *T, tlcell *K) {
     const uint64_t key =
         ((uint64_t)K->t.split | (uint64_t)K->t.quarter << 12 | (uint64_t)K->t.inside << 18) + 1;
-    tlloops *L = &T->lcache[(key * 0x9E3779B97F4A7C15ull) >> 52];
-    if (L->key != key) {
+    const size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 52);
+    tlloops *L = &T->lcache[h];
+    if (T->lkey[h] != key) {
         int nloop = 0;
         const int total = lb__tcell_loops(&K->t, L->sub, L->len, &nloop);
-        L->key = key;
+        T->lkey[h] = key;
         L->total = (int16_t)total;
         L->nloop = (uint8_t)nloop;
     }
@@ -1546,7 +1553,7 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
             if (!B->nmask[tl_lat(c, l)]) K->state = TL_FINE;
     }
     if (++T->rstamp == 0) { /* wrapped: clear the stamps once */
-        for (size_t i = 0; i < TL_KEYS; ++i) T->root[i].stamp = 0;
+        for (size_t i = 0; i < TL_KEYS; ++i) T->rdone[i] = 0;
         for (size_t i = 0; i < TL_CHKS; ++i) T->chk[i].stamp = 0;
         T->rstamp = 1;
     }
@@ -1557,13 +1564,16 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
         /* the cells to decide, and the samples their patterns read */
         size_t nq = 0;
         int todo = 0;
+        uint64_t fine = 0;
+        for (int ci = 0; ci < TL_CELLS; ++ci)
+            fine |= (uint64_t)(T->cell[ci].state == TL_FINE) << ci;
         for (int ci = 0; ci < TL_CELLS; ++ci) {
             tlcell *K = &T->cell[ci];
             if ((K->state != TL_TODO && K->state != TL_OK) || !T->dirty[ci]) continue;
             T->dirty[ci] = 0;
             const int c[3] = {ci % TL_SIDE, ci / TL_SIDE % TL_SIDE, ci / (TL_SIDE * TL_SIDE)};
             lb__tcell t;
-            tl_pattern(T, ci, &t);
+            tl_pattern(T, fine, ci, &t);
             if (K->state == TL_OK && t.split == K->t.split && t.quarter == K->t.quarter) continue;
             K->state = TL_TODO;
             K->t = t;
@@ -1623,8 +1633,8 @@ static lb_status tl_decide(const lb_evaluator *ev, const lb__grid *g, lb__block 
                 const size_t qa = tl_lat(c, a), qb = tl_lat(c, b);
                 const uint16_t key = tl_key(qa, d, len);
                 K->key[i] = key;
-                if (T->root[key].stamp == T->rstamp) continue; /* solved, or queued */
-                T->root[key].stamp = T->rstamp;
+                if (T->rdone[key] == T->rstamp) continue; /* solved, or queued */
+                T->rdone[key] = T->rstamp;
                 T->bkey[ne] = key;
                 const int ain = B->vals[qa] < 0.0;
                 const size_t qi = ain ? qa : qb, qo = ain ? qb : qa;
@@ -1825,13 +1835,10 @@ static const uint8_t *tl_known(bctx *C, lb__block *B) {
         const uint32_t w = C->eloc[e];
         const size_t q = ((size_t)((w >> 8) & 15) * TL_D + ((w >> 4) & 15)) * TL_D + (w & 15);
         const int mask = (int)((w >> 12) & 7);
-        const tlroot *R = &T->root[tl_key(q,
-                                          mask == 1   ? 0
-                                          : mask == 2 ? 1
-                                                      : 2,
-                                          w & COARSE_EDGE ? 2 : 1)];
-        T->known[e] = R->stamp == T->rstamp;
+        const uint16_t key = tl_key(q, mask == 1 ? 0 : mask == 2 ? 1 : 2, w & COARSE_EDGE ? 2 : 1);
+        T->known[e] = T->rdone[key] == T->rstamp;
         if (!T->known[e]) continue;
+        const tlroot *R = &T->root[key];
         memcpy(B->vpos + 3 * e, R->pos, 3 * sizeof(double));
         memcpy(B->vnrm + 3 * e, R->nrm, 3 * sizeof(double));
     }

@@ -171,6 +171,15 @@ static unsigned planes(uint16_t s) {
     return m;
 }
 
+/* the cosine between triangle (a, k, b)'s normal and N (its length nl), as
+ * the search below compares it (-1 for a triangle without area) */
+static float tri_cos(const double *pos, int a, int k, int b, const double N[3], double nl) {
+    double t[3];
+    lb__facing(pos + 3 * a, pos + 3 * k, pos + 3 * b, t);
+    const double tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+    return tl > 0 ? (float)((t[0] * N[0] + t[1] * N[1] + t[2] * N[2]) / (tl * nl)) : -1.0f;
+}
+
 int lb__tloop_triangles(const uint16_t *s, const double *pos, int n, uint8_t *tri) {
     if (n < 3 || n > LB__TMAX) return 0;
     unsigned pl[LB__TMAX];
@@ -194,6 +203,32 @@ int lb__tloop_triangles(const uint16_t *s, const double *pos, int n, uint8_t *tr
         tri[2] = 2;
         return 1;
     }
+    if (n == 4) { /* the search below on four vertices: diagonal 1-3 or 0-2 */
+        const float b02 = pl[0] & pl[2] ? -2.0f : tri_cos(pos, 0, 1, 2, N, nl),
+                    b13 = pl[1] & pl[3] ? -2.0f : tri_cos(pos, 1, 2, 3, N, nl);
+        float best = -2.0f;
+        int at = 0;
+        if (!(b13 < -1.5f)) {
+            float c = tri_cos(pos, 0, 1, 3, N, nl);
+            if (b13 < c) c = b13;
+            if (c > best) {
+                best = c;
+                at = 1;
+            }
+        }
+        if (!(b02 < -1.5f)) {
+            float c = tri_cos(pos, 0, 2, 3, N, nl);
+            if (b02 < c) c = b02;
+            if (c > best) {
+                best = c;
+                at = 2;
+            }
+        }
+        if (!at || !(best > 0)) return 0;
+        static const uint8_t T4[2][6] = {{0, 1, 3, 1, 2, 3}, {0, 2, 3, 0, 1, 2}};
+        memcpy(tri, T4[at - 1], 6);
+        return 2;
+    }
     /* best[a][b]: over the triangulations of the sub-polygon a..b whose
      * diagonals keep off the faces, the largest smallest cosine between a
      * triangle's normal and N (2: a side, nothing to cut); at[a][b]: the
@@ -209,14 +244,9 @@ int lb__tloop_triangles(const uint16_t *s, const double *pos, int n, uint8_t *tr
             best[a][b] = -2.0f;
             const int side = a == 0 && b == n - 1;
             if (!side && (pl[a] & pl[b])) continue;
-            const double *A = pos + 3 * a, *B = pos + 3 * b;
             for (int k = a + 1; k < b; ++k) {
                 if (best[a][k] < -1.5f || best[k][b] < -1.5f) continue;
-                double t[3];
-                lb__facing(A, pos + 3 * k, B, t);
-                const double tl = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-                float c =
-                    tl > 0 ? (float)((t[0] * N[0] + t[1] * N[1] + t[2] * N[2]) / (tl * nl)) : -1.0f;
+                float c = tri_cos(pos, a, k, b, N, nl);
                 if (best[a][k] < c) c = best[a][k];
                 if (best[k][b] < c) c = best[k][b];
                 if (c > best[a][b]) {
