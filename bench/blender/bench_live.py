@@ -9,7 +9,7 @@
    interval it returns) until the new mesh is in the Blender mesh. The analytic normals that follow once the
    field is idle (0.3 s later) are timed separately. 15 changes each. The
    same with the add-on's Viewport Simplify preference at 0.5 cells (Coarse
-   First; it ships off), and both again at 128 cells: a blend parameter
+   First, as shipped), and both again at 128 cells: a blend parameter
    remeshes every block, the case where Coarse First gains least.
 2. Next to it, Blender's own metaballs: the same balls (S1 / S2 placement,
    radii matched as in bench/mesh/blender_metaballs.py), polygonized at the
@@ -52,8 +52,10 @@ def report(**kw):
 
 def live_update(name, scene_file, viewport_simplify=0.0, cells=64):
     """the live update of name's blend parameter (every block remeshed);
-    viewport_simplify: the add-on's Viewport Simplify preference (0, as
-    shipped: the unsimplified mesh)"""
+    viewport_simplify: the add-on's Viewport Simplify preference (0: the
+    unsimplified mesh; 0.5 as shipped)"""
+    for o in list(bpy.data.objects):  # alone: the preference remeshes every field
+        bpy.data.objects.remove(o)
     PREFS.viewport_simplify = viewport_simplify
     bpy.ops.libblend.import_scene(filepath=os.path.join(SRC, "scenes", scene_file))
     out = bpy.context.view_layer.objects.active
@@ -83,8 +85,7 @@ def live_update(name, scene_file, viewport_simplify=0.0, cells=64):
            libblend_ms=1000 * statistics.median(p["mesh"] for p in parts),
            apply_ms=1000 * statistics.median(p["apply"] for p in parts))
     if viewport_simplify or cells != 64:
-        bpy.data.objects.remove(out)
-        return None
+        return
     job = live.prepare(out, 64)
     job.run()
     t0 = time.perf_counter()
@@ -99,7 +100,6 @@ def live_update(name, scene_file, viewport_simplify=0.0, cells=64):
         live.update_now(out)
         ts.append(time.perf_counter() - t0)
     report(what="update_now", scene=name, cells=64, median_ms=1000 * statistics.median(ts))
-    return out
 
 
 def metaballs(name, res):
@@ -135,10 +135,10 @@ def metaballs(name, res):
     bpy.data.objects.remove(obj)
 
 
-s1 = live_update("S1", "bench-s1-three-spheres.json")
+live_update("S1", "bench-s1-three-spheres.json")
 live_update("S1", "bench-s1-three-spheres.json", 0.5)
 metaballs("S1", 64)
-s2 = live_update("S2", "bench-s2-64-spheres.json")
+live_update("S2", "bench-s2-64-spheres.json")
 live_update("S2", "bench-s2-64-spheres.json", 0.5)
 metaballs("S2", 64)
 for vs in (0.0, 0.5):  # the same at 128 cells

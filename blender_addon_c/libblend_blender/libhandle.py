@@ -60,7 +60,7 @@ def threads():
     return p.threads if p else 0
 
 
-VIEWPORT_SIMPLIFY = 0.0  # the preference's default (ui.py): off
+VIEWPORT_SIMPLIFY = 0.5  # the preference's default (ui.py)
 
 
 def viewport_simplify():

@@ -21,13 +21,12 @@ class LIBBLEND_AP_preferences(bpy.types.AddonPreferences):
     threads: IntProperty(name="Threads", default=0, min=0, max=256,
                          description="meshing threads (0 = one per CPU, 1 = no extra threads)")
     viewport_simplify: FloatProperty(
-        name="Viewport Simplify", default=0.0, min=0.0, max=1.0, step=5, precision=2,
+        name="Viewport Simplify", default=0.5, min=0.0, max=1.0, step=5, precision=2,
         update=_viewport_simplify_changed,
         description="the viewport's meshes of fields whose Simplify is 0 and Sharp Features off: "
         "cells of twice the size wherever the surface stays within this many cells of the field "
-        "(Coarse First): fewer triangles, faster updates when a primitive moves, slower ones "
-        "when a change remeshes the whole field. Renders, bakes and Apply are not simplified. "
-        "0 = off")
+        "(Coarse First): fewer triangles and faster live updates. Renders, bakes and Apply are "
+        "not simplified. 0 = off")
 
     def draw(self, context):
         col = self.layout.column()

@@ -56,6 +56,16 @@ def enable(spec):
     return pkg, name
 
 
+def viewport_simplify_off(pkg):
+    """Turn the Viewport Simplify preference off, for the tests that
+    compare a viewport mesh with the library's unsimplified mesh; returns
+    its value as shipped, which the caller checks."""
+    p = pkg.libhandle.prefs()
+    shipped = p.viewport_simplify
+    p.viewport_simplify = 0.0
+    return shipped
+
+
 def blender_cmd(spec, work):
     """(argv prefix, env) to start another Blender with the same add-on
     enabled, the way a farm starts one: `--addons NAME`."""

@@ -46,10 +46,11 @@ assert ok, msg
 print("library:", msg)
 lib = libhandle.library()
 check, active, activate = addon_env.check, addon_env.active, addon_env.activate
-# Viewport Simplify ships off (its own section below): viewport meshes are
-# the unsimplified ones the checks compare them with
-check(libhandle.prefs().viewport_simplify == libhandle.VIEWPORT_SIMPLIFY == 0.0,
-      "Viewport Simplify ships off (%r)" % libhandle.prefs().viewport_simplify)
+# Viewport Simplify (on as shipped) off until its own section below: the
+# checks before it compare viewport meshes with unsimplified ones
+VIEWPORT_SHIPPED = addon_env.viewport_simplify_off(lbb)
+check(VIEWPORT_SHIPPED == libhandle.VIEWPORT_SIMPLIFY == 0.5,
+      "Viewport Simplify ships at 0.5 cells (%r)" % VIEWPORT_SHIPPED)
 
 
 def blender_mesh(obj):
@@ -1268,13 +1269,13 @@ check(same_as_full(lat, 96), "Coarse First through the cache: the full remesh's 
 lat.libblend.simplify, lat.libblend.simplify_method = 0.0, "COLLAPSE"
 check(not live.prepare(lat, 96).coarse_first, "Simplify off: no Coarse First")
 
-# Viewport Simplify (an add-on preference, off as shipped) at 0.5 cells:
-# the viewport's mesh of a field without Simplify and Sharp Features is
-# meshed Coarse First (docs/blender.md); renders, bakes and Apply are not
+# Viewport Simplify, the add-on preference as shipped (0.5 cells): the
+# viewport's mesh of a field without Simplify and Sharp Features is meshed
+# Coarse First (docs/blender.md); renders, bakes and Apply are not
 # simplified; the field's own Simplify and Sharp Features take precedence;
 # 0 turns it off; the sidebar says so under Simplify.
 check(live.viewport_simplify(lat) == 0.0, "Viewport Simplify off: nothing for the lattice")
-libhandle.prefs().viewport_simplify = 0.5
+libhandle.prefs().viewport_simplify = VIEWPORT_SHIPPED
 check(live.viewport_simplify(lat) == 0.5, "Viewport Simplify applies to the lattice")
 check(live.update_now(lat)[0], "mesh the lattice's viewport mesh with Viewport Simplify")
 Vv, Fv = blender_mesh(lat)

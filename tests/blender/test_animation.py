@@ -52,6 +52,8 @@ lbb, ADDON_NAME = addon_env.enable(ADDON)
 libhandle, live, tree, bake = lbb.libhandle, lbb.live, lbb.tree, lbb.bake
 print("Blender %s, add-on %s" % (bpy.app.version_string, ADDON_NAME))
 check, active, activate = addon_env.check, addon_env.active, addon_env.activate
+# the viewport meshes below are compared with unsimplified library meshes
+check(addon_env.viewport_simplify_off(lbb) == 0.5, "Viewport Simplify ships at 0.5 cells")
 
 
 def linear(obj, path):

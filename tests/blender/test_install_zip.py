@@ -46,6 +46,13 @@ assert bpy.ops.libblend.add_field() == {"FINISHED"}
 out = bpy.context.view_layer.objects.active
 assert len(out.data.polygons) > 1000, "the default sphere is meshed"
 n_sphere = len(out.data.polygons)
+# as shipped the viewport's mesh is simplified (Viewport Simplify 0.5,
+# Coarse First), the render's is not
+assert libhandle.prefs().viewport_simplify == 0.5, libhandle.prefs().viewport_simplify
+assert live.state_of(out).applied_key == live.prepare(out, out.libblend.preview_resolution,
+                                                      viewport=True).key, "a viewport mesh"
+assert live.prepare(out, 64, viewport=True).coarse_first, "the viewport meshes Coarse First"
+assert not live.prepare(out, 64).coarse_first, "the render does not"
 tree = importlib.import_module(module + ".tree")
 
 # undo / redo: an edit of a setting, then of the tree
