@@ -12,9 +12,11 @@
  * bytes.
  * bench/incremental/run_incremental_bench.py runs it.
  *
- * Usage: bench_incremental BEFORE AFTER RESOLUTION THREADS [--features]
- *                          [--simplify TOL [--coarse-first]] */
+ * Usage: bench_incremental BEFORE AFTER RESOLUTION THREADS
+ *                          [--features | --corner-normals] [--simplify TOL [--coarse-first]] */
 #define _POSIX_C_SOURCE 200809L
+#include "bench_args.h"
+
 #include <libblend/libblend.h>
 
 #include <stdio.h>
@@ -40,21 +42,10 @@ static int same(const lb_mesh *a, const lb_mesh *b) {
 int main(int argc, char **argv) {
     unsigned flags = 0;
     double simplify = 0.0;
-    if (argc > 1 && strcmp(argv[argc - 1], "--coarse-first") == 0) {
-        flags |= LB_MESH_COARSE_FIRST;
-        --argc;
-    }
-    if (argc > 2 && strcmp(argv[argc - 2], "--simplify") == 0) {
-        simplify = atof(argv[argc - 1]);
-        argc -= 2;
-    }
-    if (argc == 6 && strcmp(argv[5], "--features") == 0) {
-        flags |= LB_MESH_FEATURES;
-        --argc;
-    }
+    bench_mesh_args(&argc, argv, &flags, &simplify);
     if (argc != 5) {
-        fprintf(stderr, "usage: bench_incremental BEFORE AFTER RESOLUTION THREADS [--features] "
-                        "[--simplify TOL [--coarse-first]]\n");
+        fprintf(stderr, "usage: bench_incremental BEFORE AFTER RESOLUTION THREADS "
+                        "[--features | --corner-normals] [--simplify TOL [--coarse-first]]\n");
         return 2;
     }
     lb_error e = {LB_OK, ""};

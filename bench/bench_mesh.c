@@ -10,6 +10,8 @@
  * also LB_MESH_CORNER_NORMALS; --simplify: lb_mesh_options.simplify, cells;
  * the options come last) */
 #define _POSIX_C_SOURCE 200809L
+#include "bench_args.h"
+
 #include <libblend/libblend.h>
 
 #include <stdio.h>
@@ -37,21 +39,7 @@ static long rss_kb(void) { /* current resident set, from /proc */
 int main(int argc, char **argv) {
     unsigned flags = 0;
     double simplify = 0.0;
-    if (argc > 1 && strcmp(argv[argc - 1], "--coarse-first") == 0) {
-        flags |= LB_MESH_COARSE_FIRST;
-        --argc;
-    }
-    if (argc > 2 && strcmp(argv[argc - 2], "--simplify") == 0) {
-        simplify = atof(argv[argc - 1]);
-        argc -= 2;
-    }
-    if (argc > 1 && strcmp(argv[argc - 1], "--features") == 0) {
-        flags |= LB_MESH_FEATURES;
-        --argc;
-    } else if (argc > 1 && strcmp(argv[argc - 1], "--corner-normals") == 0) {
-        flags |= LB_MESH_FEATURES | LB_MESH_CORNER_NORMALS;
-        --argc;
-    }
+    bench_mesh_args(&argc, argv, &flags, &simplify);
     if (argc != 4 && argc != 10) {
         fprintf(stderr, "usage: bench_mesh SCENE RESOLUTION THREADS [x0 y0 z0 x1 y1 z1] "
                         "[--features | --corner-normals] [--simplify TOL] [--coarse-first]\n");
