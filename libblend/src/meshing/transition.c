@@ -208,20 +208,14 @@ int lb__tloop_triangles(const uint16_t *s, const double *pos, int n, uint8_t *tr
                     b13 = pl[1] & pl[3] ? -2.0f : tri_cos(pos, 1, 2, 3, N, nl);
         float best = -2.0f;
         int at = 0;
-        if (!(b13 < -1.5f)) {
-            float c = tri_cos(pos, 0, 1, 3, N, nl);
-            if (b13 < c) c = b13;
+        for (int k = 1; k <= 2; ++k) { /* triangle (0, k, 3) and the rest's */
+            const float rest = k == 1 ? b13 : b02;
+            if (rest < -1.5f) continue;
+            float c = tri_cos(pos, 0, k, 3, N, nl);
+            if (rest < c) c = rest;
             if (c > best) {
                 best = c;
-                at = 1;
-            }
-        }
-        if (!(b02 < -1.5f)) {
-            float c = tri_cos(pos, 0, 2, 3, N, nl);
-            if (b02 < c) c = b02;
-            if (c > best) {
-                best = c;
-                at = 2;
+                at = k;
             }
         }
         if (!at || !(best > 0)) return 0;
