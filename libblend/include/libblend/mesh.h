@@ -202,10 +202,11 @@ LB_API void lb_mesh_free(lb_mesh *mesh);
  * last mesh, plus each block's plan and shared faces and the arrays a run
  * needs only while it runs, kept for the next (on a 512-sphere lattice at
  * 256 cells 14 of 234 MiB; with LB_MESH_COARSE_FIRST also each thread's
- * decision tables, about 3 MiB a thread; lb_mesh_cache_stats.bytes). Use one cache from
+ * decision tables, about 3 MiB a thread, at most 64; lb_mesh_cache_stats.bytes). Use one cache from
  * one thread at a time (lb_mesh_create_cached uses opt->threads
  * internally); several caches may be used at once. A failed or cancelled
- * run leaves the cache as it was. */
+ * run leaves the cache's blocks as they were (the arrays it kept for the
+ * next run may have grown). */
 typedef struct lb_mesh_cache lb_mesh_cache;
 
 typedef struct lb_mesh_cache_stats {
