@@ -104,7 +104,7 @@ struct lb_mesh_cache {
     /* the threads' coarse-first scratch, kept for the next run
      * (lb__cache_tl_take, lb__cache_tl_keep) */
     void *tl[LB__TL_KEEP];
-    size_t ntl;
+    size_t ntl, tl_bytes; /* how many, and their lb__tl_bytes */
 };
 
 /* The matching of an evaluator against the cache (mesher.c's rule):
@@ -732,7 +732,7 @@ lb_status lb__cache_commit(lb_mesh_cache *C, lb__cmatch *M, const lb__grid *g, l
     slab_settle(C);
     for (size_t i = 0; i < n; ++i) bytes += cblock_bytes(&blocks[i]);
     for (size_t i = 0; i < nnodes; ++i) bytes += cblock_bytes(&nodes[i]);
-    bytes += spare_bytes(C) + run_bytes(C) + C->ntl * lb__tl_bytes() + C->slab_bytes +
+    bytes += spare_bytes(C) + run_bytes(C) + C->tl_bytes + C->slab_bytes +
              (C->slabcap + C->idlecap) * sizeof(lb__slab *) +
              (C->nslabs + C->nidle) * sizeof(lb__slab);
     C->stats.blocks = n;
@@ -781,8 +781,10 @@ void lb__cache_run_keep(lb_mesh_cache *C, int slot, void *p, size_t bytes) {
 
 void *lb__cache_tl_take(lb_mesh_cache *C) {
     if (!C->ntl) return NULL;
-    C->stats.bytes -= lb__tl_bytes();
-    return C->tl[--C->ntl];
+    void *tl = C->tl[--C->ntl];
+    C->tl_bytes -= lb__tl_bytes(tl);
+    C->stats.bytes -= lb__tl_bytes(tl);
+    return tl;
 }
 
 void lb__cache_tl_keep(lb_mesh_cache *C, void *tl) {
@@ -792,7 +794,8 @@ void lb__cache_tl_keep(lb_mesh_cache *C, void *tl) {
         return;
     }
     C->tl[C->ntl++] = tl;
-    C->stats.bytes += lb__tl_bytes();
+    C->tl_bytes += lb__tl_bytes(tl);
+    C->stats.bytes += lb__tl_bytes(tl);
 }
 
 /* ---- the public side ---- */

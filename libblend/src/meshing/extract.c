@@ -1177,6 +1177,7 @@ struct tlscratch {
         uint32_t stamp, info;
     } chk[TL_CHKS];
     uint32_t nchk; /* entries made in this block (at most TL_CHKS / 2) */
+    size_t bytes;  /* all of it, as tl_new allocated it (lb__tl_bytes) */
 };
 typedef struct tlscratch tlscratch;
 
@@ -1204,24 +1205,30 @@ void lb__tl_free(void *tl) {
     tl_free(tl);
 }
 
-size_t lb__tl_bytes(void) {
-    return sizeof(tlscratch) + TL_NODES * sizeof(size_t) + 20 * TL_EDGES * sizeof(double) +
-           14 * TL_POINTS * sizeof(double) + TL_POINTS * (3 + sizeof(size_t) + sizeof(uint32_t)) +
-           EMAP_SIZE;
+size_t lb__tl_bytes(const void *tl) {
+    return ((const tlscratch *)tl)->bytes;
+}
+
+/* malloc(n), n added to *sum */
+static void *tl_alloc(size_t n, size_t *sum) {
+    *sum += n;
+    return malloc(n);
 }
 
 static tlscratch *tl_new(void) {
     tlscratch *T = calloc(1, sizeof *T);
     if (!T) return NULL;
-    T->q = malloc(TL_NODES * sizeof *T->q);
-    T->ea = malloc(20 * TL_EDGES * sizeof *T->ea);
-    T->x = malloc(14 * TL_POINTS * sizeof *T->x);
-    T->pcell = malloc(TL_POINTS * sizeof *T->pcell);
-    T->pcell2 = malloc(TL_POINTS * sizeof *T->pcell2);
-    T->pslot = malloc(TL_POINTS * sizeof *T->pslot);
-    T->poct = malloc(TL_POINTS * sizeof *T->poct);
-    T->pord = malloc(TL_POINTS * sizeof *T->pord);
-    T->known = malloc(EMAP_SIZE);
+    size_t *sum = &T->bytes;
+    *sum = sizeof *T;
+    T->q = tl_alloc(TL_NODES * sizeof *T->q, sum);
+    T->ea = tl_alloc(20 * TL_EDGES * sizeof *T->ea, sum);
+    T->x = tl_alloc(14 * TL_POINTS * sizeof *T->x, sum);
+    T->pcell = tl_alloc(TL_POINTS * sizeof *T->pcell, sum);
+    T->pcell2 = tl_alloc(TL_POINTS * sizeof *T->pcell2, sum);
+    T->pslot = tl_alloc(TL_POINTS * sizeof *T->pslot, sum);
+    T->poct = tl_alloc(TL_POINTS * sizeof *T->poct, sum);
+    T->pord = tl_alloc(TL_POINTS * sizeof *T->pord, sum);
+    T->known = tl_alloc(EMAP_SIZE, sum);
     if (!T->q || !T->ea || !T->x || !T->pcell || !T->pcell2 || !T->pslot || !T->poct || !T->pord ||
         !T->known) {
         tl_free(T);

@@ -252,7 +252,7 @@ LB_INTERNAL void lb__cache_run_keep(lb_mesh_cache *C, int slot, void *p, size_t 
 LB_INTERNAL void *lb__cache_tl_take(lb_mesh_cache *C);
 LB_INTERNAL void lb__cache_tl_keep(lb_mesh_cache *C, void *tl);
 LB_INTERNAL void lb__tl_free(void *tl);
-LB_INTERNAL size_t lb__tl_bytes(void);
+LB_INTERNAL size_t lb__tl_bytes(const void *tl);
 
 /* The facing of triangle (a, b, c): (b - a) x (c - a), not normalised
  * (features.c's flips and folds, corners.c). */
