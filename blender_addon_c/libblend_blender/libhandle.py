@@ -60,7 +60,7 @@ def threads():
     return p.threads if p else 0
 
 
-VIEWPORT_SIMPLIFY = 0.5  # the preference's default (ui.py)
+VIEWPORT_SIMPLIFY = 0.5  # the Viewport Simplify preference's default (ui.py), cells
 
 
 def viewport_simplify():

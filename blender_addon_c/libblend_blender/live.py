@@ -397,7 +397,7 @@ def viewport_simplify(output):
     s = output.libblend
     if s.simplify > 0.0 or s.sharp_features:
         return 0.0
-    return max(0.0, min(1.0, float(libhandle.viewport_simplify())))
+    return float(libhandle.viewport_simplify())
 
 
 def prepare(output, resolution, depsgraph=None, viewport=False):
@@ -412,8 +412,9 @@ def prepare(output, resolution, depsgraph=None, viewport=False):
     bmin, bmax = _region(output)
     s = output.libblend
     simplify, coarse = s.simplify, s.simplify_method == "COARSE"
-    if viewport and viewport_simplify(output) > 0.0:
-        simplify, coarse = viewport_simplify(output), True
+    vs = viewport_simplify(output) if viewport else 0.0
+    if vs > 0.0:
+        simplify, coarse = vs, True
     return _Job(lib, text, output.name + ".json", bmin, bmax, resolution,
                 s.open_boundary, libhandle.threads(), paths,
                 fit=s.fit_region, features=s.sharp_features,

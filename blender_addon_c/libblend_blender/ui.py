@@ -21,7 +21,8 @@ class LIBBLEND_AP_preferences(bpy.types.AddonPreferences):
     threads: IntProperty(name="Threads", default=0, min=0, max=256,
                          description="meshing threads (0 = one per CPU, 1 = no extra threads)")
     viewport_simplify: FloatProperty(
-        name="Viewport Simplify", default=0.5, min=0.0, max=1.0, step=5, precision=2,
+        name="Viewport Simplify", default=libhandle.VIEWPORT_SIMPLIFY, min=0.0, max=1.0, step=5,
+        precision=2,
         update=_viewport_simplify_changed,
         description="the viewport's meshes of fields whose Simplify is 0 and Sharp Features off: "
         "cells of twice the size wherever the surface stays within this many cells of the field "
